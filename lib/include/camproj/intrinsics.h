@@ -1,0 +1,64 @@
+// Pinhole intrinsics with optional two-term radial distortion (docs/conventions.md).
+//
+//   x = X/Z, y = Y/Z                         point_in_cam -> normalized image coordinates
+//   r2 = x^2 + y^2, d = 1 + k1 r2 + k2 r2^2   radial distortion (OpenCV's k1, k2; p = k3 = 0)
+//   u = fx d x + skew d y + cx                pixel, in the pixel origin the intrinsics are in
+//   v = fy d y + cy
+//
+// K = [fx skew cx; 0 fy cy; 0 0 1]. Unless a function takes a PixelOrigin, cx and cy are in the
+// default kCenter convention; convert with ConvertPixelOrigin below.
+#ifndef CAMPROJ_INTRINSICS_H_
+#define CAMPROJ_INTRINSICS_H_
+
+#include <Eigen/Core>
+
+#include "camproj/conventions.h"
+
+namespace camproj {
+
+struct Intrinsics {
+  double fx = 1.0;    // px
+  double fy = 1.0;    // px
+  double cx = 0.0;    // px
+  double cy = 0.0;    // px
+  double skew = 0.0;  // px; K(0,1)
+  double k1 = 0.0;    // radial, on normalized coordinates
+  double k2 = 0.0;
+
+  // Throws std::invalid_argument naming the field unless all are finite and fx, fy > 0.
+  void Check() const;
+  Eigen::Matrix3d K() const;
+  bool HasDistortion() const { return k1 != 0.0 || k2 != 0.0; }
+  // The same camera without distortion (what a GL projection matrix can represent).
+  Intrinsics Pinhole() const;
+};
+
+// Intrinsics from a 3x3 upper-triangular K with K(2,2) != 0 (scaled to 1); throws otherwise.
+Intrinsics IntrinsicsFromK(const Eigen::Matrix3d& K);
+
+// cx, cy shifted by PixelOriginShift(from, to); everything else unchanged.
+Intrinsics ConvertPixelOrigin(const Intrinsics& intrinsics, PixelOrigin from, PixelOrigin to);
+
+// Pixel of normalized image coordinates (x, y) = (X/Z, Y/Z). `intrinsics` points to
+// [fx, fy, cx, cy, skew, k1, k2]. Templated so Ceres' Jets share the library's model.
+template <typename T>
+inline void PixelFromNormalized(const T* intrinsics, const T& x, const T& y, T* pixel) {
+  const T r2 = x * x + y * y;
+  const T d = T(1.0) + r2 * (intrinsics[5] + r2 * intrinsics[6]);
+  const T xd = d * x;
+  const T yd = d * y;
+  pixel[0] = intrinsics[0] * xd + intrinsics[4] * yd + intrinsics[2];
+  pixel[1] = intrinsics[1] * yd + intrinsics[3];
+}
+
+// Pixel of a point in the cam frame. Throws std::invalid_argument unless point_in_cam.z() > 0.
+Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d& point_in_cam);
+
+// The ray through `pixel`, as (x, y, 1) in the cam frame: the inverse of PixelFromCam up to depth.
+// With distortion it inverts d by Newton's method to 1e-14 in normalized units, and throws
+// std::domain_error where the distortion is not invertible (the radial map folds over).
+Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vector2d& pixel);
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_INTRINSICS_H_

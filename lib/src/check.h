@@ -1,0 +1,45 @@
+// Private helpers for argument checks: messages that name the offending value.
+#ifndef CAMPROJ_SRC_CHECK_H_
+#define CAMPROJ_SRC_CHECK_H_
+
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace camproj {
+namespace internal {
+
+template <typename... Args>
+std::string Concat(const Args&... args) {
+  std::ostringstream out;
+  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  (out << ... << args);
+  return out.str();
+}
+
+// Throws std::invalid_argument with the concatenated message unless `condition`.
+template <typename... Args>
+void Require(bool condition, const Args&... message) {
+  if (!condition) throw std::invalid_argument(Concat(message...));
+}
+
+// Throws unless `value` is finite; the message names it: "<name> must be finite, got nan".
+inline void RequireFinite(double value, const char* name) {
+  Require(std::isfinite(value), name, " must be finite, got ", value);
+}
+
+template <typename Derived>
+void RequireFiniteAll(const Derived& m, const char* name) {
+  for (int i = 0; i < m.size(); ++i) {
+    Require(std::isfinite(m.data()[i]), name, " must be finite, got ", m.data()[i],
+            " at index ", i);
+  }
+}
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_CHECK_H_

@@ -1,0 +1,256 @@
+#include "camproj/gl.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <glm/ext/matrix_clip_space.hpp>
+#include <gtest/gtest.h>
+
+#include "camproj/look_at.h"
+#include "glm_compare.h"
+#include "test_scenes.h"
+
+namespace camproj {
+namespace {
+
+using testing::kExactRelative;
+
+// The CV path K [R|t] and the GL path P V X -> divide -> viewport -> pixel are different
+// algebra on the same numbers; pixels up to ~1e4 with focal lengths up to ~2e5 px keep
+// their difference at ~1e-11..1e-10 px.
+constexpr double kPixelAgreement = 1e-9;
+
+const GlDepth kAllDepths[] = {
+    {ClipDepth::kNegativeOneToOne, false},
+    {ClipDepth::kZeroToOne, false},
+    {ClipDepth::kNegativeOneToOne, true},
+    {ClipDepth::kZeroToOne, true},
+};
+
+Frustum RandomFrustum(std::mt19937_64& rng) {
+  Frustum f;
+  f.z_near = testing::LogUniform(rng, 1e-3, 10);
+  f.z_far = f.z_near * testing::LogUniform(rng, 1.01, 1e4);
+  f.left = testing::Uniform(rng, -2, 1) * f.z_near;
+  f.right = f.left + testing::LogUniform(rng, 0.01, 3) * f.z_near;
+  f.bottom = testing::Uniform(rng, -2, 1) * f.z_near;
+  f.top = f.bottom + testing::LogUniform(rng, 0.01, 3) * f.z_near;
+  return f;
+}
+
+TEST(GlTest, FrustumEqualsGlm) {
+  std::mt19937_64 rng(1);
+  for (int i = 0; i < 1000; ++i) {
+    const Frustum f = RandomFrustum(rng);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEye(f),
+                  testing::FromGlm(glm::frustumRH_NO(f.left, f.right, f.bottom, f.top, f.z_near, f.z_far))),
+              kExactRelative);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEye(f, {ClipDepth::kZeroToOne, false}),
+                  testing::FromGlm(glm::frustumRH_ZO(f.left, f.right, f.bottom, f.top, f.z_near, f.z_far))),
+              kExactRelative);
+  }
+}
+
+TEST(GlTest, PerspectiveAndInfinitePerspectiveEqualGlm) {
+  std::mt19937_64 rng(2);
+  for (int i = 0; i < 1000; ++i) {
+    Perspective p;
+    p.fovy_deg = testing::Uniform(rng, 0.1, 179);
+    p.aspect = testing::LogUniform(rng, 0.2, 5);
+    p.z_near = testing::LogUniform(rng, 1e-4, 10);
+    p.z_far = p.z_near * testing::LogUniform(rng, 1.01, 1e6);
+    const double fovy = p.fovy_deg * M_PI / 180.0;
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEye(p), testing::FromGlm(glm::perspectiveRH_NO(fovy, p.aspect, p.z_near, p.z_far))),
+              kExactRelative);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEye(p, {ClipDepth::kZeroToOne, false}),
+                  testing::FromGlm(glm::perspectiveRH_ZO(fovy, p.aspect, p.z_near, p.z_far))),
+              kExactRelative);
+    p.z_far = kInfinity;
+    // glm 0.9.9 has only the NO infinite perspective; ZO's limit is checked in
+    // DepthConventionsMapNearAndFarWhereStated.
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEye(p), testing::FromGlm(glm::infinitePerspectiveRH(fovy, p.aspect, p.z_near))),
+              kExactRelative);
+  }
+}
+
+TEST(GlTest, OrthoEqualsGlm) {
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 1000; ++i) {
+    const Ortho o{testing::Uniform(rng, -10, 0), testing::Uniform(rng, 0.1, 10),
+                  testing::Uniform(rng, -10, 0), testing::Uniform(rng, 0.1, 10),
+                  testing::Uniform(rng, -5, 1), testing::Uniform(rng, 2, 100)};
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEyeOrtho(o),
+                  testing::FromGlm(glm::orthoRH_NO(o.left, o.right, o.bottom, o.top, o.z_near, o.z_far))),
+              kExactRelative);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEyeOrtho(o, ClipDepth::kZeroToOne),
+                  testing::FromGlm(glm::orthoRH_ZO(o.left, o.right, o.bottom, o.top, o.z_near, o.z_far))),
+              kExactRelative);
+  }
+}
+
+TEST(GlTest, DepthConventionsMapNearAndFarWhereStated) {
+  const double n = 0.25;
+  const double f = 40;
+  for (const GlDepth& depth : kAllDepths) {
+    const bool zo = depth.clip_depth == ClipDepth::kZeroToOne;
+    const double near_ndc = depth.reversed_z ? 1.0 : (zo ? 0.0 : -1.0);
+    const double far_ndc = depth.reversed_z ? (zo ? 0.0 : -1.0) : 1.0;
+    for (const double far : {f, kInfinity}) {
+      const Eigen::Matrix4d m = ClipFromGlEye(Frustum{-n, n, -n, n, n, far}, depth);
+      auto ndc_z = [&](double z_eye) {
+        const Eigen::Vector4d clip = m * Eigen::Vector4d(0, 0, z_eye, 1);
+        return clip.z() / clip.w();
+      };
+      EXPECT_NEAR(ndc_z(-n), near_ndc, 1e-15);
+      if (std::isfinite(far)) {
+        EXPECT_NEAR(ndc_z(-far), far_ndc, 1e-14);
+      } else {
+        // The limit at infinity: approached as n/z.
+        EXPECT_NEAR(ndc_z(-1e12), far_ndc, 1e-12);
+      }
+      const DepthRange range = DepthRangeFromClipFromGlEye(m, depth);
+      EXPECT_NEAR(range.z_near, n, n * kExactRelative);
+      if (std::isfinite(far)) {
+        EXPECT_NEAR(range.z_far, far, far * kExactRelative);
+      } else {
+        EXPECT_EQ(range.z_far, kInfinity);
+      }
+    }
+  }
+}
+
+// The central property: K [R|t] and the GL pipeline put every point on the same pixel.
+TEST(GlTest, GlPipelineAgreesWithPinholeProjection) {
+  std::mt19937_64 rng(4);
+  double worst = 0.0;
+  for (int i = 0; i < 1000; ++i) {
+    const testing::RandomCamera camera = testing::MakeRandomCamera(rng);
+    const double z_near = testing::LogUniform(rng, 1e-2, 1);
+    const double z_far = z_near * testing::LogUniform(rng, 10, 1e4);
+    const Eigen::Matrix4d view = GlEyeFromWorld(camera.cam_from_world);
+    for (int j = 0; j < 4; ++j) {
+      const double depth = testing::LogUniform(rng, z_near, std::min(z_far, 1e3));
+      const Eigen::Vector3d point_in_world = testing::WorldPointAtPixel(
+          camera, testing::RandomPixelInImage(rng, camera.size), depth);
+      const Eigen::Vector2d cv_pixel =
+          PixelFromCam(camera.intrinsics, camera.cam_from_world * point_in_world);
+      for (const GlDepth& depth_convention : kAllDepths) {
+        for (const bool infinite : {false, true}) {
+          for (const PixelOrigin origin : {PixelOrigin::kCenter, PixelOrigin::kCorner}) {
+            const Intrinsics k = ConvertPixelOrigin(camera.intrinsics, PixelOrigin::kCenter, origin);
+            const Eigen::Matrix4d projection = ClipFromGlEye(
+                k, camera.size, z_near, infinite ? kInfinity : z_far, depth_convention, origin);
+            const GlPixel gl = GlPixelFromWorld(projection, view, point_in_world, camera.size,
+                                                depth_convention.clip_depth, origin);
+            const Eigen::Vector2d expected =
+                ConvertPixelOrigin(cv_pixel, PixelOrigin::kCenter, origin);
+            const double error = (gl.pixel - expected).norm();
+            worst = std::max(worst, error);
+            ASSERT_LT(error, kPixelAgreement)
+                << "camera " << i << " fx " << k.fx << " cx " << k.cx << " skew " << k.skew;
+            // Points between near and far land inside the depth range.
+            EXPECT_GE(gl.window_depth, -1e-12);
+            EXPECT_LE(gl.window_depth, 1.0 + 1e-12);
+          }
+        }
+      }
+    }
+  }
+  std::ostringstream worst_text;
+  worst_text << worst;
+  RecordProperty("worst_pixel_error", worst_text.str());
+}
+
+TEST(GlTest, IntrinsicsRoundTripThroughTheProjectionMatrixAndTheFrustum) {
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 1000; ++i) {
+    const testing::RandomCamera camera = testing::MakeRandomCamera(rng);
+    const Intrinsics& k = camera.intrinsics;
+    const double w = camera.size.width;
+    const double h = camera.size.height;
+    for (const GlDepth& depth : kAllDepths) {
+      for (const PixelOrigin origin : {PixelOrigin::kCenter, PixelOrigin::kCorner}) {
+        const Eigen::Matrix4d m = ClipFromGlEye(k, camera.size, 0.5, 50, depth, origin);
+        // Any positive overall scale describes the same projection.
+        const Intrinsics back = IntrinsicsFromClipFromGlEye(3.0 * m, camera.size, origin);
+        EXPECT_NEAR(back.fx, k.fx, kExactRelative * k.fx);
+        EXPECT_NEAR(back.fy, k.fy, kExactRelative * k.fy);
+        EXPECT_NEAR(back.cx, k.cx, kExactRelative * std::max(std::abs(k.cx), w));
+        EXPECT_NEAR(back.cy, k.cy, kExactRelative * std::max(std::abs(k.cy), h));
+        EXPECT_NEAR(back.skew, k.skew, kExactRelative * k.fx);
+        Intrinsics no_skew = k;
+        no_skew.skew = 0.0;
+        const Eigen::Matrix4d unskewed = ClipFromGlEye(no_skew, camera.size, 0.5, 50, depth, origin);
+        const Frustum frustum = FrustumFromClipFromGlEye(unskewed, depth);
+        const Frustum expected = FrustumFromIntrinsics(no_skew, camera.size, 0.5, 50, origin);
+        const double scale = std::max(expected.right - expected.left, expected.top - expected.bottom);
+        EXPECT_NEAR(frustum.left, expected.left, kExactRelative * 10 * scale);
+        EXPECT_NEAR(frustum.right, expected.right, kExactRelative * 10 * scale);
+        EXPECT_NEAR(frustum.bottom, expected.bottom, kExactRelative * 10 * scale);
+        EXPECT_NEAR(frustum.top, expected.top, kExactRelative * 10 * scale);
+        EXPECT_NEAR(frustum.z_near, 0.5, 0.5 * kExactRelative);
+        EXPECT_NEAR(frustum.z_far, 50, 50 * kExactRelative * 10);
+      }
+    }
+  }
+}
+
+TEST(GlTest, ViewMatrixRoundTripsAndIsTheGlEyeFrame) {
+  std::mt19937_64 rng(6);
+  for (int i = 0; i < 100; ++i) {
+    const testing::RandomCamera camera = testing::MakeRandomCamera(rng);
+    const Eigen::Matrix4d view = GlEyeFromWorld(camera.cam_from_world);
+    const Rigid3 back = CamFromWorldFromGlEyeFromWorld(view);
+    EXPECT_LT((back.rotation - camera.cam_from_world.rotation).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_LT((back.translation - camera.cam_from_world.translation).norm(), 1e-14);
+    // A point ahead of the CV camera is at negative z in GL eye space.
+    const Eigen::Vector3d ahead = Inverse(camera.cam_from_world) * Eigen::Vector3d(0.1, 0.2, 3.0);
+    const Eigen::Vector4d eye = view * ahead.homogeneous();
+    EXPECT_NEAR(eye.z(), -3.0, 1e-12);
+    EXPECT_NEAR(eye.y(), -0.2, 1e-12);
+  }
+}
+
+TEST(GlTest, MalformedMatricesAreRefusedWithTheEntryNamed) {
+  Intrinsics k;
+  k.fx = k.fy = 500;
+  k.cx = 320;
+  k.cy = 240;
+  const ImageSize size{640, 480};
+  try {
+    IntrinsicsFromClipFromGlEye(ClipFromGlEyeOrtho(Ortho{}), size);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("row 3, col 2"), std::string::npos) << e.what();
+  }
+  Eigen::Matrix4d m = ClipFromGlEye(k, size, 1, 10);
+  m(1, 0) = 0.1;
+  EXPECT_THROW(IntrinsicsFromClipFromGlEye(m, size), std::invalid_argument);
+  m = ClipFromGlEye(k, size, 1, 10);
+  m(2, 2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(IntrinsicsFromClipFromGlEye(m, size), std::invalid_argument);
+  // Reading an NO matrix as reversed-Z gives no valid near/far: refused, not a wrong range.
+  EXPECT_THROW(DepthRangeFromClipFromGlEye(ClipFromGlEye(k, size, 1, 10), {ClipDepth::kZeroToOne, true}),
+               std::invalid_argument);
+  Intrinsics distorted = k;
+  distorted.k1 = -0.1;
+  EXPECT_THROW(ClipFromGlEye(distorted, size, 1, 10), std::invalid_argument);
+  EXPECT_NO_THROW(ClipFromGlEye(distorted.Pinhole(), size, 1, 10));
+  k.skew = 5;
+  EXPECT_THROW(FrustumFromClipFromGlEye(ClipFromGlEye(k, size, 1, 10)), std::invalid_argument);
+  EXPECT_THROW(ClipFromGlEye(k, size, 0.0, 10), std::invalid_argument);
+  EXPECT_THROW(ClipFromGlEye(k, size, 1, 0.5), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace camproj

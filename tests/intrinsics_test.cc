@@ -1,0 +1,110 @@
+#include "camproj/intrinsics.h"
+
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "test_scenes.h"
+
+namespace camproj {
+namespace {
+
+using testing::kExactRelative;
+
+// Newton's undistortion stops at a 1e-14 step in normalized units; times a focal length of
+// ~1e3 px and a few roundings that is ~1e-10 px.
+constexpr double kUndistortPixelTolerance = 1e-9;
+
+TEST(IntrinsicsTest, HandComputedProjection) {
+  Intrinsics k;
+  k.fx = 800;
+  k.fy = 600;
+  k.cx = 320;
+  k.cy = 240;
+  k.skew = 10;
+  // x = 0.5, y = 0.25: u = 800*0.5 + 10*0.25 + 320 = 722.5, v = 600*0.25 + 240 = 390.
+  const Eigen::Vector2d pixel = PixelFromCam(k, Eigen::Vector3d(1.0, 0.5, 2.0));
+  EXPECT_DOUBLE_EQ(pixel.x(), 722.5);
+  EXPECT_DOUBLE_EQ(pixel.y(), 390.0);
+  k.k1 = 0.1;
+  k.k2 = 0.01;
+  // r2 = 0.3125, d = 1 + 0.1*0.3125 + 0.01*0.3125^2 = 1.0322265625.
+  const double d = 1.0322265625;
+  const Eigen::Vector2d distorted = PixelFromCam(k, Eigen::Vector3d(1.0, 0.5, 2.0));
+  EXPECT_DOUBLE_EQ(distorted.x(), 800 * d * 0.5 + 10 * d * 0.25 + 320);
+  EXPECT_DOUBLE_EQ(distorted.y(), 600 * d * 0.25 + 240);
+}
+
+TEST(IntrinsicsTest, KRoundTripsAndPixelOriginShiftsThePrincipalPoint) {
+  Intrinsics k;
+  k.fx = 1000;
+  k.fy = 990;
+  k.cx = 959.5;
+  k.cy = 539.5;
+  k.skew = 1.5;
+  const Intrinsics back = IntrinsicsFromK(2.0 * k.K());
+  EXPECT_DOUBLE_EQ(back.fx, k.fx);
+  EXPECT_DOUBLE_EQ(back.skew, k.skew);
+  EXPECT_DOUBLE_EQ(back.cy, k.cy);
+  const Intrinsics corner = ConvertPixelOrigin(k, PixelOrigin::kCenter, PixelOrigin::kCorner);
+  EXPECT_EQ(corner.cx, 960.0);
+  EXPECT_EQ(corner.cy, 540.0);
+  EXPECT_EQ(corner.fx, k.fx);
+}
+
+TEST(IntrinsicsTest, RayFromPixelInvertsProjection) {
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 1000; ++i) {
+    Intrinsics k;
+    k.fx = testing::LogUniform(rng, 100, 10000);
+    k.fy = k.fx * testing::Uniform(rng, 0.8, 1.25);
+    k.cx = testing::Uniform(rng, 0, 2000);
+    k.cy = testing::Uniform(rng, 0, 2000);
+    k.skew = testing::Uniform(rng, -0.1, 0.1) * k.fx;
+    const bool distorted = i % 2 == 1;
+    if (distorted) {
+      k.k1 = testing::Uniform(rng, -0.3, 0.3);
+      k.k2 = testing::Uniform(rng, -0.05, 0.05);
+    }
+    // Normalized radius below 0.8 keeps d increasing for these k1, k2.
+    const Eigen::Vector3d point(testing::Uniform(rng, -0.5, 0.5), testing::Uniform(rng, -0.5, 0.5),
+                                1.0);
+    const double depth = testing::LogUniform(rng, 0.01, 100);
+    const Eigen::Vector2d pixel = PixelFromCam(k, depth * point);
+    const Eigen::Vector3d ray = CamRayFromPixel(k, pixel);
+    EXPECT_EQ(ray.z(), 1.0);
+    const Eigen::Vector2d reprojected = PixelFromCam(k, ray);
+    EXPECT_LT((reprojected - pixel).norm(), distorted ? kUndistortPixelTolerance
+                                                      : kExactRelative * pixel.norm())
+        << "case " << i;
+  }
+}
+
+TEST(IntrinsicsTest, UndistortionRefusesWhereTheRadialMapFolds) {
+  Intrinsics k;
+  k.fx = k.fy = 500;
+  k.cx = k.cy = 250;
+  k.k1 = -0.5;  // d r / d r_u = 1 - 1.5 r^2 vanishes at r = 0.816: rd peaks at 0.544.
+  EXPECT_THROW(CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 0.6, 250)), std::domain_error);
+}
+
+TEST(IntrinsicsTest, BadValuesAreNamed) {
+  Intrinsics k;
+  k.fx = -1;
+  try {
+    k.Check();
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fx"), std::string::npos) << e.what();
+  }
+  k.fx = 1;
+  k.cy = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(k.Check(), std::invalid_argument);
+  EXPECT_THROW(PixelFromCam(Intrinsics{}, Eigen::Vector3d(0, 0, -1)), std::invalid_argument);
+  EXPECT_THROW(PixelFromCam(Intrinsics{}, Eigen::Vector3d(0, 0, 0)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace camproj

@@ -1,0 +1,87 @@
+// Seeded random cameras and scenes for the property tests, and the named tolerances they use.
+#ifndef CAMPROJ_TESTS_TEST_SCENES_H_
+#define CAMPROJ_TESTS_TEST_SCENES_H_
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "camproj/conventions.h"
+#include "camproj/intrinsics.h"
+#include "camproj/pose.h"
+
+namespace camproj {
+namespace testing {
+
+// Exact algebra in double: a few dozen roundings of unit-sized quantities.
+inline constexpr double kExactRelative = 1e-12;
+
+inline double Uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+// log-uniform in [lo, hi], for scales such as focal lengths spanning decades.
+inline double LogUniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::exp(Uniform(rng, std::log(lo), std::log(hi)));
+}
+
+inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized().toRotationMatrix();
+}
+
+struct RandomCameraOptions {
+  double min_fov_deg = 1.0;          // horizontal field of view range (narrow to wide)
+  double max_fov_deg = 150.0;
+  double max_aspect_ratio = 2.0;     // fy/fx in [1/r, r]
+  double max_principal_offset = 1.0; // cx, cy within the image +- this many image sizes
+  double max_skew_ratio = 0.2;       // |skew| <= this * fx
+  double max_center_distance = 10.0; // camera centre within this radius of the origin
+};
+
+struct RandomCamera {
+  ImageSize size;
+  Intrinsics intrinsics;  // kCenter
+  Rigid3 cam_from_world;
+};
+
+inline RandomCamera MakeRandomCamera(std::mt19937_64& rng, const RandomCameraOptions& options = {}) {
+  constexpr double kPi = 3.14159265358979323846;
+  RandomCamera camera;
+  camera.size.width = static_cast<int>(Uniform(rng, 32, 4096));
+  camera.size.height = static_cast<int>(Uniform(rng, 32, 4096));
+  const double fov = Uniform(rng, options.min_fov_deg, options.max_fov_deg) * kPi / 180.0;
+  Intrinsics& k = camera.intrinsics;
+  k.fx = 0.5 * camera.size.width / std::tan(0.5 * fov);
+  k.fy = k.fx * LogUniform(rng, 1.0 / options.max_aspect_ratio, options.max_aspect_ratio);
+  const double w = camera.size.width;
+  const double h = camera.size.height;
+  k.cx = Uniform(rng, -options.max_principal_offset * w, (1.0 + options.max_principal_offset) * w);
+  k.cy = Uniform(rng, -options.max_principal_offset * h, (1.0 + options.max_principal_offset) * h);
+  k.skew = Uniform(rng, -options.max_skew_ratio, options.max_skew_ratio) * k.fx;
+  const Eigen::Vector3d center =
+      options.max_center_distance *
+      Eigen::Vector3d(Uniform(rng, -1, 1), Uniform(rng, -1, 1), Uniform(rng, -1, 1));
+  camera.cam_from_world = CamFromWorldFromCenter(RandomRotation(rng), center);
+  return camera;
+}
+
+// A world point that projects to `pixel` (kCenter) at depth z_cam = depth.
+inline Eigen::Vector3d WorldPointAtPixel(const RandomCamera& camera, const Eigen::Vector2d& pixel,
+                                         double depth) {
+  const Eigen::Vector3d ray = CamRayFromPixel(camera.intrinsics, pixel);
+  return Inverse(camera.cam_from_world) * (depth * ray);
+}
+
+// A pixel anywhere in the image (to the outer edges), kCenter.
+inline Eigen::Vector2d RandomPixelInImage(std::mt19937_64& rng, const ImageSize& size) {
+  return {Uniform(rng, -0.5, size.width - 0.5), Uniform(rng, -0.5, size.height - 0.5)};
+}
+
+}  // namespace testing
+}  // namespace camproj
+
+#endif  // CAMPROJ_TESTS_TEST_SCENES_H_
