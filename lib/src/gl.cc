@@ -84,7 +84,8 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
   const Intrinsics k = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCorner);
   const double w = size.width;
   const double h = size.height;
-  return PerspectiveMatrix(2.0 * k.fx / w, -2.0 * k.skew / w, 1.0 - 2.0 * k.cx / w,
+  // "+ 0.0" turns the -0 of a zero skew into +0, so printed matrices read as glFrustum's.
+  return PerspectiveMatrix(2.0 * k.fx / w, -2.0 * k.skew / w + 0.0, 1.0 - 2.0 * k.cx / w,
                            2.0 * k.fy / h, 2.0 * k.cy / h - 1.0, DepthRow(z_near, z_far, depth));
 }
 

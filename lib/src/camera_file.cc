@@ -1,0 +1,211 @@
+#include "camproj/camera_file.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "camproj/errors.h"
+#include "camproj/file_io.h"
+#include "check.h"
+
+namespace camproj {
+
+using json = nlohmann::json;
+
+namespace {
+
+// Reads typed values out of a parsed document, naming the source and key path on failure.
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    throw InputError(source_ + ": " + key + ": " + what);
+  }
+
+  const json& Member(const json& parent, const std::string& parent_key,
+                     const std::string& name) const {
+    const std::string key = parent_key.empty() ? name : parent_key + "." + name;
+    if (!parent.is_object()) Fail(parent_key.empty() ? "(top level)" : parent_key, "expected an object");
+    const auto it = parent.find(name);
+    if (it == parent.end()) Fail(key, "missing");
+    return *it;
+  }
+
+  double Number(const json& value, const std::string& key) const {
+    if (!value.is_number()) Fail(key, "expected a number, got " + value.dump());
+    const double number = value.get<double>();
+    if (!std::isfinite(number)) Fail(key, "expected a finite number");
+    return number;
+  }
+
+  double NumberOr(const json& parent, const std::string& parent_key, const std::string& name,
+                  double fallback) const {
+    if (!parent.contains(name)) return fallback;
+    return Number(parent.at(name), parent_key + "." + name);
+  }
+
+  Eigen::VectorXd Vector(const json& value, const std::string& key, int size) const {
+    if (!value.is_array() || static_cast<int>(value.size()) != size) {
+      Fail(key, "expected an array of " + std::to_string(size) + " numbers, got " + value.dump());
+    }
+    Eigen::VectorXd vector(size);
+    for (int i = 0; i < size; ++i) {
+      vector[i] = Number(value[static_cast<size_t>(i)], key + "[" + std::to_string(i) + "]");
+    }
+    return vector;
+  }
+
+ private:
+  std::string source_;
+};
+
+json Vector3Json(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+json Matrix4Json(const Eigen::Matrix4d& m) {
+  json numbers = json::array();
+  for (int i = 0; i < 16; ++i) numbers.push_back(m.data()[i]);  // column-major
+  return numbers;
+}
+
+json FarJson(double z_far) { return std::isinf(z_far) ? json("inf") : json(z_far); }
+
+}  // namespace
+
+void CameraFileOptions::Check() const {
+  internal::Require(std::isfinite(target_distance) && target_distance > 0.0,
+                    "target distance must be finite and positive, got ", target_distance);
+}
+
+Camera CameraFromJsonText(const std::string& text, const std::string& source) {
+  json document;
+  try {
+    document = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // nlohmann's message names the line and column of the syntax error.
+    throw InputError(source + ": not valid JSON: " + e.what());
+  }
+  const Reader reader(source);
+  Camera camera;
+  const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
+  if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
+      size[1] < 1 || size[0] > 1e6 || size[1] > 1e6) {
+    reader.Fail("image_size", "expected two positive integers (width, height)");
+  }
+  camera.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
+
+  PixelOrigin origin = PixelOrigin::kCenter;
+  if (document.contains("pixel_origin")) {
+    const json& value = document.at("pixel_origin");
+    if (!value.is_string()) reader.Fail("pixel_origin", "expected \"center\" or \"corner\"");
+    try {
+      origin = PixelOriginFromString(value.get<std::string>());
+    } catch (const std::invalid_argument& e) {
+      reader.Fail("pixel_origin", e.what());
+    }
+  }
+
+  const json& k = reader.Member(document, "", "intrinsics");
+  Intrinsics intrinsics;
+  intrinsics.fx = reader.Number(reader.Member(k, "intrinsics", "fx"), "intrinsics.fx");
+  intrinsics.fy = reader.Number(reader.Member(k, "intrinsics", "fy"), "intrinsics.fy");
+  intrinsics.cx = reader.Number(reader.Member(k, "intrinsics", "cx"), "intrinsics.cx");
+  intrinsics.cy = reader.Number(reader.Member(k, "intrinsics", "cy"), "intrinsics.cy");
+  intrinsics.skew = reader.NumberOr(k, "intrinsics", "skew", 0.0);
+  intrinsics.k1 = reader.NumberOr(k, "intrinsics", "k1", 0.0);
+  intrinsics.k2 = reader.NumberOr(k, "intrinsics", "k2", 0.0);
+  try {
+    intrinsics.Check();
+  } catch (const std::invalid_argument& e) {
+    reader.Fail("intrinsics", e.what());
+  }
+  camera.intrinsics = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCenter);
+
+  try {
+    if (document.contains("cam_from_world")) {
+      const json& pose = document.at("cam_from_world");
+      const json& rows = reader.Member(pose, "cam_from_world", "R");
+      if (!rows.is_array() || rows.size() != 3) reader.Fail("cam_from_world.R", "expected 3 rows");
+      for (int r = 0; r < 3; ++r) {
+        camera.cam_from_world.rotation.row(r) =
+            reader.Vector(rows[static_cast<size_t>(r)], "cam_from_world.R[" + std::to_string(r) + "]", 3)
+                .transpose();
+      }
+      camera.cam_from_world.translation =
+          reader.Vector(reader.Member(pose, "cam_from_world", "t"), "cam_from_world.t", 3);
+      camera.cam_from_world.Check();
+    } else {
+      const json& look = reader.Member(document, "", "look_at");
+      LookAt look_at;
+      look_at.eye = reader.Vector(reader.Member(look, "look_at", "eye"), "look_at.eye", 3);
+      look_at.target = reader.Vector(reader.Member(look, "look_at", "target"), "look_at.target", 3);
+      look_at.up = reader.Vector(reader.Member(look, "look_at", "up"), "look_at.up", 3);
+      camera.cam_from_world = CamFromWorldFromLookAt(look_at);
+    }
+  } catch (const std::invalid_argument& e) {
+    reader.Fail(document.contains("cam_from_world") ? "cam_from_world" : "look_at", e.what());
+  }
+
+  const json& frustum = reader.Member(document, "", "frustum");
+  camera.z_near = reader.Number(reader.Member(frustum, "frustum", "near"), "frustum.near");
+  const json& far = reader.Member(frustum, "frustum", "far");
+  if (far.is_string() && far.get<std::string>() == "inf") {
+    camera.z_far = kInfinity;
+  } else {
+    camera.z_far = reader.Number(far, "frustum.far");
+  }
+  try {
+    camera.Check();
+  } catch (const std::invalid_argument& e) {
+    reader.Fail("frustum", e.what());
+  }
+  return camera;
+}
+
+Camera ReadCameraFile(const std::string& path) {
+  // A camera file is a few kilobytes; a megabyte bound refuses a wrong file early.
+  return CameraFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
+}
+
+std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options) {
+  options.Check();
+  const CameraViews views = ViewsOfCamera(camera, options.target_distance, options.depth);
+  const Intrinsics k =
+      ConvertPixelOrigin(camera.intrinsics, PixelOrigin::kCenter, options.pixel_origin);
+  json document;
+  document["image_size"] = {camera.image_size.width, camera.image_size.height};
+  document["pixel_origin"] = ToString(options.pixel_origin);
+  document["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy},     {"cx", k.cx}, {"cy", k.cy},
+                            {"skew", k.skew}, {"k1", k.k1}, {"k2", k.k2}};
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) {
+    rows.push_back(Vector3Json(camera.cam_from_world.rotation.row(r).transpose()));
+  }
+  document["cam_from_world"] = {{"R", rows}, {"t", Vector3Json(camera.cam_from_world.translation)}};
+  document["look_at"] = {{"eye", Vector3Json(views.look_at.eye)},
+                         {"target", Vector3Json(views.look_at.target)},
+                         {"up", Vector3Json(views.look_at.up)}};
+  if (views.frustum) {
+    const Frustum& f = *views.frustum;
+    document["frustum"] = {{"left", f.left}, {"right", f.right}, {"bottom", f.bottom},
+                           {"top", f.top},   {"near", f.z_near}, {"far", FarJson(f.z_far)}};
+  } else {
+    // Skew has no glFrustum form; near and far still define the export's depth range.
+    document["frustum"] = {{"near", camera.z_near}, {"far", FarJson(camera.z_far)},
+                           {"note", "skew != 0 has no glFrustum form: use gl.projection"}};
+  }
+  if (views.perspective) {
+    document["perspective"] = {{"fovy_deg", views.perspective->fovy_deg},
+                               {"aspect", views.perspective->aspect}};
+  }
+  document["gl"] = {{"projection", Matrix4Json(views.clip_from_gl_eye)},
+                    {"view", Matrix4Json(views.gl_eye_from_world)},
+                    {"depth", ToString(options.depth.clip_depth)},
+                    {"reversed_z", options.depth.reversed_z}};
+  if (camera.intrinsics.HasDistortion()) {
+    document["gl"]["note"] = "the projection matrix is the pinhole part: k1, k2 are not in it";
+  }
+  return document.dump(2) + "\n";
+}
+
+}  // namespace camproj

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# README command 2: build (if needed) and run the whole test suite with ctest.
+# With --sanitize, uses a separate build with -fsanitize=address,undefined.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+if [[ "${1:-}" == "--sanitize" ]]; then
+  build="$root/build/sanitize"
+  bash "$root/scripts/build.sh" "$build" -DCAMPROJ_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+else
+  build="$root/build/release"
+  bash "$root/scripts/build.sh" "$build"
+fi
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+ctest --test-dir "$build" --output-on-failure -j "$(nproc)"

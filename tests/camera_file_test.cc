@@ -1,0 +1,115 @@
+#include "camproj/camera_file.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "camproj/errors.h"
+#include "camproj/file_io.h"
+#include "test_scenes.h"
+
+namespace camproj {
+namespace {
+
+Camera RandomFileCamera(std::mt19937_64& rng) {
+  const testing::RandomCamera random = testing::MakeRandomCamera(rng);
+  Camera camera;
+  camera.image_size = random.size;
+  camera.intrinsics = random.intrinsics;
+  camera.intrinsics.k1 = testing::Uniform(rng, -0.2, 0.2);
+  camera.cam_from_world = random.cam_from_world;
+  camera.z_near = testing::LogUniform(rng, 1e-3, 1);
+  camera.z_far = camera.z_near * testing::LogUniform(rng, 2, 1e5);
+  return camera;
+}
+
+std::string ExpectInputError(const std::string& text) {
+  try {
+    CameraFromJsonText(text, "cam.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError for " << text;
+  return "";
+}
+
+TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
+  std::mt19937_64 rng(8);
+  for (int i = 0; i < 200; ++i) {
+    const Camera camera = RandomFileCamera(rng);
+    CameraFileOptions options;
+    options.pixel_origin = i % 2 ? PixelOrigin::kCorner : PixelOrigin::kCenter;
+    const Camera back = CameraFromJsonText(CameraToJsonText(camera, options), "test");
+    EXPECT_EQ(back.image_size.width, camera.image_size.width);
+    EXPECT_EQ(back.intrinsics.fx, camera.intrinsics.fx);
+    EXPECT_EQ(back.intrinsics.skew, camera.intrinsics.skew);
+    EXPECT_EQ(back.intrinsics.k1, camera.intrinsics.k1);
+    if (options.pixel_origin == PixelOrigin::kCenter) {
+      EXPECT_EQ(back.intrinsics.cx, camera.intrinsics.cx);
+      EXPECT_EQ(back.intrinsics.cy, camera.intrinsics.cy);
+    } else {
+      // +0.5 then -0.5 may round once.
+      EXPECT_NEAR(back.intrinsics.cx, camera.intrinsics.cx, 1e-15 * (std::abs(camera.intrinsics.cx) + 1));
+    }
+    EXPECT_EQ(back.cam_from_world.rotation, camera.cam_from_world.rotation);
+    EXPECT_EQ(back.cam_from_world.translation, camera.cam_from_world.translation);
+    EXPECT_EQ(back.z_near, camera.z_near);
+    EXPECT_EQ(back.z_far, camera.z_far);
+  }
+}
+
+TEST(CameraFileTest, InfiniteFarAndLookAtPoseAreRead) {
+  const Camera camera = CameraFromJsonText(R"({
+    "image_size": [640, 480],
+    "intrinsics": {"fx": 500, "fy": 500, "cx": 319.5, "cy": 239.5},
+    "look_at": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "frustum": {"near": 0.1, "far": "inf"}})", "t");
+  EXPECT_EQ(camera.z_far, kInfinity);
+  EXPECT_EQ(camera.cam_from_world.translation, Eigen::Vector3d(0, 0, 5));
+  EXPECT_NE(CameraToJsonText(camera).find("\"perspective\""), std::string::npos);
+}
+
+TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {
+  const std::string good_prefix =
+      R"({"image_size": [640, 480], "intrinsics": {"fx": 500, "fy": 500, "cx": 1, "cy": 2},)";
+  EXPECT_NE(ExpectInputError("{\n\"image_size\": [640,\n 480,,]}").find("line 3"), std::string::npos);
+  EXPECT_NE(ExpectInputError("").find("cam.json"), std::string::npos);
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640]})").find("image_size"), std::string::npos);
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480]})").find("intrinsics: missing"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(good_prefix + R"("frustum": {"near": 1, "far": 2}})").find("look_at: missing"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(good_prefix + R"("look_at": {"eye": [0,0,0], "target": [0,0,0], "up": [0,1,0]},
+            "frustum": {"near": 1, "far": 2}})").find("equals target"), std::string::npos);
+  EXPECT_NE(ExpectInputError(good_prefix + R"("look_at": {"eye": [0,0,1], "target": [0,0,0], "up": [0,1,0]},
+            "frustum": {"near": 0, "far": 2}})").find("near must be positive"), std::string::npos);
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "intrinsics": {"fx": "a", "fy": 1, "cx": 1, "cy": 2}})")
+                .find("intrinsics.fx: expected a number"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(good_prefix + R"("cam_from_world": {"R": [[1,0,0],[0,1,0],[0,0,-1]], "t": [0,0,0]},
+            "frustum": {"near": 1, "far": 2}})").find("left-handed"), std::string::npos);
+}
+
+TEST(CameraFileTest, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("camproj_atomic_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "camera.json").string();
+  WriteFileAtomically(path, "first");
+  WriteFileAtomically(path, "second, longer");
+  EXPECT_EQ(ReadWholeFile(path), "second, longer");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);
+  // A folder that does not exist: an error naming the path, and nothing created.
+  EXPECT_THROW(WriteFileAtomically((dir / "missing" / "c.json").string(), "x"), InputError);
+  EXPECT_THROW(ReadWholeFile((dir / "nope.json").string()), InputError);
+  EXPECT_THROW(ReadWholeFile(dir.string()), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace camproj
