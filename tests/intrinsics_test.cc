@@ -1,5 +1,6 @@
 #include "camproj/intrinsics.h"
 
+#include <cmath>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -88,6 +89,16 @@ TEST(IntrinsicsTest, UndistortionRefusesWhereTheRadialMapFolds) {
   k.cx = k.cy = 250;
   k.k1 = -0.5;  // d r / d r_u = 1 - 1.5 r^2 vanishes at r = 0.816: rd peaks at 0.544.
   EXPECT_THROW(CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 0.6, 250)), std::domain_error);
+  EXPECT_NO_THROW(CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 0.5, 250)));
+  // k1 = -1, k2 = 0.4: g(r) = r - r^3 + 0.4 r^5 rises to 0.424 at r = 0.707, dips, then rises
+  // again. Only radii below the first fold are invertible, whatever Newton's start would find.
+  k.k1 = -1.0;
+  k.k2 = 0.4;
+  EXPECT_THROW(CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 1.2, 250)), std::domain_error);
+  EXPECT_THROW(CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 0.849, 250)), std::domain_error);
+  const Eigen::Vector3d ray = CamRayFromPixel(k, Eigen::Vector2d(250 + 500 * 0.4, 250));
+  EXPECT_NEAR(PixelFromCam(k, ray).x(), 250 + 500 * 0.4, kUndistortPixelTolerance);
+  EXPECT_LT(ray.x(), std::sqrt(0.5));
 }
 
 TEST(IntrinsicsTest, BadValuesAreNamed) {
@@ -104,6 +115,11 @@ TEST(IntrinsicsTest, BadValuesAreNamed) {
   EXPECT_THROW(k.Check(), std::invalid_argument);
   EXPECT_THROW(PixelFromCam(Intrinsics{}, Eigen::Vector3d(0, 0, -1)), std::invalid_argument);
   EXPECT_THROW(PixelFromCam(Intrinsics{}, Eigen::Vector3d(0, 0, 0)), std::invalid_argument);
+  Intrinsics negative;
+  negative.fx = -1;
+  EXPECT_THROW(PixelFromCam(negative, Eigen::Vector3d(0, 0, 1)), std::invalid_argument);
+  EXPECT_THROW(PixelFromCam(Intrinsics{}, Eigen::Vector3d(std::nan(""), 0, 1)),
+               std::invalid_argument);
 }
 
 }  // namespace

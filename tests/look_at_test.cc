@@ -98,5 +98,16 @@ TEST(LookAtTest, DegenerateInputIsAClearErrorNotNaN) {
   EXPECT_THROW(LookAtFromCamFromWorld(Rigid3{}, 0.0), std::invalid_argument);
 }
 
+TEST(LookAtTest, ExtremeScalesGiveTheSamePose) {
+  // A gaze of 1e-200 (no underflow to "eye equals target") or 1e200 (no overflow to NaN).
+  const LookAt unit{Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 2, -3), Eigen::Vector3d(0, 1, 0)};
+  const Rigid3 expected = CamFromWorldFromLookAt(unit);
+  for (const double scale : {1e-200, 1e200}) {
+    const LookAt scaled{Eigen::Vector3d::Zero(), scale * unit.target, scale * unit.up};
+    const Rigid3 pose = CamFromWorldFromLookAt(scaled);
+    EXPECT_LT((pose.rotation - expected.rotation).cwiseAbs().maxCoeff(), kExactRelative);
+  }
+}
+
 }  // namespace
 }  // namespace camproj

@@ -1,10 +1,16 @@
 #include "camproj/intrinsics.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "check.h"
 
 namespace camproj {
+
+namespace {
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+}  // namespace
 
 using internal::Require;
 using internal::RequireFinite;
@@ -60,6 +66,8 @@ Intrinsics ConvertPixelOrigin(const Intrinsics& intrinsics, PixelOrigin from, Pi
 }
 
 Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d& point_in_cam) {
+  intrinsics.Check();
+  internal::RequireFiniteAll(point_in_cam, "point_in_cam");
   Require(point_in_cam.z() > 0.0, "point is not in front of the camera: z = ", point_in_cam.z());
   const double params[7] = {intrinsics.fx, intrinsics.fy,   intrinsics.cx, intrinsics.cy,
                             intrinsics.skew, intrinsics.k1, intrinsics.k2};
@@ -77,32 +85,59 @@ Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vecto
   const double xd = (pixel.x() - intrinsics.cx - intrinsics.skew * yd) / intrinsics.fx;
   if (!intrinsics.HasDistortion()) return {xd, yd, 1.0};
 
-  // Radial distortion scales the radius: rd = r (1 + k1 r^2 + k2 r^4). Solve for r by Newton's
-  // method from r = rd; the map must be increasing on [0, r] to be invertible.
-  const double rd = std::hypot(xd, yd);
-  if (rd == 0.0) return {0.0, 0.0, 1.0};
+  // Radial distortion scales the radius: rd = g(r) = r (1 + k1 r^2 + k2 r^4). g is invertible
+  // where it is increasing, on [0, r_fold) with r_fold the first zero of
+  // g'(r) = 1 + 3 k1 r^2 + 5 k2 r^4; beyond g(r_fold) the image folds over and is refused.
   const double k1 = intrinsics.k1;
   const double k2 = intrinsics.k2;
-  double r = rd;
-  constexpr int kMaxIterations = 100;
-  constexpr double kRadiusTolerance = 1e-14;
-  for (int i = 0; i < kMaxIterations; ++i) {
-    const double r2 = r * r;
-    const double f = r * (1.0 + r2 * (k1 + r2 * k2)) - rd;
-    const double df = 1.0 + r2 * (3.0 * k1 + 5.0 * k2 * r2);
-    if (!(df > 0.0)) break;
-    const double step = f / df;
-    r -= step;
-    if (std::abs(step) <= kRadiusTolerance * (1.0 + r)) {
-      const double r2_final = r * r;
-      const double slope = 1.0 + r2_final * (3.0 * k1 + 5.0 * k2 * r2_final);
-      if (r >= 0.0 && slope > 0.0) return {xd * r / rd, yd * r / rd, 1.0};
-      break;
+  auto g = [&](double r) { return r * (1.0 + r * r * (k1 + r * r * k2)); };
+  double r_fold = kInfinity;
+  {
+    // Smallest positive root s = r^2 of 5 k2 s^2 + 3 k1 s + 1.
+    double s_fold = kInfinity;
+    if (k2 == 0.0) {
+      if (k1 < 0.0) s_fold = -1.0 / (3.0 * k1);
+    } else {
+      const double disc = 9.0 * k1 * k1 - 20.0 * k2;
+      if (disc >= 0.0) {
+        const double sq = std::sqrt(disc);
+        for (const double s : {(-3.0 * k1 - sq) / (10.0 * k2), (-3.0 * k1 + sq) / (10.0 * k2)}) {
+          if (s > 0.0) s_fold = std::min(s_fold, s);
+        }
+      }
     }
+    r_fold = std::sqrt(s_fold);
   }
-  throw std::domain_error(internal::Concat("cannot undistort pixel (", pixel.x(), ", ", pixel.y(),
-                                           "): radial distortion k1 = ", k1, ", k2 = ", k2,
-                                           " is not invertible at that radius"));
+  const double rd = std::hypot(xd, yd);
+  if (rd == 0.0) return {0.0, 0.0, 1.0};
+  if (std::isfinite(r_fold) && !(rd < g(r_fold))) {
+    throw std::domain_error(internal::Concat(
+        "cannot undistort pixel (", pixel.x(), ", ", pixel.y(), "): radial distortion k1 = ", k1,
+        ", k2 = ", k2, " folds over at normalized radius ", r_fold, " (distorted ", g(r_fold),
+        "), this pixel is at distorted radius ", rd));
+  }
+  // Safeguarded Newton on the bracket [0, min(r_fold, upper)] where g is increasing.
+  double lo = 0.0;
+  double hi = r_fold;
+  if (!std::isfinite(hi)) {
+    hi = std::max(1.0, rd);
+    while (g(hi) < rd) hi *= 2.0;
+  }
+  double r = std::min(rd, 0.5 * (lo + hi));
+  constexpr int kMaxIterations = 200;
+  constexpr double kRadiusTolerance = 1e-15;
+  for (int i = 0; i < kMaxIterations; ++i) {
+    const double f = g(r) - rd;
+    if (f < 0.0) lo = r; else hi = r;
+    const double r2 = r * r;
+    const double slope = 1.0 + r2 * (3.0 * k1 + 5.0 * k2 * r2);
+    double next = r - f / slope;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const bool done = std::abs(next - r) <= kRadiusTolerance * (1.0 + r);
+    r = next;
+    if (done || hi - lo <= kRadiusTolerance * (1.0 + r)) break;
+  }
+  return {xd * r / rd, yd * r / rd, 1.0};
 }
 
 }  // namespace camproj

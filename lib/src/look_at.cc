@@ -14,13 +14,14 @@ Rigid3 CamFromWorldFromLookAt(const LookAt& look_at) {
   RequireFiniteAll(look_at.target, "look-at target");
   RequireFiniteAll(look_at.up, "look-at up");
   const Eigen::Vector3d gaze = look_at.target - look_at.eye;
-  Require(gaze.norm() > 0.0, "look-at eye equals target (", look_at.eye.transpose(),
+  RequireFiniteAll(gaze, "look-at target - eye");
+  // stableNorm/stableNormalized: no underflow for a gaze of 1e-200, no overflow for 1e200.
+  Require(gaze.stableNorm() > 0.0, "look-at eye equals target (", look_at.eye.transpose(),
           "): the gaze direction is undefined");
-  const double up_norm = look_at.up.norm();
-  Require(up_norm > 0.0, "look-at up is the zero vector");
-  const Eigen::Vector3d w = -gaze.normalized();
-  const Eigen::Vector3d up_cross_w = look_at.up.cross(w);
-  const double sin_angle = up_cross_w.norm() / up_norm;
+  Require(look_at.up.stableNorm() > 0.0, "look-at up is the zero vector");
+  const Eigen::Vector3d w = -gaze.stableNormalized();
+  const Eigen::Vector3d up_cross_w = look_at.up.stableNormalized().cross(w);
+  const double sin_angle = up_cross_w.norm();
   Require(sin_angle >= kLookAtMinSinUpGaze, "look-at up (", look_at.up.transpose(),
           ") is parallel to the gaze (sin of the angle ", sin_angle, " < ",
           kLookAtMinSinUpGaze, "): the roll is undefined; choose another up");

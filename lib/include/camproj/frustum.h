@@ -64,6 +64,7 @@ struct Viewport {
 // frustum counts as symmetric: a centred principal point, cx = (W - 1)/2, rounds to ~1e-16 here.
 inline constexpr double kSymmetryTolerance = 1e-9;
 
+// Throws on an invalid frustum (Frustum::Check).
 bool IsSymmetric(const Frustum& frustum);
 
 Frustum FrustumFromPerspective(const Perspective& perspective);

@@ -53,7 +53,7 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
 Eigen::Matrix4d ClipFromGlEyeOrtho(const Ortho& ortho,
                                    ClipDepth clip_depth = ClipDepth::kNegativeOneToOne);
 
-// Intrinsics (fx, fy, cx, cy, skew in `origin`) of a perspective projection matrix built as
+// Intrinsics (fx, fy, skew; cx, cy in `origin`) of a perspective projection matrix built as
 // above for the image size. The matrix may carry any positive overall scale (clip.w > 0 in front
 // of the camera). Throws
 // std::invalid_argument naming the entry if it is not of that form (e.g. an orthographic matrix).

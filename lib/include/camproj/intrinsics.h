@@ -51,12 +51,14 @@ inline void PixelFromNormalized(const T* intrinsics, const T& x, const T& y, T* 
   pixel[1] = intrinsics[1] * yd + intrinsics[3];
 }
 
-// Pixel of a point in the cam frame. Throws std::invalid_argument unless point_in_cam.z() > 0.
+// Pixel of a point in the cam frame. Throws std::invalid_argument on invalid intrinsics,
+// a non-finite point, or unless point_in_cam.z() > 0.
 Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d& point_in_cam);
 
 // The ray through `pixel`, as (x, y, 1) in the cam frame: the inverse of PixelFromCam up to depth.
-// With distortion it inverts d by Newton's method to 1e-14 in normalized units, and throws
-// std::domain_error where the distortion is not invertible (the radial map folds over).
+// With distortion it inverts the radial map by safeguarded Newton to ~1e-15 in normalized units.
+// The map r -> r d(r) is invertible where it increases, up to its first fold r_fold (where
+// d/dr [r d(r)] = 0); a pixel at or beyond the fold's distorted radius throws std::domain_error.
 Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vector2d& pixel);
 
 }  // namespace camproj
