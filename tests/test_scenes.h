@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -79,6 +80,52 @@ inline Eigen::Vector3d WorldPointAtPixel(const RandomCamera& camera, const Eigen
 // A pixel anywhere in the image (to the outer edges), kCenter.
 inline Eigen::Vector2d RandomPixelInImage(std::mt19937_64& rng, const ImageSize& size) {
   return {Uniform(rng, -0.5, size.width - 0.5), Uniform(rng, -0.5, size.height - 0.5)};
+}
+
+struct SceneOptions {
+  int num_points = 20;
+  bool planar = false;          // all points on one plane (tilted against the image plane)
+  double min_depth = 2.0;       // depth range in front of the camera (z_cam)
+  double max_depth = 4.0;
+  double pixel_noise = 0.0;     // Gaussian sigma per axis, px
+};
+
+struct Scene {
+  std::vector<Eigen::Vector3d> points_in_world;
+  std::vector<Eigen::Vector2d> true_pixels;      // kCenter
+  std::vector<Eigen::Vector2d> observed_pixels;  // true + noise
+};
+
+// Points that project inside the image at depths in [min_depth, max_depth]; planar scenes put
+// them on a plane through the middle of that range with a random tilt of 20..70 degrees.
+inline Scene MakeScene(std::mt19937_64& rng, const RandomCamera& camera,
+                       const SceneOptions& options) {
+  Scene scene;
+  const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
+  const double mid_depth = 0.5 * (options.min_depth + options.max_depth);
+  constexpr double kPi = 3.14159265358979323846;
+  const double tilt = Uniform(rng, 20.0, 70.0) * kPi / 180.0;
+  const double azimuth = Uniform(rng, 0.0, 2.0 * kPi);
+  const Eigen::Vector3d normal(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth),
+                               -std::cos(tilt));
+  std::normal_distribution<double> noise(0.0, 1.0);
+  while (static_cast<int>(scene.points_in_world.size()) < options.num_points) {
+    const Eigen::Vector2d pixel = RandomPixelInImage(rng, camera.size);
+    const Eigen::Vector3d ray = CamRayFromPixel(camera.intrinsics, pixel);
+    double depth = Uniform(rng, options.min_depth, options.max_depth);
+    if (options.planar) {
+      // Plane through (0, 0, mid_depth) with `normal`: depth along the ray where it meets it.
+      const double denominator = normal.dot(ray);
+      if (std::abs(denominator) < 1e-9) continue;
+      depth = normal.dot(Eigen::Vector3d(0, 0, mid_depth)) / denominator;
+      if (!(depth > 0.2 * options.min_depth && depth < 5.0 * options.max_depth)) continue;
+    }
+    scene.points_in_world.push_back(world_from_cam * (depth * ray));
+    scene.true_pixels.push_back(PixelFromCam(camera.intrinsics, depth * ray));
+    scene.observed_pixels.push_back(scene.true_pixels.back() +
+                                    options.pixel_noise * Eigen::Vector2d(noise(rng), noise(rng)));
+  }
+  return scene;
 }
 
 }  // namespace testing

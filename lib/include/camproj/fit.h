@@ -1,0 +1,168 @@
+// Fitting a camera or projector to 2D-3D correspondences: the only fitting entry point.
+//
+// FitCamera starts from a closed form (Hartley-normalized DLT for >= 6 non-coplanar points, a
+// homography with constrained intrinsics for planar scenes, SQPnP when the intrinsics are known or
+// only the focal length is free with few points), then refines with Ceres: residuals are
+// predicted - observed pixels; rotation on a quaternion manifold, translation in a world frame
+// centred and scaled to the points (so units and offsets do not matter); fixed intrinsics are
+// constants, not penalties. Conventions: docs/conventions.md.
+#ifndef CAMPROJ_FIT_H_
+#define CAMPROJ_FIT_H_
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/camera.h"
+#include "camproj/conventions.h"
+#include "camproj/intrinsics.h"
+
+namespace camproj {
+
+// How one intrinsic parameter is treated.
+struct ParameterMode {
+  enum class Kind {
+    kDefault,  // fixed at its default: focal has none (must be free or given), aspect 1,
+               // principal point at the image centre ((W-1)/2, (H-1)/2 in kCenter), skew 0, k = 0
+    kFree,     // estimated
+    kFixed,    // fixed at `value` (px for focal, principal point, skew; fy/fx for aspect)
+  };
+  Kind kind = Kind::kDefault;
+  double value = 0.0;       // for kFixed; for the principal point `value` is cx and `value2` cy
+  double value2 = 0.0;
+
+  static ParameterMode Default() { return {}; }
+  static ParameterMode Free() { return {Kind::kFree, 0.0, 0.0}; }
+  static ParameterMode Fixed(double v, double v2 = 0.0) { return {Kind::kFixed, v, v2}; }
+  bool IsFree() const { return kind == Kind::kFree; }
+};
+
+enum class LossType { kNone, kHuber, kCauchy };
+
+struct FitOptions {
+  // The intrinsic model. focal: fx (fy = aspect * fx). Defaults: focal, aspect and principal
+  // point free (an off-axis pinhole: 10 parameters with the pose), skew 0, no distortion.
+  ParameterMode focal = ParameterMode::Free();
+  ParameterMode aspect = ParameterMode::Free();
+  ParameterMode principal_point = ParameterMode::Free();
+  ParameterMode skew = ParameterMode::Default();
+  ParameterMode k1 = ParameterMode::Default();
+  ParameterMode k2 = ParameterMode::Default();
+
+  // When set, the intrinsics are known (in `pixel_origin`) and only the pose is fitted; the
+  // modes above are ignored.
+  std::optional<Intrinsics> known_intrinsics;
+
+  // Convention of the observed pixels, of fixed principal-point values and of known_intrinsics;
+  // the result is always in kCenter (Camera's convention) with residuals in pixels.
+  PixelOrigin pixel_origin = PixelOrigin::kCenter;
+
+  LossType loss = LossType::kNone;
+  double loss_scale_px = 1.0;  // Huber / Cauchy scale, px, > 0
+
+  // Expected pixel noise (standard deviation per axis, px). Unset: estimated from the residuals
+  // as sqrt(sum of squared residuals / (2N - p)).
+  std::optional<double> pixel_sigma;
+
+  int max_iterations = 100;
+  double function_tolerance = 1e-14;   // Ceres' relative cost change
+  double gradient_tolerance = 1e-16;
+  double parameter_tolerance = 1e-14;  // relative step
+
+  // Depth range of the result's GL matrices. Unset: tight around the points' depths, near =
+  // min depth / (1 + depth_margin), far = max depth * (1 + depth_margin).
+  std::optional<double> z_near;
+  std::optional<double> z_far;
+  double depth_margin = 0.1;
+
+  // |correlation| at or above which a pair of parameters is reported as strongly correlated.
+  double strong_correlation = 0.9;
+
+  // Throws std::invalid_argument naming the field.
+  void Check() const;
+};
+
+// A refusal: the data cannot determine the requested camera. what() says why and what to do.
+class SceneError : public std::runtime_error {
+ public:
+  enum class Reason {
+    kTooFewPoints,
+    kCollinearPoints,
+    kPlanarUnderdetermined,  // a plane determines at most 2 intrinsics (besides distortion)
+    kNonFiniteInput,
+    kPointsBehindCamera,
+    kMirroredWorld,          // left-handed world frame
+    kDegenerate,             // no unique solution (e.g. a plane seen head-on with free focal)
+  };
+  SceneError(Reason reason, const std::string& message)
+      : std::runtime_error(message), reason_(reason) {}
+  Reason reason() const { return reason_; }
+
+ private:
+  Reason reason_;
+};
+
+// One LM iteration: elapsed wall time since FitCamera started, and the RMS reprojection error.
+struct TraceEntry {
+  int iteration = 0;
+  double elapsed_us = 0.0;
+  double rms_px = 0.0;
+};
+
+// A reported parameter with its standard deviation in user units.
+struct ParameterSigma {
+  std::string name;  // "fx", "cx", "fovy_deg", "eye_x", "rotation_x_deg", ...
+  double value = 0.0;
+  double sigma = 0.0;
+  std::string unit;  // "px", "deg", "world", ""
+};
+
+struct Correlation {
+  std::string first;
+  std::string second;
+  double correlation = 0.0;
+};
+
+struct FitResult {
+  Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
+  CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
+
+  // Per point: predicted - observed, px, in input order.
+  std::vector<Eigen::Vector2d> residuals_px;
+  double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
+  double median_px = 0.0;  // median |residual|
+  double max_px = 0.0;
+
+  std::string start_method;  // "dlt", "homography", "pnp", "pnp-focal-sweep"
+  bool planar = false;       // the points are (numerically) coplanar
+  std::vector<std::string> free_parameters;   // names in the covariance's order
+  std::vector<std::string> fixed_parameters;  // "aspect = 1 (default)", ...
+
+  int iterations = 0;
+  std::string termination;  // Ceres' termination type and message
+  double time_ms = 0.0;
+  std::vector<TraceEntry> trace;
+
+  // Uncertainty: sigma used (given or estimated), covariance of the free parameters in the
+  // order of free_parameters (pose as rotation_x/y/z_deg about the camera axes and eye_x/y/z in
+  // world units; intrinsics in px), sigmas of every reported parameter, strong correlations.
+  double pixel_sigma = 0.0;
+  bool pixel_sigma_estimated = true;
+  bool covariance_available = false;
+  Eigen::MatrixXd covariance;
+  std::vector<ParameterSigma> sigmas;
+  std::vector<Correlation> strong_correlations;
+};
+
+// Fits a camera to points_in_world[i] observed at observed_pixels[i] (in options.pixel_origin).
+// Throws std::invalid_argument for bad options or mismatched sizes, SceneError for a refusal.
+FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options = {});
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_FIT_H_

@@ -1,0 +1,295 @@
+#include "closed_form.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "camproj/fit.h"
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+// Hartley's normalization of image points: centroid to the origin, mean distance sqrt(2).
+Eigen::Matrix3d HartleyTransform(const std::vector<Eigen::Vector2d>& pixels) {
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const auto& p : pixels) centroid += p;
+  centroid /= static_cast<double>(pixels.size());
+  double mean_distance = 0.0;
+  for (const auto& p : pixels) mean_distance += (p - centroid).norm();
+  mean_distance /= static_cast<double>(pixels.size());
+  const double scale = mean_distance > 0.0 ? std::sqrt(2.0) / mean_distance : 1.0;
+  Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
+  t(0, 0) = t(1, 1) = scale;
+  t.block<2, 1>(0, 2) = -scale * centroid;
+  return t;
+}
+
+Eigen::Matrix3d ClosestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
+  if (r.determinant() < 0.0) {
+    Eigen::Matrix3d u = svd.matrixU();
+    u.col(2) *= -1.0;
+    r = u * svd.matrixV().transpose();
+  }
+  return r;
+}
+
+// Planar homography (plane coordinates -> pixels) by the normalized DLT.
+Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
+                                     const std::vector<Eigen::Vector2d>& pixels) {
+  const Eigen::Matrix3d t_plane = HartleyTransform(plane);
+  const Eigen::Matrix3d t_pixel = HartleyTransform(pixels);
+  const int n = static_cast<int>(plane.size());
+  Eigen::MatrixXd a(2 * n, 9);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = t_plane * plane[i].homogeneous();
+    const Eigen::Vector3d u = t_pixel * pixels[i].homogeneous();
+    a.row(2 * i) << x.transpose(), Eigen::RowVector3d::Zero(), -u.x() * x.transpose();
+    a.row(2 * i + 1) << Eigen::RowVector3d::Zero(), x.transpose(), -u.y() * x.transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
+  const Eigen::VectorXd h = svd.matrixV().col(8);
+  Eigen::Matrix3d hn;
+  hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
+  return t_pixel.inverse() * hn * t_plane;
+}
+
+std::vector<cv::Point3d> ToCv(const std::vector<Eigen::Vector3d>& points) {
+  std::vector<cv::Point3d> out;
+  out.reserve(points.size());
+  for (const auto& p : points) out.emplace_back(p.x(), p.y(), p.z());
+  return out;
+}
+
+// SQPnP on normalized image coordinates (x, y) = (X/Z, Y/Z): K = I.
+bool SqPnp(const std::vector<Eigen::Vector3d>& points, const std::vector<cv::Point2d>& normalized,
+           StartCamera* start) {
+  if (points.size() < 3) return false;
+  cv::Mat rvec;
+  cv::Mat tvec;
+  bool ok = false;
+  try {
+    ok = cv::solvePnP(ToCv(points), normalized, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
+                      false, cv::SOLVEPNP_SQPNP);
+  } catch (const cv::Exception&) {
+    return false;
+  }
+  if (!ok) return false;
+  cv::Mat r;
+  cv::Rodrigues(rvec, r);
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  for (int i = 0; i < 3; ++i) {
+    translation(i) = tvec.at<double>(i);
+    for (int j = 0; j < 3; ++j) rotation(i, j) = r.at<double>(i, j);
+  }
+  if (!rotation.allFinite() || !translation.allFinite()) return false;
+  start->rotation = rotation;
+  start->center = -rotation.transpose() * translation;
+  return true;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
+                                          const std::vector<Eigen::Vector2d>& pixels) {
+  // The 3D points arrive centred and unit-scaled (fit.cc); the pixels are normalized here.
+  const Eigen::Matrix3d t_pixel = HartleyTransform(pixels);
+  const int n = static_cast<int>(points.size());
+  Eigen::MatrixXd a(2 * n, 12);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::RowVector4d x = points[i].homogeneous().transpose();
+    const Eigen::Vector3d u = t_pixel * pixels[i].homogeneous();
+    a.row(2 * i) << x, Eigen::RowVector4d::Zero(), -u.x() * x;
+    a.row(2 * i + 1) << Eigen::RowVector4d::Zero(), x, -u.y() * x;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeThinV);
+  const Eigen::VectorXd p = svd.matrixV().col(11);
+  Eigen::Matrix<double, 3, 4> pn;
+  pn << p.segment<4>(0).transpose(), p.segment<4>(4).transpose(), p.segment<4>(8).transpose();
+  return t_pixel.inverse() * pn;
+}
+
+void RqDecomposition(const Eigen::Matrix3d& m, Eigen::Matrix3d* k, Eigen::Matrix3d* r) {
+  // RQ from QR of the row-reversed transpose: with J the exchange matrix,
+  // (J M)^T = Q U gives M = (J U^T J) (J Q^T), the first factor upper triangular.
+  Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+  j(0, 2) = j(1, 1) = j(2, 0) = 1.0;
+  const Eigen::HouseholderQR<Eigen::Matrix3d> qr((j * m).transpose());
+  const Eigen::Matrix3d q = qr.householderQ();
+  const Eigen::Matrix3d u = qr.matrixQR().triangularView<Eigen::Upper>();
+  Eigen::Matrix3d upper = j * u.transpose() * j;
+  Eigen::Matrix3d rotation = j * q.transpose();
+  // Make K's diagonal positive: M = (K D)(D R) with D = diag(+-1), D^2 = I.
+  const Eigen::Vector3d signs(upper(0, 0) < 0 ? -1.0 : 1.0, upper(1, 1) < 0 ? -1.0 : 1.0,
+                              upper(2, 2) < 0 ? -1.0 : 1.0);
+  upper = upper * signs.asDiagonal();
+  rotation = signs.asDiagonal() * rotation;
+  *k = upper / upper(2, 2);
+  *r = rotation;
+}
+
+StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels) {
+  Eigen::Matrix<double, 3, 4> p = NormalizedDlt(points, pixels);
+  // P = lambda K [R | t]: the third row gives lambda * depth. Choose the sign that puts the
+  // points in front; if no sign does, no camera sees them all.
+  int in_front = 0;
+  for (const auto& x : points) in_front += p.row(2).dot(x.homogeneous()) > 0.0 ? 1 : 0;
+  const int n = static_cast<int>(points.size());
+  if (in_front < n - in_front) {
+    p = -p;
+    in_front = n - in_front;
+  }
+  if (in_front != n) {
+    throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                     "the correspondences fit no camera that has every point in front of it (" +
+                         std::to_string(n - in_front) + " of " + std::to_string(n) +
+                         " points behind the best linear camera): check the point order and "
+                         "look for mismatched or mis-clicked points");
+  }
+  const Eigen::Matrix3d m = p.leftCols<3>();
+  Eigen::Matrix3d k;
+  Eigen::Matrix3d r;
+  RqDecomposition(m, &k, &r);
+  if (m.determinant() < 0.0) {
+    throw SceneError(SceneError::Reason::kMirroredWorld,
+                     "the points are seen as through a mirror: every point is in front of the "
+                     "camera but the world frame is left-handed (det < 0). Flip one world axis "
+                     "(e.g. negate Z of every point, and again in anything you render) and refit");
+  }
+  StartCamera start;
+  start.rotation = r;
+  start.center = -m.inverse() * p.col(3);
+  start.intrinsics = IntrinsicsFromK(k);
+  return start;
+}
+
+bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels,
+                     const Eigen::Matrix3d& plane_basis, const Intrinsics& guess, bool focal_free,
+                     bool aspect_free, StartCamera* start) {
+  std::vector<Eigen::Vector2d> plane;
+  plane.reserve(points.size());
+  for (const auto& x : points) plane.push_back((plane_basis.transpose() * x).head<2>());
+  const Eigen::Matrix3d h = NormalizedHomography(plane, pixels);
+
+  // G = T^-1 H with T the principal point and skew part of K: G ~ diag(fx, fy, 1) [r1 r2 t].
+  Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
+  t(0, 2) = guess.cx;
+  t(1, 2) = guess.cy;
+  const Eigen::Matrix3d g = t.inverse() * h;
+  const Eigen::Vector3d g1 = g.col(0);
+  const Eigen::Vector3d g2 = g.col(1);
+  // r1 . r2 = 0 and |r1| = |r2| with r = (gx / fx, gy / fy, gz): linear in 1/fx^2, 1/fy^2.
+  double fx = guess.fx;
+  double fy = guess.fy;
+  if (focal_free) {
+    Eigen::Matrix2d a;
+    Eigen::Vector2d b;
+    a << g1.x() * g2.x(), g1.y() * g2.y(), g1.x() * g1.x() - g2.x() * g2.x(),
+        g1.y() * g1.y() - g2.y() * g2.y();
+    b << -g1.z() * g2.z(), g2.z() * g2.z() - g1.z() * g1.z();
+    double wx = 0.0;
+    double wy = 0.0;
+    const double aspect = guess.fy / guess.fx;
+    if (aspect_free) {
+      const Eigen::Vector2d w = a.fullPivLu().solve(b);
+      wx = w.x();
+      wy = w.y();
+    } else {
+      // 1/fy^2 = 1/(aspect^2 fx^2): one unknown, least squares over both equations.
+      const Eigen::Vector2d column = a.col(0) + a.col(1) / (aspect * aspect);
+      const double denominator = column.squaredNorm();
+      if (!(denominator > 0.0)) return false;
+      wx = column.dot(b) / denominator;
+      wy = wx / (aspect * aspect);
+    }
+    if (!(wx > 0.0 && wy > 0.0) || !std::isfinite(wx) || !std::isfinite(wy)) return false;
+    fx = 1.0 / std::sqrt(wx);
+    fy = 1.0 / std::sqrt(wy);
+  }
+  Intrinsics k = guess;
+  k.fx = fx;
+  k.fy = fy;
+  k.k1 = k.k2 = 0.0;
+  const Eigen::Matrix3d m = k.K().inverse() * h;
+  double scale = 1.0 / std::sqrt(m.col(0).norm() * m.col(1).norm());
+  // The plane's centroid (plane coordinates 0) is at m.col(2) in the camera: in front.
+  if (m(2, 2) * scale < 0.0) scale = -scale;
+  Eigen::Matrix3d r_plane;
+  r_plane.col(0) = scale * m.col(0);
+  r_plane.col(1) = scale * m.col(1);
+  r_plane.col(2) = r_plane.col(0).cross(r_plane.col(1));
+  r_plane = ClosestRotation(r_plane);
+  const Eigen::Vector3d translation = scale * m.col(2);
+  // point_in_cam = r_plane * plane_basis^T * point + translation.
+  start->rotation = r_plane * plane_basis.transpose();
+  start->center = -start->rotation.transpose() * translation;
+  start->intrinsics = k;
+  return start->rotation.allFinite() && start->center.allFinite() && std::isfinite(fx);
+}
+
+bool PnpStart(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
+              StartCamera* start) {
+  std::vector<cv::Point2d> normalized;
+  normalized.reserve(pixels.size());
+  try {
+    for (const auto& pixel : pixels) {
+      const Eigen::Vector3d ray = CamRayFromPixel(intrinsics, pixel);
+      normalized.emplace_back(ray.x(), ray.y());
+    }
+  } catch (const std::domain_error&) {
+    return false;
+  }
+  if (!SqPnp(points, normalized, start)) return false;
+  start->intrinsics = intrinsics;
+  return true;
+}
+
+bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& guess,
+                     double aspect, int image_width, StartCamera* start) {
+  constexpr double kPi = 3.14159265358979323846;
+  constexpr int kSteps = 48;
+  constexpr double kMinFovDeg = 0.5;
+  constexpr double kMaxFovDeg = 175.0;
+  const double f_min = 0.5 * image_width / std::tan(0.5 * kMaxFovDeg * kPi / 180.0);
+  const double f_max = 0.5 * image_width / std::tan(0.5 * kMinFovDeg * kPi / 180.0);
+  double best_rms = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < kSteps; ++i) {
+    Intrinsics k = guess;
+    k.fx = f_min * std::pow(f_max / f_min, i / (kSteps - 1.0));
+    k.fy = aspect * k.fx;
+    StartCamera candidate;
+    if (!PnpStart(points, pixels, k, &candidate)) continue;
+    double sum = 0.0;
+    bool all_in_front = true;
+    for (size_t j = 0; j < points.size(); ++j) {
+      const Eigen::Vector3d p = candidate.rotation * (points[j] - candidate.center);
+      if (!(p.z() > 0.0)) {
+        all_in_front = false;
+        break;
+      }
+      sum += (PixelFromCam(k, p) - pixels[j]).squaredNorm();
+    }
+    if (!all_in_front) continue;
+    const double rms = std::sqrt(sum / static_cast<double>(points.size()));
+    if (rms < best_rms) {
+      best_rms = rms;
+      *start = candidate;
+    }
+  }
+  return std::isfinite(best_rms);
+}
+
+}  // namespace internal
+}  // namespace camproj

@@ -1,0 +1,62 @@
+// Closed-form starts for the fitter (private). All work in the normalized world frame of
+// fit.cc: points centred on their centroid and scaled to unit RMS distance.
+#ifndef CAMPROJ_SRC_CLOSED_FORM_H_
+#define CAMPROJ_SRC_CLOSED_FORM_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/intrinsics.h"
+
+namespace camproj {
+namespace internal {
+
+// A camera in the normalized world: point_in_cam = rotation * (point - center).
+struct StartCamera {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Intrinsics intrinsics;  // kCenter, k1 = k2 = 0
+};
+
+// Hartley-normalized DLT (>= 6 non-coplanar points) and RQ decomposition: K with positive
+// diagonal, det(R) = +1. Throws SceneError kMirroredWorld when every point is in front but the
+// frame is left-handed, kPointsBehindCamera when no camera has all points in front.
+StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels);
+
+// The 3x4 camera matrix fitted by the normalized DLT (scale arbitrary).
+Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
+                                          const std::vector<Eigen::Vector2d>& pixels);
+
+// M = K R with K upper triangular with positive diagonal, K(2,2) = 1 and R orthogonal (its
+// determinant has the sign of det(M)).
+void RqDecomposition(const Eigen::Matrix3d& m, Eigen::Matrix3d* k, Eigen::Matrix3d* r);
+
+// Planar scene (>= 4 points): a homography from the plane to the image, then the focal length
+// (and the aspect when aspect_free) from the two orthonormality constraints with the principal
+// point and skew of `guess`, then the pose. `plane_basis` has the plane's in-plane axes as its
+// first two columns and the normal as the third (a rotation). When focal_free is false the
+// focal length of `guess` is used. Returns false where the constraints do not determine the
+// focal length (e.g. a plane seen head-on).
+bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels,
+                     const Eigen::Matrix3d& plane_basis, const Intrinsics& guess, bool focal_free,
+                     bool aspect_free, StartCamera* start);
+
+// Pose from known intrinsics (distortion included) by OpenCV's SQPnP, >= 3 points.
+// Returns false if SQPnP fails.
+bool PnpStart(const std::vector<Eigen::Vector3d>& points,
+              const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
+              StartCamera* start);
+
+// Focal length unknown, everything else given: SQPnP over a log-spaced sweep of focal lengths
+// (fields of view from 0.5 to 175 degrees across the image width), keeping the lowest RMS.
+bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& guess,
+                     double aspect, int image_width, StartCamera* start);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_CLOSED_FORM_H_

@@ -1,0 +1,598 @@
+#include "camproj/fit.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numeric>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <Eigen/Dense>
+
+#include "check.h"
+#include "closed_form.h"
+#include "reprojection_error.h"
+
+namespace camproj {
+
+using internal::Require;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegPerRad = 180.0 / kPi;
+
+// The point cloud's singular values s1 >= s2 >= s3 (RMS extents along its principal axes):
+// collinear below s2 / s1 = kCollinearRatio, exactly planar (for counting what a plane
+// determines) below s3 / s1 = kPlanarRatio, started from a homography below kPlanarStartRatio
+// (the DLT's 3D information is then too weak to trust under noise).
+constexpr double kCollinearRatio = 1e-9;
+constexpr double kPlanarRatio = 1e-9;
+constexpr double kPlanarStartRatio = 1e-2;
+// Below this reciprocal condition number of the Jacobi-scaled normal equations the parameters
+// are not determined by the points (double precision leaves ~1e-16; 1e-12 keeps a margin).
+constexpr double kSingularRcond = 1e-12;
+
+using Clock = std::chrono::steady_clock;
+
+double MicrosecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+// Names of the fit-intrinsics slots, in reprojection_error.h's layout.
+const std::array<const char*, internal::kFitIntrinsicsSize> kSlotNames = {
+    "focal", "aspect", "cx", "cy", "skew", "k1", "k2"};
+
+// The intrinsic model: which slots are free and the value of every slot (the start for free
+// ones).
+struct Model {
+  std::array<bool, internal::kFitIntrinsicsSize> free{};
+  std::array<double, internal::kFitIntrinsicsSize> value{};
+  std::vector<std::string> fixed_descriptions;
+
+  int NumFree() const { return static_cast<int>(std::count(free.begin(), free.end(), true)); }
+  // focal, aspect, principal point, skew: what a homography constrains (k1, k2 aside).
+  int NumFreeLinear() const {
+    return static_cast<int>(std::count(free.begin(), free.begin() + 5, true));
+  }
+  Intrinsics ToIntrinsics() const {
+    Intrinsics k;
+    k.fx = value[0];
+    k.fy = value[1] * value[0];
+    k.cx = value[2];
+    k.cy = value[3];
+    k.skew = value[4];
+    k.k1 = value[5];
+    k.k2 = value[6];
+    return k;
+  }
+};
+
+std::string Describe(const char* name, double value, const char* why) {
+  return internal::Concat(name, " = ", value, " (", why, ")");
+}
+
+Model MakeModel(const FitOptions& options, const ImageSize& size) {
+  Model model;
+  if (options.known_intrinsics) {
+    const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
+                                            PixelOrigin::kCenter);
+    model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2};
+    model.fixed_descriptions.push_back("intrinsics (known)");
+    return model;
+  }
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value) {
+    model.free[slot] = mode.IsFree();
+    model.value[slot] = mode.kind == ParameterMode::Kind::kFixed ? fixed_value : default_value;
+    if (mode.kind == ParameterMode::Kind::kFixed) {
+      model.fixed_descriptions.push_back(Describe(kSlotNames[slot], model.value[slot], "given"));
+    } else if (mode.kind == ParameterMode::Kind::kDefault) {
+      model.fixed_descriptions.push_back(Describe(kSlotNames[slot], model.value[slot], "default"));
+    }
+  };
+  // A free focal length's start comes from the closed form; 1 is a placeholder.
+  set(0, options.focal, 1.0, options.focal.value);
+  set(1, options.aspect, 1.0, options.aspect.value);
+  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift);
+  set(3, options.principal_point, 0.5 * (size.height - 1.0),
+      options.principal_point.value2 + shift);
+  set(4, options.skew, 0.0, options.skew.value);
+  set(5, options.k1, 0.0, options.k1.value);
+  set(6, options.k2, 0.0, options.k2.value);
+  // The principal point is one choice, described once.
+  if (!options.principal_point.IsFree()) {
+    auto& d = model.fixed_descriptions;
+    const auto cx = std::find_if(d.begin(), d.end(), [](const std::string& s) { return s.rfind("cx", 0) == 0; });
+    const auto cy = std::find_if(d.begin(), d.end(), [](const std::string& s) { return s.rfind("cy", 0) == 0; });
+    if (cx != d.end() && cy != d.end()) {
+      *cx = internal::Concat("principal point = (", model.value[2], ", ", model.value[3], ") (",
+                             options.principal_point.kind == ParameterMode::Kind::kFixed
+                                 ? "given" : "default: image centre", ")");
+      d.erase(cy);
+    }
+  }
+  return model;
+}
+
+std::string FreeLinearNames(const Model& model) {
+  std::string names;
+  const char* labels[] = {"focal", "aspect", "principal point", "", "skew"};
+  for (int slot = 0; slot < 5; ++slot) {
+    if (slot == 3 || !model.free[slot]) continue;
+    if (!names.empty()) names += ", ";
+    names += labels[slot];
+  }
+  return names;
+}
+
+// Records (iteration, elapsed, RMS) after every Ceres iteration.
+class TraceCallback : public ceres::IterationCallback {
+ public:
+  TraceCallback(const std::vector<Eigen::Vector3d>& points,
+                const std::vector<Eigen::Vector2d>& pixels, const double* rotation,
+                const double* center, const double* intrinsics, Clock::time_point start,
+                std::vector<TraceEntry>* trace)
+      : points_(points), pixels_(pixels), rotation_(rotation), center_(center),
+        intrinsics_(intrinsics), start_(start), trace_(trace) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration > 0 && !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    const Eigen::Map<const Eigen::Quaterniond> q(rotation_);
+    const Eigen::Map<const Eigen::Vector3d> c(center_);
+    double sum = 0.0;
+    for (size_t i = 0; i < points_.size(); ++i) {
+      const Eigen::Vector3d p = q * (points_[i] - c);
+      double pixel[2];
+      internal::PixelFromFitIntrinsics(intrinsics_, p.x() / p.z(), p.y() / p.z(), pixel);
+      sum += (Eigen::Vector2d(pixel[0], pixel[1]) - pixels_[i]).squaredNorm();
+    }
+    trace_->push_back({summary.iteration, MicrosecondsSince(start_),
+                       std::sqrt(sum / static_cast<double>(points_.size()))});
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& pixels_;
+  const double* rotation_;
+  const double* center_;
+  const double* intrinsics_;
+  Clock::time_point start_;
+  std::vector<TraceEntry>* trace_;
+};
+
+// The Jacobian of all residuals with respect to the user parameterization u = [omega (3, rad,
+// R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots], by Jets.
+constexpr int kMaxParams = 6 + internal::kFitIntrinsicsSize;
+using Jet = ceres::Jet<double, kMaxParams>;
+
+Eigen::MatrixXd UserJacobian(const std::vector<Eigen::Vector3d>& points,
+                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                             const Model& model, int num_params) {
+  const int n = static_cast<int>(points.size());
+  Eigen::MatrixXd jacobian(2 * n, num_params);
+  Jet omega[3];
+  Jet c[3];
+  Jet k[internal::kFitIntrinsicsSize];
+  for (int i = 0; i < 3; ++i) {
+    omega[i] = Jet(0.0, i);
+    c[i] = Jet(center[i], 3 + i);
+  }
+  int next = 6;
+  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+    k[slot] = model.free[slot] ? Jet(model.value[slot], next++) : Jet(model.value[slot]);
+  }
+  for (int i = 0; i < n; ++i) {
+    Jet p0[3];
+    for (int r = 0; r < 3; ++r) {
+      p0[r] = Jet(0.0);
+      for (int col = 0; col < 3; ++col) p0[r] += rotation(r, col) * (points[i][col] - c[col]);
+    }
+    Jet p[3];
+    ceres::AngleAxisRotatePoint(omega, p0, p);
+    Jet pixel[2];
+    internal::PixelFromFitIntrinsics(k, p[0] / p[2], p[1] / p[2], pixel);
+    for (int j = 0; j < num_params; ++j) {
+      jacobian(2 * i, j) = pixel[0].v[j];
+      jacobian(2 * i + 1, j) = pixel[1].v[j];
+    }
+  }
+  return jacobian;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double median = values[mid];
+  if (values.size() % 2 == 0) {
+    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
+  }
+  return median;
+}
+
+}  // namespace
+
+void FitOptions::Check() const {
+  Require(focal.kind != ParameterMode::Kind::kDefault || known_intrinsics.has_value(),
+          "focal has no default: make it free or fix it at a value");
+  auto check_fixed = [](const ParameterMode& mode, const char* name) {
+    if (mode.kind != ParameterMode::Kind::kFixed) return;
+    internal::RequireFinite(mode.value, name);
+    internal::RequireFinite(mode.value2, name);
+  };
+  check_fixed(focal, "fixed focal");
+  check_fixed(aspect, "fixed aspect");
+  check_fixed(principal_point, "fixed principal point");
+  check_fixed(skew, "fixed skew");
+  check_fixed(k1, "fixed k1");
+  check_fixed(k2, "fixed k2");
+  Require(focal.kind != ParameterMode::Kind::kFixed || focal.value > 0.0,
+          "fixed focal must be positive, got ", focal.value);
+  Require(aspect.kind != ParameterMode::Kind::kFixed || aspect.value > 0.0,
+          "fixed aspect (fy/fx) must be positive, got ", aspect.value);
+  if (known_intrinsics) known_intrinsics->Check();
+  Require(std::isfinite(loss_scale_px) && loss_scale_px > 0.0,
+          "loss scale must be positive (px), got ", loss_scale_px);
+  Require(!pixel_sigma || (std::isfinite(*pixel_sigma) && *pixel_sigma > 0.0),
+          "pixel sigma must be positive, got ", pixel_sigma.value_or(0.0));
+  Require(max_iterations >= 0, "max iterations must be >= 0, got ", max_iterations);
+  Require(function_tolerance >= 0.0 && gradient_tolerance >= 0.0 && parameter_tolerance >= 0.0,
+          "tolerances must be >= 0");
+  Require(!z_near || (std::isfinite(*z_near) && *z_near > 0.0), "near must be positive, got ",
+          z_near.value_or(0.0));
+  Require(!z_far || (!std::isnan(*z_far) && *z_far > z_near.value_or(0.0)),
+          "far must be greater than near, got ", z_far.value_or(0.0));
+  Require(std::isfinite(depth_margin) && depth_margin >= 0.0, "depth margin must be >= 0, got ",
+          depth_margin);
+  Require(strong_correlation > 0.0 && strong_correlation <= 1.0,
+          "strong correlation threshold must be in (0, 1], got ", strong_correlation);
+}
+
+FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options) {
+  const Clock::time_point start_time = Clock::now();
+  options.Check();
+  image_size.Check();
+  Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
+          " 3D points but ", observed_pixels.size(), " pixels");
+  const int n = static_cast<int>(points_in_world.size());
+  for (int i = 0; i < n; ++i) {
+    if (!points_in_world[i].allFinite() || !observed_pixels[i].allFinite()) {
+      throw SceneError(SceneError::Reason::kNonFiniteInput,
+                       internal::Concat("point ", i, " is not finite (X = ",
+                                        points_in_world[i].transpose(), ", pixel = ",
+                                        observed_pixels[i].transpose(), "): remove or fix it"));
+    }
+  }
+  const Model start_model = MakeModel(options, image_size);
+  const int num_params = 6 + start_model.NumFree();
+  if (2 * n < num_params || n < 3) {
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     internal::Concat(n, " points give ", 2 * n, " equations, but the model has ",
+                                      num_params, " unknowns (pose 6 + ", start_model.NumFree(),
+                                      " free intrinsics): add points (at least ",
+                                      std::max(3, (num_params + 1) / 2),
+                                      ") or fix intrinsics"));
+  }
+
+  // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
+  // offsets reach the numerics.
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  std::vector<Eigen::Vector2d> pixels(observed_pixels);
+  for (auto& p : pixels) p += Eigen::Vector2d(shift, shift);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& x : points_in_world) centroid += x;
+  centroid /= n;
+  Eigen::MatrixXd centred(n, 3);
+  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
+  const double scale = std::sqrt(centred.squaredNorm() / n);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
+  const Eigen::Vector3d extents = shape.singularValues();
+  if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
+    throw SceneError(SceneError::Reason::kCollinearPoints,
+                     "the 3D points are collinear (or coincide): a line does not determine a "
+                     "camera's rotation about it; add points off the line");
+  }
+  std::vector<Eigen::Vector3d> points(n);
+  for (int i = 0; i < n; ++i) points[i] = centred.row(i).transpose() / scale;
+  const bool planar = extents(2) <= kPlanarRatio * extents(0);
+  const bool planar_start = extents(2) <= kPlanarStartRatio * extents(0);
+
+  const bool known = options.known_intrinsics.has_value();
+  if (planar && start_model.NumFreeLinear() > 2) {
+    throw SceneError(
+        SceneError::Reason::kPlanarUnderdetermined,
+        "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
+        "principal point (2) and skew, but " + FreeLinearNames(start_model) +
+            " are free. Fix the principal point (at the image centre by default) and the "
+            "aspect (square pixels), or add points off the plane");
+  }
+
+  // Closed-form start.
+  internal::StartCamera start;
+  std::string start_method;
+  Model model = start_model;
+  const Intrinsics guess = start_model.ToIntrinsics();
+  if (known) {
+    if (!internal::PnpStart(points, pixels, guess, &start)) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "SQPnP found no pose for the known intrinsics: check the correspondences "
+                       "and the intrinsics' pixel convention");
+    }
+    start_method = "pnp";
+  } else if (planar_start) {
+    if (n < 4) {
+      throw SceneError(SceneError::Reason::kTooFewPoints,
+                       internal::Concat("a planar scene needs at least 4 points, got ", n));
+    }
+    Intrinsics plane_guess = guess;
+    const bool focal_free = start_model.free[0];
+    if (internal::HomographyStart(points, pixels, shape.matrixV().determinant() > 0
+                                                      ? Eigen::Matrix3d(shape.matrixV())
+                                                      : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal()),
+                                  plane_guess, focal_free, start_model.free[1], &start)) {
+      start_method = "homography";
+    } else if (focal_free && internal::FocalSweepStart(points, pixels, guess, start_model.value[1],
+                                                       image_size.width, &start)) {
+      start_method = "pnp-focal-sweep";
+    } else {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "the plane's homography does not determine the focal length (the plane "
+                       "is seen nearly head-on, or the points are mismatched): fix the focal "
+                       "length (--focal / --fovy) or add points off the plane");
+    }
+  } else if (n >= 6) {
+    start = internal::DltStart(points, pixels);
+    start_method = "dlt";
+  } else if (start_model.NumFreeLinear() <= 1 && !start_model.free[1] && !start_model.free[2] &&
+             !start_model.free[4]) {
+    const bool ok = start_model.free[0]
+                        ? internal::FocalSweepStart(points, pixels, guess, start_model.value[1],
+                                                    image_size.width, &start)
+                        : internal::PnpStart(points, pixels, guess, &start);
+    if (!ok) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "no camera found for these few points: check the correspondences");
+    }
+    start_method = start_model.free[0] ? "pnp-focal-sweep" : "pnp";
+  } else {
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     internal::Concat("the linear start (DLT) needs 6 non-coplanar points to "
+                                      "free ", FreeLinearNames(start_model), "; got ", n,
+                                      ": add points or fix all but the focal length"));
+  }
+
+  // Start values of the free slots from the closed form, fixed ones as given. DLT's K is
+  // projected onto the model (square pixels: geometric mean of fx, fy).
+  const Intrinsics& k0 = start.intrinsics;
+  if (!known) {
+    if (model.free[0]) {
+      model.value[0] = model.free[1] ? k0.fx : std::sqrt(k0.fx * k0.fy / model.value[1]);
+    }
+    if (model.free[1]) model.value[1] = k0.fy / model.value[0];
+    if (model.free[2]) model.value[2] = k0.cx;
+    if (model.free[3]) model.value[3] = k0.cy;
+    if (model.free[4]) model.value[4] = k0.skew;
+  }
+  if (start_method == "dlt" && model.NumFreeLinear() < 5) {
+    // With intrinsics held, the DLT's pose belongs to another K: re-solve it for this one and
+    // keep whichever reprojects better.
+    internal::StartCamera pnp;
+    Intrinsics projected = model.ToIntrinsics();
+    if (internal::PnpStart(points, pixels, projected, &pnp)) {
+      auto sum_squares = [&](const internal::StartCamera& camera) {
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Vector3d p = camera.rotation * (points[i] - camera.center);
+          if (!(p.z() > 0.0)) return std::numeric_limits<double>::infinity();
+          sum += (PixelFromCam(projected, p) - pixels[i]).squaredNorm();
+        }
+        return sum;
+      };
+      if (sum_squares(pnp) < sum_squares(start)) {
+        start.rotation = pnp.rotation;
+        start.center = pnp.center;
+      }
+    }
+  }
+
+  // Refinement.
+  Eigen::Quaterniond rotation(start.rotation);
+  rotation.normalize();
+  Eigen::Vector3d center = start.center;
+  std::array<double, internal::kFitIntrinsicsSize> intrinsics = model.value;
+  ceres::Problem problem;
+  ceres::LossFunction* loss = nullptr;
+  if (options.loss == LossType::kHuber) loss = new ceres::HuberLoss(options.loss_scale_px);
+  if (options.loss == LossType::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale_px);
+  for (int i = 0; i < n; ++i) {
+    problem.AddResidualBlock(internal::ReprojectionError::Create(points[i], pixels[i]), loss,
+                             rotation.coeffs().data(), center.data(), intrinsics.data());
+  }
+  problem.SetManifold(rotation.coeffs().data(), new ceres::EigenQuaternionManifold);
+  std::vector<int> constant_slots;
+  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+    if (!model.free[slot]) constant_slots.push_back(slot);
+  }
+  if (constant_slots.size() == internal::kFitIntrinsicsSize) {
+    problem.SetParameterBlockConstant(intrinsics.data());
+  } else if (!constant_slots.empty()) {
+    problem.SetManifold(intrinsics.data(),
+                        new ceres::SubsetManifold(internal::kFitIntrinsicsSize, constant_slots));
+  }
+
+  FitResult result;
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.num_threads = 1;
+  solver_options.update_state_every_iteration = true;
+  TraceCallback trace_callback(points, pixels, rotation.coeffs().data(), center.data(),
+                               intrinsics.data(), start_time, &result.trace);
+  solver_options.callbacks.push_back(&trace_callback);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the refinement failed: " + summary.message +
+                         ": check the correspondences");
+  }
+  model.value = intrinsics;
+  rotation.normalize();
+  const Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
+
+  // Residuals and depths.
+  Camera& camera = result.camera;
+  camera.image_size = image_size;
+  camera.intrinsics = model.ToIntrinsics();
+  camera.intrinsics.skew += 0.0;  // no -0 in files
+  camera.cam_from_world = CamFromWorldFromCenter(rotation_matrix, centroid + scale * center);
+  std::vector<double> depths(n);
+  std::vector<double> norms(n);
+  double sum_squares = 0.0;
+  int behind = 0;
+  result.residuals_px.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = rotation_matrix * (points[i] - center);
+    depths[i] = p.z() * scale;
+    if (!(p.z() > 0.0)) {
+      ++behind;
+      continue;
+    }
+    result.residuals_px[i] = PixelFromCam(camera.intrinsics, p) - pixels[i];
+    norms[i] = result.residuals_px[i].norm();
+    sum_squares += norms[i] * norms[i];
+  }
+  if (behind > 0) {
+    throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                     internal::Concat(behind, " of ", n, " points are behind the fitted camera: "
+                                      "the correspondences are inconsistent (mismatched or "
+                                      "mis-clicked points); check them or use a robust loss"));
+  }
+  result.rms_px = std::sqrt(sum_squares / n);
+  result.median_px = Median(norms);
+  result.max_px = *std::max_element(norms.begin(), norms.end());
+  result.start_method = start_method;
+  result.planar = planar;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
+                       ": " + summary.message;
+
+  // Depth range and views.
+  const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
+  camera.z_near = options.z_near.value_or(*min_depth / (1.0 + options.depth_margin));
+  camera.z_far = options.z_far.value_or(*max_depth * (1.0 + options.depth_margin));
+  Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
+          camera.z_far, ")");
+  result.views = ViewsOfCamera(camera, Median(depths));
+
+  // Parameter names in the user parameterization.
+  std::vector<std::string> names = {"rotation_x_deg", "rotation_y_deg", "rotation_z_deg",
+                                    "eye_x", "eye_y", "eye_z"};
+  const char* user_slot_names[] = {"fx", "fy", "cx", "cy", "skew", "k1", "k2"};
+  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+    if (model.free[slot]) names.push_back(user_slot_names[slot]);
+  }
+  result.free_parameters = names;
+  result.fixed_parameters = model.fixed_descriptions;
+
+  // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
+  const Eigen::MatrixXd jacobian = UserJacobian(points, rotation_matrix, center, model, num_params);
+  const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+  const Eigen::VectorXd column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::MatrixXd scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+  const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(num_params - 1);
+  if (!(rcond > kSingularRcond)) {
+    // Name the parameters that move along the unconstrained direction.
+    const Eigen::VectorXd direction = eigen.eigenvectors().col(0);
+    std::string involved;
+    for (int j = 0; j < num_params; ++j) {
+      if (std::abs(direction(j)) > 0.3) involved += (involved.empty() ? "" : ", ") + names[j];
+    }
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     internal::Concat("the points do not determine ", involved,
+                                      " (singular normal equations, reciprocal condition ", rcond,
+                                      "): fix them, or add points that spread further in depth "
+                                      "and across the image"));
+  }
+  const int dof = 2 * n - num_params;
+  if (options.pixel_sigma) {
+    result.pixel_sigma = *options.pixel_sigma;
+    result.pixel_sigma_estimated = false;
+  } else if (dof > 0) {
+    result.pixel_sigma = std::sqrt(sum_squares / dof);
+  }
+  if (options.pixel_sigma || dof > 0) {
+    const Eigen::MatrixXd scaled_inverse =
+        eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
+        eigen.eigenvectors().transpose();
+    const Eigen::MatrixXd covariance_u = result.pixel_sigma * result.pixel_sigma *
+                                         column_scale.asDiagonal() * scaled_inverse *
+                                         column_scale.asDiagonal();
+    Eigen::MatrixXd l = Eigen::MatrixXd::Identity(num_params, num_params);
+    for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
+    for (int j = 3; j < 6; ++j) l(j, j) = scale;
+    if (model.free[1]) {
+      // fy = aspect * f: d fy = aspect d f + f d aspect.
+      const int aspect_index = 6 + (model.free[0] ? 1 : 0);
+      l(aspect_index, aspect_index) = model.value[0];
+      if (model.free[0]) l(aspect_index, 6) = model.value[1];
+    }
+    result.covariance = l * covariance_u * l.transpose();
+    result.covariance_available = true;
+
+    std::vector<double> values = {0.0, 0.0, 0.0};
+    for (int j = 0; j < 3; ++j) values.push_back(CameraCenterInWorld(camera.cam_from_world)(j));
+    const Intrinsics& k = camera.intrinsics;
+    const double slot_values[] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model.free[slot]) values.push_back(slot_values[slot]);
+    }
+    for (int j = 0; j < num_params; ++j) {
+      const std::string unit = j < 3 ? "deg" : j < 6 ? "world" : (j >= 6 && names[j][0] == 'k') ? "" : "px";
+      result.sigmas.push_back({names[j], values[j], std::sqrt(result.covariance(j, j)), unit});
+    }
+    // Fields of view from fx, fy: fov = 2 atan(extent / (2 f)), d fov / d f = -extent / (f^2 +
+    // extent^2 / 4).
+    auto index_of = [&](const char* name) {
+      const auto it = std::find(names.begin(), names.end(), name);
+      return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+    };
+    const int fx_index = index_of("fx");
+    const int fy_index = index_of("fy");
+    auto fov_sigma = [&](double f, double extent, double var_f) {
+      const double derivative = extent / (f * f + 0.25 * extent * extent);
+      return std::abs(derivative) * std::sqrt(var_f) * kDegPerRad;
+    };
+    const double var_fx = fx_index >= 0 ? result.covariance(fx_index, fx_index) : 0.0;
+    double var_fy = fy_index >= 0 ? result.covariance(fy_index, fy_index) : 0.0;
+    if (fy_index < 0 && fx_index >= 0) var_fy = var_fx * model.value[1] * model.value[1];
+    result.sigmas.push_back({"fovx_deg", 2.0 * std::atan(0.5 * image_size.width / k.fx) * kDegPerRad,
+                             fov_sigma(k.fx, image_size.width, var_fx), "deg"});
+    result.sigmas.push_back({"fovy_deg", 2.0 * std::atan(0.5 * image_size.height / k.fy) * kDegPerRad,
+                             fov_sigma(k.fy, image_size.height, var_fy), "deg"});
+    for (int a = 0; a < num_params; ++a) {
+      for (int b = a + 1; b < num_params; ++b) {
+        const double rho = result.covariance(a, b) /
+                           std::sqrt(result.covariance(a, a) * result.covariance(b, b));
+        if (std::abs(rho) >= options.strong_correlation) {
+          result.strong_correlations.push_back({names[a], names[b], rho});
+        }
+      }
+    }
+  }
+  result.time_ms = MicrosecondsSince(start_time) / 1000.0;
+  return result;
+}
+
+}  // namespace camproj
