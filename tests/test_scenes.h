@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <Eigen/Core>
@@ -96,28 +97,43 @@ struct Scene {
   std::vector<Eigen::Vector2d> observed_pixels;  // true + noise
 };
 
-// Points that project inside the image at depths in [min_depth, max_depth]; planar scenes put
-// them on a plane through the middle of that range with a random tilt of 20..70 degrees.
+// Points that project inside the image at depths in [min_depth, max_depth]. Planar scenes put
+// them on a plane through the point seen at the image centre at the middle depth, tilted by
+// 20..70 degrees against that viewing ray. Throws if the camera cannot produce the scene.
 inline Scene MakeScene(std::mt19937_64& rng, const RandomCamera& camera,
                        const SceneOptions& options) {
   Scene scene;
   const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
   const double mid_depth = 0.5 * (options.min_depth + options.max_depth);
   constexpr double kPi = 3.14159265358979323846;
+  const Eigen::Vector3d center_ray =
+      options.planar ? CamRayFromPixel(camera.intrinsics,
+                                       Eigen::Vector2d(0.5 * (camera.size.width - 1),
+                                                       0.5 * (camera.size.height - 1)))
+                     : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d anchor = mid_depth * center_ray;
+  const Eigen::Vector3d view = center_ray.normalized();
+  const Eigen::Vector3d side = view.unitOrthogonal();
   const double tilt = Uniform(rng, 20.0, 70.0) * kPi / 180.0;
-  const double azimuth = Uniform(rng, 0.0, 2.0 * kPi);
-  const Eigen::Vector3d normal(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth),
-                               -std::cos(tilt));
+  const Eigen::Vector3d normal =
+      Eigen::AngleAxisd(tilt, Eigen::AngleAxisd(Uniform(rng, 0.0, 2.0 * kPi), view) * side) * -view;
   std::normal_distribution<double> noise(0.0, 1.0);
-  while (static_cast<int>(scene.points_in_world.size()) < options.num_points) {
+  for (int attempt = 0; static_cast<int>(scene.points_in_world.size()) < options.num_points; ++attempt) {
+    if (attempt > 1000 * options.num_points + 100000) {
+      throw std::runtime_error("MakeScene: this camera cannot see the requested scene");
+    }
     const Eigen::Vector2d pixel = RandomPixelInImage(rng, camera.size);
-    const Eigen::Vector3d ray = CamRayFromPixel(camera.intrinsics, pixel);
+    Eigen::Vector3d ray;
+    try {
+      ray = CamRayFromPixel(camera.intrinsics, pixel);
+    } catch (const std::domain_error&) {
+      continue;  // beyond the distortion's fold
+    }
     double depth = Uniform(rng, options.min_depth, options.max_depth);
     if (options.planar) {
-      // Plane through (0, 0, mid_depth) with `normal`: depth along the ray where it meets it.
       const double denominator = normal.dot(ray);
       if (std::abs(denominator) < 1e-9) continue;
-      depth = normal.dot(Eigen::Vector3d(0, 0, mid_depth)) / denominator;
+      depth = normal.dot(anchor) / denominator;
       if (!(depth > 0.2 * options.min_depth && depth < 5.0 * options.max_depth)) continue;
     }
     scene.points_in_world.push_back(world_from_cam * (depth * ray));

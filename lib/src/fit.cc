@@ -26,8 +26,9 @@ constexpr double kDegPerRad = 180.0 / kPi;
 
 // The point cloud's singular values s1 >= s2 >= s3 (RMS extents along its principal axes):
 // collinear below s2 / s1 = kCollinearRatio, exactly planar (for counting what a plane
-// determines) below s3 / s1 = kPlanarRatio, started from a homography below kPlanarStartRatio
-// (the DLT's 3D information is then too weak to trust under noise).
+// determines) below s3 / s2 = kPlanarRatio, started from a homography below kPlanarStartRatio
+// (the DLT's 3D information is then too weak to trust under noise). Thickness is measured
+// against s2, not s1: a narrow field of view makes a deep but slender cloud, not a plane.
 constexpr double kCollinearRatio = 1e-9;
 constexpr double kPlanarRatio = 1e-9;
 constexpr double kPlanarStartRatio = 1e-2;
@@ -271,12 +272,13 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   }
   const Model start_model = MakeModel(options, image_size);
   const int num_params = 6 + start_model.NumFree();
-  if (2 * n < num_params || n < 3) {
+  // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
+  if (2 * n < num_params || n < 4) {
     throw SceneError(SceneError::Reason::kTooFewPoints,
                      internal::Concat(n, " points give ", 2 * n, " equations, but the model has ",
                                       num_params, " unknowns (pose 6 + ", start_model.NumFree(),
-                                      " free intrinsics): add points (at least ",
-                                      std::max(3, (num_params + 1) / 2),
+                                      " free intrinsics) and a unique pose needs 4 points: add "
+                                      "points (at least ", std::max(4, (num_params + 1) / 2),
                                       ") or fix intrinsics"));
   }
 
@@ -300,8 +302,8 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   }
   std::vector<Eigen::Vector3d> points(n);
   for (int i = 0; i < n; ++i) points[i] = centred.row(i).transpose() / scale;
-  const bool planar = extents(2) <= kPlanarRatio * extents(0);
-  const bool planar_start = extents(2) <= kPlanarStartRatio * extents(0);
+  const bool planar = extents(2) <= kPlanarRatio * extents(1);
+  const bool planar_start = extents(2) <= kPlanarStartRatio * extents(1);
 
   const bool known = options.known_intrinsics.has_value();
   if (planar && start_model.NumFreeLinear() > 2) {

@@ -1,0 +1,381 @@
+#include "camproj/points_file.h"
+
+#include <sys/stat.h>
+
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <string_view>
+#include <system_error>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "camproj/errors.h"
+#include "check.h"
+
+namespace camproj {
+
+namespace {
+
+constexpr std::array<const char*, 5> kRequiredColumns = {"X", "Y", "Z", "u", "v"};
+constexpr std::string_view kIdColumn = "id";
+constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
+// File text quoted in a message is cut to this many bytes: a message is read, not a dump.
+constexpr size_t kMaxQuotedBytes = 60;
+
+std::string_view Trim(std::string_view text) {
+  const size_t begin = text.find_first_not_of(" \t");
+  if (begin == std::string_view::npos) return {};
+  return text.substr(begin, text.find_last_not_of(" \t") - begin + 1);
+}
+
+// File text made safe for a terminal and cut short.
+std::string Printable(std::string_view text) {
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < kMaxQuotedBytes; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 0xf];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  if (text.size() > kMaxQuotedBytes) out += "...";
+  return out;
+}
+
+std::string Quoted(std::string_view text) { return "\"" + Printable(text) + "\""; }
+
+void Split(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
+  size_t begin = 0;
+  while (true) {
+    const size_t comma = line.find(',', begin);
+    if (comma == std::string_view::npos) {
+      fields.push_back(Trim(line.substr(begin)));
+      return;
+    }
+    fields.push_back(Trim(line.substr(begin, comma - begin)));
+    begin = comma + 1;
+  }
+}
+
+bool ParsesAsNumber(std::string_view field) {
+  if (field.size() > 1 && field[0] == '+' && field[1] != '-' && field[1] != '+') {
+    field.remove_prefix(1);
+  }
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+  return error == std::errc() && end == field.data() + field.size();
+}
+
+// Fed one line at a time, so that text and streamed files share every rule and message.
+class CsvParser {
+ public:
+  CsvParser(std::string source, const CorrespondencesLimits& limits)
+      : source_(std::move(source)), limits_(limits) {}
+
+  // The line number the next AddLine call will be given.
+  int64_t next_line() const { return line_ + 1; }
+
+  [[noreturn]] void FailLine(int64_t line, const std::string& what) const {
+    throw InputError(source_ + ": line " + std::to_string(line) + ": " + what);
+  }
+
+  [[noreturn]] void FailLongLine(int64_t line) const {
+    throw InputError(source_ + ": line " + std::to_string(line) + " is longer than " +
+                     std::to_string(limits_.max_line_bytes) + " bytes");
+  }
+
+  // `line` has no '\n'; a trailing '\r' is still there.
+  void AddLine(std::string_view line) {
+    ++line_;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.size() > limits_.max_line_bytes) FailLongLine(line_);
+    if (line_ > INT_MAX) FailLine(line_, "more than " + std::to_string(INT_MAX) + " lines");
+    if (line_ == 1 && line.substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark) {
+      line.remove_prefix(kUtf8ByteOrderMark.size());
+    }
+    const std::string_view trimmed = Trim(line);
+    if (trimmed.empty()) return;
+    saw_text_ = true;
+    if (trimmed.front() == '#') return;
+    Split(line, fields_);
+    if (header_line_ == 0) {
+      ReadHeader();
+    } else {
+      ReadRow();
+    }
+  }
+
+  Correspondences Finish() {
+    if (header_line_ == 0) {
+      throw InputError(
+          source_ + ": " +
+          (saw_text_ ? "no header: the file has only comments and blank lines" : "empty file") +
+          "; expected a header line naming the columns X,Y,Z,u,v");
+    }
+    if (result_.pixels.empty()) {
+      throw InputError(source_ + ": the header (line " + std::to_string(header_line_) +
+                       ") is followed by no data rows");
+    }
+    return std::move(result_);
+  }
+
+ private:
+  std::string ColumnLabel(size_t index) const {
+    std::string label = "column " + std::to_string(index + 1);
+    if (index < names_.size() && !names_[index].empty()) label += " (" + names_[index] + ")";
+    return label;
+  }
+
+  [[noreturn]] void FailField(size_t index, const std::string& what) const {
+    throw InputError(source_ + ": line " + std::to_string(line_) + ", " + ColumnLabel(index) +
+                     ": " + what);
+  }
+
+  void ReadHeader() {
+    header_line_ = line_;
+    std::unordered_map<std::string_view, size_t> index_of_name;
+    for (size_t i = 0; i < fields_.size(); ++i) {
+      names_.emplace_back(fields_[i]);
+      // Unnamed columns (a trailing comma) are ignored like any extra column.
+      if (fields_[i].empty()) continue;
+      const auto [it, inserted] = index_of_name.emplace(fields_[i], i);
+      if (!inserted) {
+        FailField(i, "duplicate column name; column " + std::to_string(it->second + 1) +
+                         " is also " + Printable(fields_[i]));
+      }
+    }
+    std::string missing;
+    int missing_count = 0;
+    for (size_t c = 0; c < kRequiredColumns.size(); ++c) {
+      const auto it = index_of_name.find(kRequiredColumns[c]);
+      if (it == index_of_name.end()) {
+        missing += (missing.empty() ? "" : ",") + std::string(kRequiredColumns[c]);
+        ++missing_count;
+      } else {
+        column_[c] = it->second;
+      }
+    }
+    if (missing_count > 0) {
+      std::string has;
+      for (size_t i = 0; i < names_.size(); ++i) has += (i == 0 ? "" : ",") + names_[i];
+      FailLine(line_, std::string("header lacks column") + (missing_count > 1 ? "s " : " ") +
+                          missing + "; it has " + Printable(has) + HeaderHint());
+    }
+    const auto id = index_of_name.find(kIdColumn);
+    if (id != index_of_name.end()) id_column_ = id->second;
+  }
+
+  // Names the likely cause of a header that lacks the required columns.
+  std::string HeaderHint() const {
+    if (ParsesAsNumber(fields_[0])) {
+      return " (the first line that is not blank or a comment must be the header)";
+    }
+    for (const std::string& name : names_) {
+      if (name.find_first_of(";\t") != std::string::npos) {
+        return " (fields must be separated by commas)";
+      }
+      for (const char* required : kRequiredColumns) {
+        if (name.size() == 1 && name[0] != required[0] &&
+            std::tolower(static_cast<unsigned char>(name[0])) ==
+                std::tolower(static_cast<unsigned char>(required[0]))) {
+          return " (column names are case-sensitive)";
+        }
+      }
+    }
+    return "";
+  }
+
+  void ReadRow() {
+    bool all_empty = true;  // ",,,,"
+    for (const std::string_view field : fields_) all_empty = all_empty && field.empty();
+    if (all_empty) return;
+    if (fields_.size() < names_.size()) {
+      FailLine(line_, std::to_string(fields_.size()) + " fields, but the header (line " +
+                          std::to_string(header_line_) + ") has " + std::to_string(names_.size()) +
+                          "; " + ColumnLabel(fields_.size()) + " is missing");
+    }
+    if (fields_.size() > names_.size()) {
+      FailLine(line_, std::to_string(fields_.size()) + " fields, but the header (line " +
+                          std::to_string(header_line_) + ") has " + std::to_string(names_.size()) +
+                          "; column " + std::to_string(names_.size() + 1) +
+                          " is not in the header");
+    }
+    if (result_.pixels.size() >= limits_.max_points) {
+      FailLine(line_, "more than " + std::to_string(limits_.max_points) + " data rows");
+    }
+    std::array<double, 5> values{};
+    for (size_t c = 0; c < values.size(); ++c) values[c] = Number(column_[c]);
+    std::string id;
+    if (id_column_) {
+      const std::string_view text = fields_[*id_column_];
+      if (text.empty()) FailField(*id_column_, "empty id");
+      const auto [it, inserted] = line_of_id_.emplace(std::string(text), static_cast<int>(line_));
+      if (!inserted) {
+        FailField(*id_column_, "duplicate id " + Quoted(text) + " (also on line " +
+                                   std::to_string(it->second) + ")");
+      }
+      id = text;
+    } else {
+      id = std::to_string(result_.pixels.size() + 1);
+    }
+    result_.points_in_world.emplace_back(values[0], values[1], values[2]);
+    result_.pixels.emplace_back(values[3], values[4]);
+    result_.ids.push_back(std::move(id));
+    result_.line_numbers.push_back(static_cast<int>(line_));
+  }
+
+  double Number(size_t index) const {
+    std::string_view field = fields_[index];
+    // from_chars refuses the '+' that strtod and spreadsheets accept.
+    if (field.size() > 1 && field[0] == '+' && field[1] != '-' && field[1] != '+') {
+      field.remove_prefix(1);
+    }
+    double value = 0.0;
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+    if (error == std::errc::result_out_of_range) {
+      FailField(index, Quoted(fields_[index]) + " is out of the range of a double");
+    }
+    if (error != std::errc() || end != field.data() + field.size()) {
+      FailField(index, "expected a number, got " + Quoted(fields_[index]));
+    }
+    if (!std::isfinite(value)) FailField(index, Quoted(fields_[index]) + " is not finite");
+    return value;
+  }
+
+  std::string source_;
+  CorrespondencesLimits limits_;
+  int64_t line_ = 0;
+  bool saw_text_ = false;
+  int64_t header_line_ = 0;  // 0 until the header is read
+  std::vector<std::string> names_;
+  std::array<size_t, 5> column_{};  // index of X, Y, Z, u, v in a row
+  std::optional<size_t> id_column_;
+  std::unordered_map<std::string, int> line_of_id_;
+  std::vector<std::string_view> fields_;  // reused: one allocation for all rows
+  Correspondences result_;
+};
+
+std::string IdProblem(const std::string& id) {
+  if (id.empty()) return "is empty";
+  if (id.find_first_of(",\r\n") != std::string::npos) return "contains a comma or line break";
+  if (Trim(id).size() != id.size()) return "has surrounding spaces or tabs";
+  return "";
+}
+
+void AppendNumber(double value, std::string& out) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  (void)error;  // 32 bytes hold any double's shortest form (at most 24)
+  out.append(buffer, end);
+}
+
+}  // namespace
+
+void CorrespondencesLimits::Check() const {
+  internal::Require(max_line_bytes > 0, "max_line_bytes must be positive, got ", max_line_bytes);
+  internal::Require(max_points > 0, "max_points must be positive, got ", max_points);
+}
+
+Correspondences CorrespondencesFromCsvText(const std::string& text, const std::string& source,
+                                           const CorrespondencesLimits& limits) {
+  limits.Check();
+  CsvParser parser(source, limits);
+  const std::string_view all(text);
+  size_t begin = 0;
+  while (begin < all.size()) {
+    size_t end = all.find('\n', begin);
+    if (end == std::string_view::npos) end = all.size();
+    parser.AddLine(all.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return parser.Finish();
+}
+
+Correspondences ReadCorrespondencesFile(const std::string& path,
+                                        const CorrespondencesLimits& limits) {
+  limits.Check();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
+  struct stat info {};
+  if (stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) {
+    throw InputError(path + ": is a directory, expected a file");
+  }
+  CsvParser parser(path, limits);
+  // `pending` holds the start of a line that runs past the buffer; a line may end in '\r' that
+  // AddLine drops, so one byte more than the limit is still a candidate.
+  std::string pending;
+  std::vector<char> buffer(size_t{1} << 16);
+  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
+    const std::string_view chunk(buffer.data(), static_cast<size_t>(in.gcount()));
+    size_t begin = 0;
+    while (begin < chunk.size()) {
+      const size_t newline = chunk.find('\n', begin);
+      const size_t end = newline == std::string_view::npos ? chunk.size() : newline;
+      const std::string_view piece = chunk.substr(begin, end - begin);
+      if (pending.size() + piece.size() > limits.max_line_bytes + 1) {
+        parser.FailLongLine(parser.next_line());
+      }
+      if (newline == std::string_view::npos) {
+        pending.append(piece);
+      } else if (pending.empty()) {
+        parser.AddLine(piece);
+      } else {
+        pending.append(piece);
+        parser.AddLine(pending);
+        pending.clear();
+      }
+      begin = end + 1;
+    }
+  }
+  if (in.bad()) throw InputError(path + ": cannot read: " + std::strerror(errno));
+  if (!pending.empty()) parser.AddLine(pending);
+  return parser.Finish();
+}
+
+std::string CorrespondencesToCsvText(const Correspondences& correspondences) {
+  const Correspondences& c = correspondences;
+  const size_t n = c.points_in_world.size();
+  internal::Require(n > 0, "no correspondences to write");
+  internal::Require(c.pixels.size() == n, "points_in_world has ", n, " entries but pixels has ",
+                    c.pixels.size());
+  internal::Require(c.ids.empty() || c.ids.size() == n, "points_in_world has ", n,
+                    " entries but ids has ", c.ids.size());
+  bool write_ids = false;
+  std::unordered_set<std::string_view> seen;
+  for (size_t i = 0; i < c.ids.size(); ++i) {
+    const std::string problem = IdProblem(c.ids[i]);
+    internal::Require(problem.empty(), "id ", i, " ", Quoted(c.ids[i]), " ", problem);
+    internal::Require(seen.insert(c.ids[i]).second, "id ", Quoted(c.ids[i]), " is repeated");
+    write_ids = write_ids || c.ids[i] != std::to_string(i + 1);
+  }
+  std::string text = write_ids ? "X,Y,Z,u,v,id\n" : "X,Y,Z,u,v\n";
+  for (size_t i = 0; i < n; ++i) {
+    internal::Require(c.points_in_world[i].allFinite() && c.pixels[i].allFinite(), "point ", i,
+                      " is not finite: X,Y,Z = ", c.points_in_world[i].transpose(),
+                      ", u,v = ", c.pixels[i].transpose());
+    const double values[] = {c.points_in_world[i].x(), c.points_in_world[i].y(),
+                             c.points_in_world[i].z(), c.pixels[i].x(), c.pixels[i].y()};
+    for (size_t k = 0; k < 5; ++k) {
+      if (k > 0) text += ',';
+      AppendNumber(values[k], text);
+    }
+    if (write_ids) text += "," + c.ids[i];
+    text += '\n';
+  }
+  return text;
+}
+
+}  // namespace camproj
