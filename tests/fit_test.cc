@@ -1,6 +1,7 @@
 #include "camproj/fit.h"
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -147,6 +148,286 @@ INSTANTIATE_TEST_SUITE_P(
         NoiseFreeCase{"RadialDistortion",   30, false, 12, 80, true,  false, false, false},
         NoiseFreeCase{"KnownIntrinsics",    30, false, 4,  40, true,  false, false, true}),
     [](const ::testing::TestParamInfo<NoiseFreeCase>& info) { return info.param.name; });
+
+// A projector-like camera: off-axis principal point (lens shift), fx != fy, moderate field of view.
+RandomCamera ProjectorLikeCamera(std::mt19937_64& rng) {
+  RandomCamera camera;
+  camera.size = {1280, 800};
+  camera.intrinsics.fx = testing::Uniform(rng, 900, 1500);
+  camera.intrinsics.fy = camera.intrinsics.fx * testing::Uniform(rng, 0.97, 1.03);
+  camera.intrinsics.cx = testing::Uniform(rng, 500, 780);
+  camera.intrinsics.cy = testing::Uniform(rng, 500, 799);
+  camera.cam_from_world =
+      CamFromWorldFromCenter(testing::RandomRotation(rng),
+                             Eigen::Vector3d(testing::Uniform(rng, -5, 5),
+                                             testing::Uniform(rng, -5, 5), testing::Uniform(rng, -5, 5)));
+  return camera;
+}
+
+// The estimation error in the fit's user parameterization (fit.h: rotation as the small angle
+// omega with R = exp(omega) R_hat, degrees; eye in world units; free intrinsics in px).
+Eigen::VectorXd EstimationError(const FitResult& fit, const RandomCamera& truth) {
+  const int p = static_cast<int>(fit.free_parameters.size());
+  Eigen::VectorXd error(p);
+  const Eigen::AngleAxisd omega_true(truth.cam_from_world.rotation *
+                                     fit.camera.cam_from_world.rotation.transpose());
+  // u_hat = 0, u_true = omega_true: error = -omega_true.
+  error.head<3>() = -omega_true.angle() * omega_true.axis() * 180.0 / M_PI;
+  error.segment<3>(3) = CameraCenterInWorld(fit.camera.cam_from_world) -
+                        CameraCenterInWorld(truth.cam_from_world);
+  const Intrinsics& k = fit.camera.intrinsics;
+  const Intrinsics& t = truth.intrinsics;
+  for (int j = 6; j < p; ++j) {
+    const std::string& name = fit.free_parameters[j];
+    if (name == "fx") error(j) = k.fx - t.fx;
+    if (name == "fy") error(j) = k.fy - t.fy;
+    if (name == "cx") error(j) = k.cx - t.cx;
+    if (name == "cy") error(j) = k.cy - t.cy;
+    if (name == "skew") error(j) = k.skew - t.skew;
+    if (name == "k1") error(j) = k.k1 - t.k1;
+    if (name == "k2") error(j) = k.k2 - t.k2;
+  }
+  return error;
+}
+
+struct NoisyCase {
+  int num_points;
+  int trials;
+  double rms_tolerance;  // relative, on the mean of RMS^2 (see the test)
+};
+
+class NoisyFitTest : public ::testing::TestWithParam<NoisyCase> {};
+
+// With sigma = 1 px per axis, the sum of squared residuals at the least-squares optimum is
+// sigma^2 chi^2 with 2N - p degrees of freedom (to first order), so E[RMS^2] = sigma^2 (2N - p)/N.
+// Over T trials the mean of RMS^2 has relative standard deviation sqrt(2 / ((2N - p) T)):
+// 1.4 % for N = 10, T = 1000 (bound 5 %: 3.5 sd) and 0.58 % for N = 100, T = 300 (bound 3 %).
+// NEES = e^T Sigma^-1 e with the given sigma is chi^2_p: its mean over T trials has relative sd
+// sqrt(2 / (p T)) = 2.6 % for p = 10, T = 300 (bound 10 %: 3.9 sd).
+TEST_P(NoisyFitTest, ResidualsAndReportedSigmasMatchTheirDistributions) {
+  const NoisyCase& c = GetParam();
+  std::mt19937_64 rng(1000 + c.num_points);
+  double sum_rms2 = 0.0;
+  double sum_nees = 0.0;
+  int p = 0;
+  for (int trial = 0; trial < c.trials; ++trial) {
+    const RandomCamera camera = ProjectorLikeCamera(rng);
+    SceneOptions scene_options;
+    scene_options.num_points = c.num_points;
+    scene_options.pixel_noise = 1.0;
+    const Scene scene = MakeScene(rng, camera, scene_options);
+    FitOptions options;  // focal, aspect, principal point free: p = 10
+    options.pixel_sigma = 1.0;
+    const FitResult fit = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+    p = static_cast<int>(fit.free_parameters.size());
+    sum_rms2 += fit.rms_px * fit.rms_px;
+    ASSERT_TRUE(fit.covariance_available);
+    const Eigen::VectorXd e = EstimationError(fit, camera);
+    sum_nees += e.dot(fit.covariance.ldlt().solve(e));
+  }
+  ASSERT_EQ(p, 10);
+  const double expected_rms2 = (2.0 * c.num_points - p) / c.num_points;
+  const double mean_rms2 = sum_rms2 / c.trials;
+  EXPECT_NEAR(mean_rms2 / expected_rms2, 1.0, c.rms_tolerance)
+      << "mean RMS^2 " << mean_rms2 << " expected " << expected_rms2;
+  const double mean_nees = sum_nees / c.trials;
+  EXPECT_NEAR(mean_nees / p, 1.0, 0.10) << "mean NEES " << mean_nees << " for p = " << p;
+}
+
+INSTANTIATE_TEST_SUITE_P(SigmaOnePixel, NoisyFitTest,
+                         ::testing::Values(NoisyCase{10, 1000, 0.05}, NoisyCase{100, 300, 0.03},
+                                           NoisyCase{1000, 300, 0.03}),
+                         [](const ::testing::TestParamInfo<NoisyCase>& info) {
+                           return "N" + std::to_string(info.param.num_points);
+                         });
+
+// The same scene in metres, in millimetres, and in millimetres offset by 4e6 (projected map
+// coordinates) must give the same camera: the fitter centres and scales the world first.
+TEST(FitTest, InvariantToWorldUnitsAndOffsets) {
+  std::mt19937_64 rng(77);
+  for (int i = 0; i < 20; ++i) {
+    const RandomCamera camera = ProjectorLikeCamera(rng);
+    SceneOptions scene_options;
+    scene_options.num_points = 30;
+    scene_options.pixel_noise = 1.0;
+    scene_options.planar = i % 4 == 3;
+    const Scene scene = MakeScene(rng, camera, scene_options);
+    FitOptions options;
+    if (scene_options.planar) {
+      options.principal_point = ParameterMode::Default();
+      options.aspect = ParameterMode::Default();
+    }
+    const FitResult metres = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+    const Eigen::Vector3d offset(4e6, 4e6, 1e3);
+    for (const bool with_offset : {false, true}) {
+      std::vector<Eigen::Vector3d> points = scene.points_in_world;
+      for (auto& x : points) x = 1000.0 * x + (with_offset ? offset : Eigen::Vector3d::Zero());
+      const FitResult mm = FitCamera(points, scene.observed_pixels, camera.size, options);
+      const Intrinsics& a = metres.camera.intrinsics;
+      const Intrinsics& b = mm.camera.intrinsics;
+      constexpr double kInvariance = 1e-9;
+      EXPECT_NEAR(b.fx, a.fx, kInvariance * a.fx) << i;
+      EXPECT_NEAR(b.fy, a.fy, kInvariance * a.fy) << i;
+      EXPECT_NEAR(b.cx, a.cx, kInvariance * a.fx) << i;
+      EXPECT_NEAR(b.cy, a.cy, kInvariance * a.fx) << i;
+      const Eigen::Vector3d eye_m = CameraCenterInWorld(metres.camera.cam_from_world);
+      const Eigen::Vector3d eye_mm =
+          (CameraCenterInWorld(mm.camera.cam_from_world) - (with_offset ? offset : Eigen::Vector3d::Zero())) / 1000.0;
+      EXPECT_LT((eye_mm - eye_m).norm(), kInvariance * (eye_m.norm() + 1.0)) << i;
+      EXPECT_LT(RotationAngle(mm.camera.cam_from_world.rotation, metres.camera.cam_from_world.rotation),
+                kInvariance) << i;
+      EXPECT_NEAR(mm.rms_px, metres.rms_px, kInvariance * metres.rms_px) << i;
+    }
+  }
+}
+
+SceneError::Reason RefusalOf(const std::vector<Eigen::Vector3d>& points,
+                             const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                             const FitOptions& options, std::string* message) {
+  try {
+    FitCamera(points, pixels, size, options);
+  } catch (const SceneError& e) {
+    *message = e.what();
+    return e.reason();
+  }
+  ADD_FAILURE() << "no refusal";
+  return SceneError::Reason::kDegenerate;
+}
+
+class RefusalTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::mt19937_64 rng(5);
+    camera_ = ProjectorLikeCamera(rng);
+    SceneOptions options;
+    options.num_points = 20;
+    scene_ = MakeScene(rng, camera_, options);
+  }
+  RandomCamera camera_;
+  Scene scene_;
+  std::string message_;
+};
+
+TEST_F(RefusalTest, TooFewPointsForTheFreeParameters) {
+  std::vector<Eigen::Vector3d> points(scene_.points_in_world.begin(), scene_.points_in_world.begin() + 4);
+  std::vector<Eigen::Vector2d> pixels(scene_.observed_pixels.begin(), scene_.observed_pixels.begin() + 4);
+  EXPECT_EQ(RefusalOf(points, pixels, camera_.size, {}, &message_), SceneError::Reason::kTooFewPoints);
+  EXPECT_NE(message_.find("10 unknowns"), std::string::npos) << message_;
+  // Five non-coplanar points with the principal point free: 10 equations, but no linear start.
+  points.push_back(scene_.points_in_world[4]);
+  pixels.push_back(scene_.observed_pixels[4]);
+  EXPECT_EQ(RefusalOf(points, pixels, camera_.size, {}, &message_), SceneError::Reason::kTooFewPoints);
+  EXPECT_NE(message_.find("6 non-coplanar"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, CollinearPoints) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  for (int i = 0; i < 10; ++i) {
+    points.push_back(Eigen::Vector3d(1, 2, 3) + i * Eigen::Vector3d(0.3, -0.1, 0.2));
+    pixels.push_back(Eigen::Vector2d(100 + i, 200 + 2 * i));
+  }
+  EXPECT_EQ(RefusalOf(points, pixels, camera_.size, {}, &message_), SceneError::Reason::kCollinearPoints);
+  EXPECT_NE(message_.find("collinear"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, PlanarSceneWithTooManyFreeIntrinsicsNamesWhatToFix) {
+  std::mt19937_64 rng(6);
+  SceneOptions options;
+  options.planar = true;
+  options.num_points = 30;
+  const Scene plane = MakeScene(rng, camera_, options);
+  EXPECT_EQ(RefusalOf(plane.points_in_world, plane.observed_pixels, camera_.size, {}, &message_),
+            SceneError::Reason::kPlanarUnderdetermined);
+  EXPECT_NE(message_.find("focal, aspect, principal point are free"), std::string::npos) << message_;
+  EXPECT_NE(message_.find("Fix the principal point"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, NonFiniteInputNamesThePoint) {
+  std::vector<Eigen::Vector3d> points = scene_.points_in_world;
+  points[7].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(RefusalOf(points, scene_.observed_pixels, camera_.size, {}, &message_),
+            SceneError::Reason::kNonFiniteInput);
+  EXPECT_NE(message_.find("point 7"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, PointsBehindTheCamera) {
+  // Reflecting half the points through the camera centre keeps their pixels (the projective
+  // camera cannot tell) but puts them behind it: no real camera sees all of them.
+  const Eigen::Vector3d center = CameraCenterInWorld(camera_.cam_from_world);
+  std::vector<Eigen::Vector3d> points = scene_.points_in_world;
+  for (size_t i = 0; i < points.size(); i += 2) points[i] = 2.0 * center - points[i];
+  EXPECT_EQ(RefusalOf(points, scene_.true_pixels, camera_.size, {}, &message_),
+            SceneError::Reason::kPointsBehindCamera);
+  EXPECT_NE(message_.find("behind"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, MirroredWorldIsNamedWithTheFix) {
+  std::vector<Eigen::Vector3d> points = scene_.points_in_world;
+  for (auto& x : points) x.z() = -x.z();
+  EXPECT_EQ(RefusalOf(points, scene_.true_pixels, camera_.size, {}, &message_),
+            SceneError::Reason::kMirroredWorld);
+  EXPECT_NE(message_.find("left-handed"), std::string::npos) << message_;
+  EXPECT_NE(message_.find("Flip one world axis"), std::string::npos) << message_;
+}
+
+TEST_F(RefusalTest, PlaneSeenHeadOnDoesNotDetermineTheFocalLength) {
+  // A plane parallel to the image plane: distance and focal length trade off exactly.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  Intrinsics k;
+  k.fx = k.fy = 1000;
+  k.cx = 639.5;
+  k.cy = 399.5;
+  for (int i = 0; i < 5; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const Eigen::Vector3d point_in_cam(-0.8 + 0.4 * i, -0.6 + 0.4 * j, 3.0);
+      points.push_back(point_in_cam);
+      pixels.push_back(PixelFromCam(k, point_in_cam));
+    }
+  }
+  FitOptions options;
+  options.aspect = ParameterMode::Default();
+  options.principal_point = ParameterMode::Default();
+  EXPECT_EQ(RefusalOf(points, pixels, {1280, 800}, options, &message_), SceneError::Reason::kDegenerate);
+  EXPECT_NE(message_.find("fx"), std::string::npos) << message_;
+  // With the focal length given, the same points determine the pose.
+  options.focal = ParameterMode::Fixed(1000);
+  const FitResult fit = FitCamera(points, pixels, {1280, 800}, options);
+  EXPECT_LT((CameraCenterInWorld(fit.camera.cam_from_world)).norm(), 1e-9);
+}
+
+TEST_F(RefusalTest, BadOptionsAreInvalidArguments) {
+  FitOptions options;
+  options.loss = LossType::kHuber;
+  options.loss_scale_px = 0;
+  EXPECT_THROW(FitCamera(scene_.points_in_world, scene_.observed_pixels, camera_.size, options),
+               std::invalid_argument);
+  options = {};
+  options.focal = ParameterMode::Default();
+  EXPECT_THROW(FitCamera(scene_.points_in_world, scene_.observed_pixels, camera_.size, options),
+               std::invalid_argument);
+  std::vector<Eigen::Vector2d> fewer(scene_.observed_pixels.begin(), scene_.observed_pixels.end() - 1);
+  EXPECT_THROW(FitCamera(scene_.points_in_world, fewer, camera_.size, {}), std::invalid_argument);
+}
+
+TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
+  const FitResult fit = FitCamera(scene_.points_in_world, scene_.observed_pixels, camera_.size, {});
+  ASSERT_GE(fit.trace.size(), 2u);
+  EXPECT_EQ(fit.trace.front().iteration, 0);
+  EXPECT_LE(fit.trace.back().rms_px, fit.trace.front().rms_px);
+  EXPECT_NEAR(fit.trace.back().rms_px, fit.rms_px, 1e-9);
+  // Near and far: 10 % margin around the depths (2..4 in MakeScene).
+  EXPECT_GT(fit.camera.z_near, 2.0 / 1.1 - 1e-6);
+  EXPECT_LT(fit.camera.z_far, 4.0 * 1.1 + 1e-6);
+  // The look-at target is on the gaze at the points' median depth.
+  const Eigen::Vector3d target_in_cam = fit.camera.cam_from_world * fit.views.look_at.target;
+  EXPECT_NEAR(target_in_cam.x(), 0.0, 1e-9);
+  EXPECT_GT(target_in_cam.z(), 2.0);
+  EXPECT_LT(target_in_cam.z(), 4.0);
+  EXPECT_TRUE(fit.views.frustum.has_value());
+  EXPECT_FALSE(fit.views.perspective.has_value());  // off-axis
+}
 
 }  // namespace
 }  // namespace camproj

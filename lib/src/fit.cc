@@ -170,11 +170,15 @@ class TraceCallback : public ceres::IterationCallback {
 constexpr int kMaxParams = 6 + internal::kFitIntrinsicsSize;
 using Jet = ceres::Jet<double, kMaxParams>;
 
+// Also fills `residuals` (predicted - observed, 2N) when given.
 Eigen::MatrixXd UserJacobian(const std::vector<Eigen::Vector3d>& points,
                              const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                             const Model& model, int num_params) {
+                             const Model& model, int num_params,
+                             const std::vector<Eigen::Vector2d>* pixels = nullptr,
+                             Eigen::VectorXd* residuals = nullptr) {
   const int n = static_cast<int>(points.size());
   Eigen::MatrixXd jacobian(2 * n, num_params);
+  if (residuals != nullptr) residuals->resize(2 * n);
   Jet omega[3];
   Jet c[3];
   Jet k[internal::kFitIntrinsicsSize];
@@ -200,8 +204,53 @@ Eigen::MatrixXd UserJacobian(const std::vector<Eigen::Vector3d>& points,
       jacobian(2 * i, j) = pixel[0].v[j];
       jacobian(2 * i + 1, j) = pixel[1].v[j];
     }
+    if (residuals != nullptr) {
+      (*residuals)(2 * i) = pixel[0].a - (*pixels)[i].x();
+      (*residuals)(2 * i + 1) = pixel[1].a - (*pixels)[i].y();
+    }
   }
   return jacobian;
+}
+
+// Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
+// (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
+// flat directions; undamped steps with the exact Jacobian take it to rounding level.
+void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
+                       const std::vector<Eigen::Vector2d>& pixels, int num_params,
+                       Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model) {
+  constexpr int kMaxSteps = 4;
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian =
+      UserJacobian(points, *rotation, *center, *model, num_params, &pixels, &residuals);
+  double cost = residuals.squaredNorm();
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const Eigen::VectorXd delta = -jacobian.colPivHouseholderQr().solve(residuals);
+    if (!delta.allFinite()) return;
+    Eigen::Matrix3d new_rotation = *rotation;
+    const double angle = delta.head<3>().norm();
+    if (angle > 0.0) {
+      new_rotation = Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix() * *rotation;
+    }
+    const Eigen::Vector3d new_center = *center + delta.segment<3>(3);
+    Model new_model = *model;
+    int next = 6;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (new_model.free[slot]) new_model.value[slot] += delta(next++);
+    }
+    Eigen::VectorXd new_residuals;
+    const Eigen::MatrixXd new_jacobian = UserJacobian(points, new_rotation, new_center, new_model,
+                                                      num_params, &pixels, &new_residuals);
+    const double new_cost = new_residuals.squaredNorm();
+    if (!(new_cost <= cost)) return;
+    *rotation = new_rotation;
+    *center = new_center;
+    *model = new_model;
+    const bool settled = cost - new_cost <= 1e-15 * cost;
+    cost = new_cost;
+    jacobian = new_jacobian;
+    residuals = new_residuals;
+    if (settled) return;
+  }
 }
 
 double Median(std::vector<double> values) {
@@ -450,7 +499,10 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   }
   model.value = intrinsics;
   rotation.normalize();
-  const Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
+  Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
+  if (options.loss == LossType::kNone) {
+    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model);
+  }
 
   // Residuals and depths.
   Camera& camera = result.camera;

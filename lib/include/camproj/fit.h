@@ -68,7 +68,7 @@ struct FitOptions {
   std::optional<double> pixel_sigma;
 
   int max_iterations = 100;
-  double function_tolerance = 1e-14;   // Ceres' relative cost change
+  double function_tolerance = 1e-16;   // Ceres' relative cost change
   double gradient_tolerance = 1e-16;
   double parameter_tolerance = 1e-14;  // relative step
 
