@@ -20,8 +20,8 @@
 namespace camproj {
 namespace {
 
-// Real correspondences shared by the project (provenance in /work/shared/data/real/README.md).
-const std::string kRealData = "/work/shared/data/real";
+// Real correspondences bundled with the project (provenance in data/real/README.md).
+const std::string kRealData = CAMPROJ_DATA_DIR "/real";
 
 uint64_t Bits(double value) {
   uint64_t bits = 0;
@@ -69,9 +69,6 @@ void ExpectContainsAll(const std::string& message, std::initializer_list<const c
 TEST(PointsFileTest, ReadsTheRealBalbianelloAndChessboardFiles) {
   const std::string balbianello = kRealData + "/balbianello/cam0.csv";
   const std::string chessboard = kRealData + "/opencv_chessboard/left01.csv";
-  if (!std::filesystem::exists(balbianello) || !std::filesystem::exists(chessboard)) {
-    GTEST_SKIP() << "shared real data not present under " << kRealData;
-  }
   const Correspondences b = ReadCorrespondencesFile(balbianello);
   ASSERT_EQ(b.points_in_world.size(), 279u);
   ASSERT_EQ(b.pixels.size(), 279u);
