@@ -434,5 +434,58 @@ TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
   EXPECT_FALSE(fit.views.perspective.has_value());  // off-axis
 }
 
+// Three mis-clicked points (60 px off) among 40: a Cauchy loss with a 2 px scale keeps the camera
+// near the truth; plain least squares is pulled away by them.
+TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
+  std::mt19937_64 rng(31);
+  const RandomCamera camera = ProjectorLikeCamera(rng);
+  SceneOptions scene_options;
+  scene_options.num_points = 40;
+  scene_options.pixel_noise = 0.5;
+  Scene scene = MakeScene(rng, camera, scene_options);
+  for (int i : {3, 17, 29}) scene.observed_pixels[i] += Eigen::Vector2d(60, -45);
+  FitOptions plain;
+  FitOptions robust;
+  robust.loss = LossType::kCauchy;
+  robust.loss_scale_px = 2.0;
+  const FitResult a = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, plain);
+  const FitResult b = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, robust);
+  const double plain_error = std::abs(a.camera.intrinsics.fx / camera.intrinsics.fx - 1.0);
+  const double robust_error = std::abs(b.camera.intrinsics.fx / camera.intrinsics.fx - 1.0);
+  EXPECT_LT(robust_error, 0.01);
+  EXPECT_LT(robust_error, 0.25 * plain_error);
+  // The outliers stand out in the robust fit's residuals.
+  for (int i : {3, 17, 29}) EXPECT_GT(b.residuals_px[i].norm(), 40.0) << i;
+  EXPECT_LT(b.median_px, 1.5);
+}
+
+// A 3-degree field of view: focal length and distance trade off almost exactly (a telephoto
+// view is nearly affine), and the result says so.
+TEST(FitTest, ReportsTheFocalDistanceCorrelationOfANarrowView) {
+  std::mt19937_64 rng(32);
+  RandomCamera camera = ProjectorLikeCamera(rng);
+  camera.intrinsics.fx = camera.intrinsics.fy = 0.5 * camera.size.width / std::tan(1.5 * M_PI / 180.0);
+  camera.intrinsics.cx = 0.5 * (camera.size.width - 1);
+  camera.intrinsics.cy = 0.5 * (camera.size.height - 1);
+  SceneOptions scene_options;
+  scene_options.num_points = 50;
+  scene_options.pixel_noise = 0.5;
+  scene_options.min_depth = 90;
+  scene_options.max_depth = 110;
+  const Scene scene = MakeScene(rng, camera, scene_options);
+  FitOptions options;
+  options.aspect = ParameterMode::Default();
+  options.principal_point = ParameterMode::Default();
+  const FitResult fit = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+  bool found = false;
+  for (const Correlation& c : fit.strong_correlations) {
+    if ((c.first == "fx" || c.second == "fx") && c.first.rfind("eye", 0) == 0) found = true;
+  }
+  EXPECT_TRUE(found);
+  double fovy_sigma = 0.0;
+  for (const ParameterSigma& s : fit.sigmas) if (s.name == "fovy_deg") fovy_sigma = s.sigma;
+  EXPECT_GT(fovy_sigma, 0.0);
+}
+
 }  // namespace
 }  // namespace camproj
