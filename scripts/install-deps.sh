@@ -7,6 +7,7 @@ packages=(
   libceres-dev libopencv-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  clang libclang-rt-dev llvm  # scripts/fuzz.sh: clang, libFuzzer runtime, llvm-symbolizer
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,67 +1,57 @@
-// camproj: the command line. Each subcommand parses, reads, calls one library function and
-// prints or writes; exit codes: 0 ok, 1 usage, 2 bad input, 3 the scene cannot determine the
-// requested camera.
+// camproj: the command line. Each subcommand parses, reads, calls the library and prints or
+// writes (one file per subcommand). Exit codes: 0 ok, 1 usage, 2 bad input, 3 the scene cannot
+// determine the requested camera.
 #include <iostream>
-#include <string>
+#include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "camproj/camera_file.h"
 #include "camproj/errors.h"
-#include "camproj/export.h"
-
-namespace {
-
-constexpr int kExitUsage = 1;
-constexpr int kExitBadInput = 2;
-
-}  // namespace
+#include "camproj/fit.h"
+#include "cli.h"
 
 int main(int argc, char** argv) {
+  using namespace camproj::cli;
   CLI::App app{
-      "camproj: make an OpenGL camera see exactly what a real camera or projector sees.\n"
-      "Conventions: docs/conventions.md. Exit codes: 0 ok, 1 usage, 2 bad input, 3 the scene\n"
-      "cannot determine the requested camera."};
+      "camproj: make an OpenGL camera see exactly what a real camera or projector sees.\n\n"
+      "Fit a camera to 2D-3D correspondences, export it as OpenGL / glm / OpenCV / COLMAP /\n"
+      "three.js matrices, project points, convert between intrinsics, frustum and projection\n"
+      "matrices. Pixels follow OpenCV's convention ((0,0) is the centre of the top-left pixel)\n"
+      "unless --pixel-origin corner; every convention is in docs/conventions.md.\n\n"
+      "Exit codes: 0 ok, 1 usage, 2 bad input (names the file, line and field), 3 the points\n"
+      "cannot determine the requested camera (says why and what to fix).\n\n"
+      "Example:\n"
+      "  camproj fit data/projector/points.csv --image-size 1920x1080 -o camera.json\n"
+      "  camproj export camera.json --to gl",
+      "camproj"};
   app.require_subcommand(1);
-
-  std::string camera_path;
-  std::string to = "gl";
-  std::string depth = "no";
-  bool reversed_z = false;
-  bool row_major = false;
-  CLI::App* export_cmd = app.add_subcommand(
-      "export", "Print a camera's GL projection and view matrices.\n"
-                "Example: camproj export data/projector/camera.json --to gl --depth zo");
-  export_cmd->add_option("CAMERA", camera_path, "camera file (JSON, docs/camera-file.md)")
-      ->required();
-  export_cmd->add_option("--to", to, "output format")->check(CLI::IsMember({"gl"}));
-  export_cmd->add_option("--depth", depth, "clip depth: no = [-1,1] (GL default), zo = [0,1]")
-      ->check(CLI::IsMember({"no", "zo"}));
-  export_cmd->add_flag("--reversed-z", reversed_z, "near maps to 1, far to 0 (or -1 for no)");
-  export_cmd->add_flag("--row-major", row_major, "print rows instead of GL's column-major order");
-
+  app.fallthrough(false);
+  const std::vector<Command> commands = {AddFitCommand(app),     AddExportCommand(app),
+                                         AddProjectCommand(app), AddConvertCommand(app),
+                                         AddSynthCommand(app),   AddOverlayCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : kExitUsage;
+    return code == 0 ? kExitOk : kExitUsage;
   }
-
   try {
-    if (*export_cmd) {
-      const camproj::Camera camera = camproj::ReadCameraFile(camera_path);
-      camproj::GlExportOptions options;
-      options.depth.clip_depth = camproj::ClipDepthFromString(depth);
-      options.depth.reversed_z = reversed_z;
-      options.row_major = row_major;
-      std::cout << camproj::ExportGl(camera, options);
+    for (const Command& command : commands) {
+      if (*command.app) return command.run();
     }
+  } catch (const UsageError& e) {
+    std::cerr << "camproj: usage: " << e.what() << "\n(see camproj --help)\n";
+    return kExitUsage;
+  } catch (const camproj::SceneError& e) {
+    std::cerr << "camproj: cannot fit: " << e.what() << '\n';
+    return kExitScene;
   } catch (const camproj::InputError& e) {
     std::cerr << "camproj: error: " << e.what() << '\n';
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
     std::cerr << "camproj: error: " << e.what() << '\n';
     return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "camproj: error: " << e.what() << '\n';
+    return kExitBadInput;
   }
-  return 0;
+  return kExitUsage;
 }

@@ -70,30 +70,8 @@ json Matrix4Json(const Eigen::Matrix4d& m) {
 
 json FarJson(double z_far) { return std::isinf(z_far) ? json("inf") : json(z_far); }
 
-}  // namespace
-
-void CameraFileOptions::Check() const {
-  internal::Require(std::isfinite(target_distance) && target_distance > 0.0,
-                    "target distance must be finite and positive, got ", target_distance);
-}
-
-Camera CameraFromJsonText(const std::string& text, const std::string& source) {
-  json document;
-  try {
-    document = json::parse(text);
-  } catch (const json::parse_error& e) {
-    // nlohmann's message names the line and column of the syntax error.
-    throw InputError(source + ": not valid JSON: " + e.what());
-  }
-  const Reader reader(source);
-  Camera camera;
-  const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
-  if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
-      size[1] < 1 || size[0] > 1e6 || size[1] > 1e6) {
-    reader.Fail("image_size", "expected two positive integers (width, height)");
-  }
-  camera.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
-
+// The intrinsics of a camera-file document, in kCenter.
+Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
   PixelOrigin origin = PixelOrigin::kCenter;
   if (document.contains("pixel_origin")) {
     const json& value = document.at("pixel_origin");
@@ -119,7 +97,40 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   } catch (const std::invalid_argument& e) {
     reader.Fail("intrinsics", e.what());
   }
-  camera.intrinsics = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCenter);
+  return ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCenter);
+}
+
+json ParseJson(const std::string& text, const std::string& source) {
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    // nlohmann's message names the line and column of the syntax error.
+    throw InputError(source + ": not valid JSON: " + e.what());
+  } catch (const json::exception& e) {
+    // E.g. a number beyond a double's range ("1e400"): out_of_range, not a parse_error.
+    throw InputError(source + ": invalid JSON: " + e.what());
+  }
+}
+
+}  // namespace
+
+void CameraFileOptions::Check() const {
+  internal::Require(std::isfinite(target_distance) && target_distance > 0.0,
+                    "target distance must be finite and positive, got ", target_distance);
+}
+
+Camera CameraFromJsonText(const std::string& text, const std::string& source) {
+  const json document = ParseJson(text, source);
+  const Reader reader(source);
+  Camera camera;
+  const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
+  if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
+      size[1] < 1 || size[0] > 1e6 || size[1] > 1e6) {
+    reader.Fail("image_size", "expected two positive integers (width, height)");
+  }
+  camera.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
+
+  camera.intrinsics = ReadIntrinsics(document, reader);
 
   try {
     if (document.contains("cam_from_world")) {
@@ -162,12 +173,21 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   return camera;
 }
 
+Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source) {
+  return ReadIntrinsics(ParseJson(text, source), Reader(source));
+}
+
+Intrinsics ReadIntrinsicsFile(const std::string& path) {
+  return IntrinsicsFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
+}
+
 Camera ReadCameraFile(const std::string& path) {
   // A camera file is a few kilobytes; a megabyte bound refuses a wrong file early.
   return CameraFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
 }
 
-std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options) {
+std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options,
+                             const FitRecord* fit) {
   options.Check();
   const CameraViews views = ViewsOfCamera(camera, options.target_distance, options.depth);
   const Intrinsics k =
@@ -204,6 +224,26 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
                     {"reversed_z", options.depth.reversed_z}};
   if (camera.intrinsics.HasDistortion()) {
     document["gl"]["note"] = "the projection matrix is the pinhole part: k1, k2 are not in it";
+  }
+  if (fit != nullptr) {
+    json record;
+    record["rms_px"] = fit->rms_px;
+    record["median_px"] = fit->median_px;
+    record["max_px"] = fit->max_px;
+    record["num_points"] = fit->num_points;
+    record["start"] = fit->start;
+    record["free"] = fit->free;
+    record["fixed"] = json::array();
+    for (const auto& [name, value] : fit->fixed) record["fixed"].push_back({{"name", name}, {"value", value}});
+    record["left_out"] = json::array();
+    for (const auto& [name, why] : fit->left_out) record["left_out"].push_back({{"name", name}, {"why", why}});
+    record["sigma"] = json::object();
+    for (const auto& [name, sigma] : fit->sigma) record["sigma"][name] = sigma;
+    record["pixel_sigma"] = fit->pixel_sigma;
+    record["pixel_sigma_estimated"] = fit->pixel_sigma_estimated;
+    record["iterations"] = fit->iterations;
+    record["time_ms"] = fit->time_ms;
+    document["fit"] = record;
   }
   return document.dump(2) + "\n";
 }

@@ -1,12 +1,73 @@
 #include "camproj/export.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <limits>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <sstream>
+
+#include "camproj/camera_file.h"
+#include "check.h"
 
 namespace camproj {
 
 namespace {
+
+using ordered_json = nlohmann::ordered_json;
+
+constexpr double kRadToDeg = 57.295779513082320876798154814105;
+
+struct FormatName {
+  ExportFormat format;
+  const char* name;
+};
+
+constexpr FormatName kFormatNames[] = {
+    {ExportFormat::kGl, "gl"},
+    {ExportFormat::kGlm, "glm"},
+    {ExportFormat::kOpenCvYaml, "opencv-yaml"},
+    {ExportFormat::kColmap, "colmap"},
+    {ExportFormat::kThree, "three"},
+    {ExportFormat::kJson, "json"},
+};
+
+// A stream that prints doubles so that they read back bit for bit.
+std::ostringstream ExactStream() {
+  std::ostringstream out;
+  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  return out;
+}
+
+// The GL state a matrix built with `depth` needs, as one comment line per call.
+std::string DepthState(const GlDepth& depth, const std::string& prefix) {
+  std::string text = prefix + "glDepthRange(0.0, 1.0);";
+  if (depth.clip_depth == ClipDepth::kZeroToOne) {
+    text += " glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);";
+  }
+  text += depth.reversed_z ? " glDepthFunc(GL_GREATER); glClearDepth(0.0);"
+                           : " glDepthFunc(GL_LESS); glClearDepth(1.0);";
+  return text + "\n";
+}
+
+std::string DepthSummary(const GlDepth& depth) {
+  std::string text = ToString(depth.clip_depth);
+  text += depth.clip_depth == ClipDepth::kZeroToOne ? " ([0, 1])" : " ([-1, 1], GL's default)";
+  if (depth.reversed_z) {
+    text += depth.clip_depth == ClipDepth::kZeroToOne ? ", reversed-Z (near -> 1, far -> 0)"
+                                                      : ", reversed-Z (near -> 1, far -> -1)";
+  }
+  return text;
+}
+
+std::string DistortionNote(const Intrinsics& intrinsics) {
+  auto out = ExactStream();
+  out << "k1 = " << intrinsics.k1 << ", k2 = " << intrinsics.k2
+      << " are not in the projection matrix (GL projection is linear)";
+  return out.str();
+}
 
 void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, bool row_major) {
   out << name;
@@ -18,27 +79,300 @@ void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, 
   out << '\n';
 }
 
-}  // namespace
-
-std::string ExportGl(const Camera& camera, const GlExportOptions& options) {
+std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
   const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
-  std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  auto out = ExactStream();
   out << "# camproj GL export: projection = clip_from_gl_eye, view = gl_eye_from_world\n"
-      << "# " << (options.row_major ? "row-major (transpose before a GL_FALSE upload)"
-                                    : "column-major: upload with transpose = GL_FALSE")
+      << "# "
+      << (options.row_major ? "row-major (transpose before a GL_FALSE upload)"
+                            : "column-major: upload with transpose = GL_FALSE")
       << "; depth " << ToString(options.depth.clip_depth)
-      << (options.depth.clip_depth == ClipDepth::kZeroToOne ? " (glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE))" : " ([-1,1], GL default)")
+      << (options.depth.clip_depth == ClipDepth::kZeroToOne
+              ? " (glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE))"
+              : " ([-1,1], GL default)")
       << (options.depth.reversed_z ? ", reversed-Z (glDepthFunc(GL_GREATER), clear depth 0)" : "")
       << "; near " << camera.z_near << ", far " << camera.z_far << "; viewport 0 0 "
       << camera.image_size.width << ' ' << camera.image_size.height << '\n';
   if (camera.intrinsics.HasDistortion()) {
-    out << "# note: k1 = " << camera.intrinsics.k1 << ", k2 = " << camera.intrinsics.k2
-        << " are not in the projection matrix (GL projection is linear)\n";
+    out << "# note: " << DistortionNote(camera.intrinsics) << '\n';
   }
   PrintMatrix(out, "projection", views.clip_from_gl_eye, options.row_major);
   PrintMatrix(out, "view", views.gl_eye_from_world, options.row_major);
   return out.str();
+}
+
+// A C++ double literal that reads back bit for bit ("0.0", not "0", which glm would take as int).
+std::string CppDouble(double value) {
+  auto out = ExactStream();
+  out << value;
+  std::string text = out.str();
+  if (text.find_first_of(".e") == std::string::npos) text += ".0";
+  return text;
+}
+
+void PrintGlmMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m) {
+  out << "const glm::dmat4 " << name << "(\n";
+  for (int col = 0; col < 4; ++col) {
+    out << "    ";
+    for (int row = 0; row < 4; ++row) {
+      out << CppDouble(m(row, col)) << (row < 3 ? ", " : "");
+    }
+    out << (col < 3 ? ",  // column " : ");  // column ") << col << '\n';
+  }
+}
+
+std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
+  const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
+  auto out = ExactStream();
+  out << "// camproj glm export: projection = clip_from_gl_eye, view = gl_eye_from_world.\n"
+      << "// #include <glm/glm.hpp> and <glm/gtc/type_ptr.hpp>. glm is column-major: the\n"
+      << "// 16-number glm::dmat4 constructor takes column 0 first, the order GL uploads.\n"
+      << "// Depth " << DepthSummary(options.depth) << "; near " << camera.z_near << ", far "
+      << camera.z_far << ".\n"
+      << "// GL state: glViewport(0, 0, " << camera.image_size.width << ", "
+      << camera.image_size.height << ");\n"
+      << DepthState(options.depth, "//   ") << "// Upload to a mat4 uniform (float):\n"
+      << "//   const glm::mat4 projection_f(projection), view_f(view);\n"
+      << "//   glUniformMatrix4fv(projection_location, 1, GL_FALSE, "
+         "glm::value_ptr(projection_f));\n"
+      << "//   glUniformMatrix4fv(view_location, 1, GL_FALSE, glm::value_ptr(view_f));\n"
+      << "// or to a dmat4 uniform (GL 4.0): glUniformMatrix4dv(location, 1, GL_FALSE, "
+         "glm::value_ptr(projection)).\n";
+  if (camera.intrinsics.HasDistortion()) {
+    out << "// Note: " << DistortionNote(camera.intrinsics) << ".\n";
+  }
+  PrintGlmMatrix(out, "projection", views.clip_from_gl_eye);
+  PrintGlmMatrix(out, "view", views.gl_eye_from_world);
+  return out.str();
+}
+
+// The unit quaternion of a rotation with w >= 0 (COLMAP's QW QX QY QZ), and its Rodrigues vector
+// (angle * axis). Eigen's matrix -> quaternion -> angle-axis path stays accurate at angles near 0
+// and pi, where cv::Rodrigues' acos-based formula loses digits.
+Eigen::Quaterniond QuaternionOf(const Eigen::Matrix3d& rotation) {
+  Eigen::Quaterniond q(rotation);
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  return q;
+}
+
+Eigen::Vector3d RodriguesOf(const Eigen::Matrix3d& rotation) {
+  const Eigen::AngleAxisd angle_axis(QuaternionOf(rotation));
+  return angle_axis.angle() * angle_axis.axis();
+}
+
+cv::Mat CvMatrix(const Eigen::MatrixXd& m) {
+  cv::Mat result(static_cast<int>(m.rows()), static_cast<int>(m.cols()), CV_64F);
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) result.at<double>(r, c) = m(r, c);
+  }
+  return result;
+}
+
+void RequireNoSkew(const Camera& camera, const char* format, const char* why) {
+  internal::Require(camera.intrinsics.skew == 0.0, format, " cannot represent this camera: ", why,
+                    ", but skew = ", camera.intrinsics.skew,
+                    " px (fit with skew fixed at 0, or export to gl, glm, three or json)");
+}
+
+std::string ExportOpenCvYamlText(const Camera& camera) {
+  camera.Check();
+  RequireNoSkew(camera, "opencv-yaml",
+                "OpenCV's camera model has no skew (cv::projectPoints ignores camera_matrix(0,1))");
+  const Intrinsics& k = camera.intrinsics;
+  Eigen::Matrix<double, 1, 5> distortion;
+  distortion << k.k1, k.k2, 0.0, 0.0, 0.0;
+  cv::FileStorage storage(
+      "", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  storage.writeComment(
+      "camproj OpenCV export: read with cv::FileStorage(path, cv::FileStorage::READ).");
+  storage.writeComment("Pixel origin: OpenCV's, (0, 0) = centre of the top-left pixel.");
+  storage.writeComment(
+      "rvec, tvec: cam_from_world (x_cam = R x_world + t, as cv::solvePnP returns it); "
+      "R = cv::Rodrigues(rvec), also written as R.");
+  storage.writeComment("distortion_coefficients: k1 k2 p1 p2 k3 (p1 = p2 = k3 = 0).");
+  storage << "image_width" << camera.image_size.width;
+  storage << "image_height" << camera.image_size.height;
+  storage << "camera_matrix" << CvMatrix(k.K());
+  storage << "distortion_coefficients" << CvMatrix(distortion);
+  storage << "rvec" << CvMatrix(RodriguesOf(camera.cam_from_world.rotation));
+  storage << "tvec" << CvMatrix(camera.cam_from_world.translation);
+  storage << "R" << CvMatrix(camera.cam_from_world.rotation);
+  return storage.releaseAndGetString();
+}
+
+// -0 printed as "0" (-0 + 0 = +0): COLMAP's files never hold a negative zero.
+double WithoutNegativeZero(double value) { return value + 0.0; }
+
+std::string ExportColmapText(const Camera& camera) {
+  camera.Check();
+  RequireNoSkew(camera, "colmap", "no COLMAP camera model (PINHOLE, OPENCV, ...) has skew");
+  const Intrinsics k =
+      ConvertPixelOrigin(camera.intrinsics, PixelOrigin::kCenter, PixelOrigin::kCorner);
+  const Eigen::Quaterniond q = QuaternionOf(camera.cam_from_world.rotation);
+  const Eigen::Vector3d& t = camera.cam_from_world.translation;
+  auto out = ExactStream();
+  out << "# camproj COLMAP export: a text model. Save each section below as its own file in one\n"
+      << "# folder (docs/exports.md). Pixel origin: COLMAP's, (0.5, 0.5) = centre of the top-left\n"
+      << "# pixel. QW QX QY QZ, TX TY TZ: cam_from_world (x_cam = R x_world + t).\n"
+      << "# ==> cameras.txt <==\n"
+      << "# Camera list with one line of data per camera:\n"
+      << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+      << "# Number of cameras: 1\n"
+      << "1 " << (k.HasDistortion() ? "OPENCV" : "PINHOLE") << ' ' << camera.image_size.width << ' '
+      << camera.image_size.height << ' ' << k.fx << ' ' << k.fy << ' ' << k.cx << ' ' << k.cy;
+  if (k.HasDistortion()) out << ' ' << k.k1 << ' ' << k.k2 << " 0 0";
+  out << '\n'
+      << "# ==> images.txt <==\n"
+      << "# Image list with two lines of data per image:\n"
+      << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+      << "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+      << "# Number of images: 1, mean observations per image: 0\n"
+      << "1 " << WithoutNegativeZero(q.w()) << ' ' << WithoutNegativeZero(q.x()) << ' '
+      << WithoutNegativeZero(q.y()) << ' ' << WithoutNegativeZero(q.z()) << ' '
+      << WithoutNegativeZero(t.x()) << ' ' << WithoutNegativeZero(t.y()) << ' '
+      << WithoutNegativeZero(t.z()) << " 1 image\n"
+      << '\n'
+      << "# ==> points3D.txt <==\n"
+      << "# 3D point list with one line of data per point:\n"
+      << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+      << "# Number of points: 0, mean track length: 0\n";
+  return out.str();
+}
+
+ordered_json Matrix4Json(const Eigen::Matrix4d& m) {
+  ordered_json numbers = ordered_json::array();
+  for (int i = 0; i < 16; ++i) numbers.push_back(m.data()[i]);  // column-major
+  return numbers;
+}
+
+std::string ExportThreeText(const Camera& camera, const ExportOptions& options) {
+  const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
+  const Rigid3 world_from_gl_eye = Inverse(Rigid3FromMatrix(views.gl_eye_from_world));
+  const Eigen::Quaterniond q(world_from_gl_eye.rotation);
+  const Eigen::Vector3d& position = world_from_gl_eye.translation;
+  const GlDepth& depth = options.depth;
+
+  ordered_json document;
+  document["projectionMatrix"] = Matrix4Json(views.clip_from_gl_eye);
+  document["matrixWorld"] = Matrix4Json(world_from_gl_eye.ToMatrix());
+  document["position"] = {position.x(), position.y(), position.z()};
+  document["quaternion"] = {q.x(), q.y(), q.z(), q.w()};  // three's Quaternion.fromArray order
+  // Why three's updateProjectionMatrix() cannot rebuild projectionMatrix, if it cannot.
+  std::string no_rebuild;
+  std::string off_axis;
+  if (views.frustum) {
+    // Enlarge the frustum to one centred on the gaze and show the image as a window of it, in
+    // units of s = W / (r - l) per near-plane unit on both axes, so that fullWidth / fullHeight
+    // is the full view's aspect (setViewOffset sets aspect to it). Exactly centred: no window.
+    const Frustum& f = *views.frustum;
+    const double half_width = std::max(-f.left, f.right);
+    const double half_height = std::max(f.top, -f.bottom);
+    const double s = camera.image_size.width / (f.right - f.left);
+    document["fov"] = 2.0 * std::atan(half_height / f.z_near) * kRadToDeg;
+    document["aspect"] = half_width / half_height;
+    if (f.left != -f.right || f.bottom != -f.top) {
+      document["view"] = {{"enabled", true},
+                          {"fullWidth", 2.0 * half_width * s},
+                          {"fullHeight", 2.0 * half_height * s},
+                          {"offsetX", (f.left + half_width) * s},
+                          {"offsetY", (half_height - f.top) * s},
+                          {"width", (f.right - f.left) * s},
+                          {"height", (f.top - f.bottom) * s}};
+      off_axis =
+          " The principal point is off-centre: fov and aspect are those of an enlarged view "
+          "centred on the gaze, and view is the image's window in it, as "
+          "camera.setViewOffset(fullWidth, fullHeight, offsetX, offsetY, width, height) sets it.";
+    }
+  } else {
+    no_rebuild += " skew != 0 (no fov, aspect or view form);";
+  }
+  document["near"] = camera.z_near;
+  if (std::isfinite(camera.z_far)) {
+    document["far"] = camera.z_far;
+  } else {
+    document["far"] = nullptr;
+    no_rebuild += " the far plane is infinite (far = Infinity gives NaN);";
+  }
+  document["zoom"] = 1.0;
+  document["filmOffset"] = 0.0;
+  document["depth"] = ToString(depth.clip_depth);
+  document["reversed_z"] = depth.reversed_z;
+  document["image_size"] = {camera.image_size.width, camera.image_size.height};
+
+  std::string note =
+      "projectionMatrix is exact: camera.projectionMatrix.fromArray(projectionMatrix); "
+      "camera.projectionMatrixInverse.copy(camera.projectionMatrix).invert(). "
+      "camera.updateProjectionMatrix() (which resize handlers call, and the renderer too when "
+      "reversedDepthBuffer is on) rebuilds it from fov, aspect, near, far, zoom and view: ";
+  if (depth.clip_depth == ClipDepth::kNegativeOneToOne && depth.reversed_z) {
+    no_rebuild += " three has no [-1, 1] reversed-Z depth;";
+  }
+  if (no_rebuild.empty()) {
+    note += "set those too, and it rebuilds projectionMatrix to rounding.";
+  } else {
+    no_rebuild.pop_back();
+    note += "here it cannot (" + no_rebuild.substr(1) + "), so never let it run.";
+  }
+  note += off_axis;
+  note += depth.reversed_z
+              ? (depth.clip_depth == ClipDepth::kZeroToOne
+                     ? " Depth zo reversed-Z: a renderer made with reversedDepthBuffer: true."
+                     : "")
+              : (depth.clip_depth == ClipDepth::kZeroToOne ? " Depth zo: WebGPURenderer."
+                                                           : " Depth no: WebGLRenderer.");
+  if (camera.intrinsics.HasDistortion()) {
+    note += " " + DistortionNote(camera.intrinsics) + ".";
+  }
+  note +=
+      " matrixWorld = world_from_gl_eye (three's camera looks down -z with y up); for a camera "
+      "without a parent set camera.position.fromArray(position) and "
+      "camera.quaternion.fromArray(quaternion), which the renderer turns into this matrixWorld.";
+  document["note"] = note;
+  return document.dump(2) + "\n";
+}
+
+}  // namespace
+
+const char* ToString(ExportFormat format) {
+  for (const FormatName& entry : kFormatNames) {
+    if (entry.format == format) return entry.name;
+  }
+  return "unknown";
+}
+
+ExportFormat ExportFormatFromString(const std::string& text) {
+  std::string choices;
+  for (const FormatName& entry : kFormatNames) {
+    if (text == entry.name) return entry.format;
+    choices += std::string(choices.empty() ? "" : ", ") + "\"" + entry.name + "\"";
+  }
+  throw std::invalid_argument("export format must be one of " + choices + ", got \"" + text + "\"");
+}
+
+std::string ExportCamera(const Camera& camera, ExportFormat format, const ExportOptions& options) {
+  switch (format) {
+    case ExportFormat::kGl:
+      return ExportGlText(camera, options);
+    case ExportFormat::kGlm:
+      return ExportGlmText(camera, options);
+    case ExportFormat::kOpenCvYaml:
+      return ExportOpenCvYamlText(camera);
+    case ExportFormat::kColmap:
+      return ExportColmapText(camera);
+    case ExportFormat::kThree:
+      return ExportThreeText(camera, options);
+    case ExportFormat::kJson:
+      return CameraToJsonText(camera, CameraFileOptions{options.pixel_origin, 1.0, options.depth});
+  }
+  throw std::invalid_argument(internal::Concat("unknown export format ", static_cast<int>(format)));
+}
+
+std::string ExportGl(const Camera& camera, const GlExportOptions& options) {
+  ExportOptions export_options;
+  export_options.depth = options.depth;
+  export_options.row_major = options.row_major;
+  return ExportCamera(camera, ExportFormat::kGl, export_options);
 }
 
 }  // namespace camproj

@@ -51,7 +51,7 @@ const std::array<const char*, internal::kFitIntrinsicsSize> kSlotNames = {
 struct Model {
   std::array<bool, internal::kFitIntrinsicsSize> free{};
   std::array<double, internal::kFitIntrinsicsSize> value{};
-  std::vector<std::string> fixed_descriptions;
+  std::vector<FixedParameter> fixed;
 
   int NumFree() const { return static_cast<int>(std::count(free.begin(), free.end(), true)); }
   // focal, aspect, principal point, skew: what a homography constrains (k1, k2 aside).
@@ -71,50 +71,46 @@ struct Model {
   }
 };
 
-std::string Describe(const char* name, double value, const char* why) {
-  return internal::Concat(name, " = ", value, " (", why, ")");
-}
-
 Model MakeModel(const FitOptions& options, const ImageSize& size) {
   Model model;
   if (options.known_intrinsics) {
     const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
                                             PixelOrigin::kCenter);
     model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2};
-    model.fixed_descriptions.push_back("intrinsics (known)");
+    model.fixed.push_back({"intrinsics", internal::Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx,
+                                                          ", cy ", k.cy, ", skew ", k.skew, ", k1 ",
+                                                          k.k1, ", k2 ", k.k2),
+                           "given: pose only"});
     return model;
   }
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
-  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value) {
+  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value,
+                 const char* default_why) {
     model.free[slot] = mode.IsFree();
     model.value[slot] = mode.kind == ParameterMode::Kind::kFixed ? fixed_value : default_value;
-    if (mode.kind == ParameterMode::Kind::kFixed) {
-      model.fixed_descriptions.push_back(Describe(kSlotNames[slot], model.value[slot], "given"));
-    } else if (mode.kind == ParameterMode::Kind::kDefault) {
-      model.fixed_descriptions.push_back(Describe(kSlotNames[slot], model.value[slot], "default"));
+    if (mode.IsFree() || slot == 3) return;  // cy is described with cx
+    std::string name = kSlotNames[slot];
+    std::string value = internal::Concat(model.value[slot]);
+    if (slot == 2) {
+      name = "principal point";
+      value = internal::Concat(model.value[2], ", ",
+                               mode.kind == ParameterMode::Kind::kFixed
+                                   ? options.principal_point.value2 + shift
+                                   : 0.5 * (size.height - 1.0));
     }
+    model.fixed.push_back({name, value,
+                           mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
   };
   // A free focal length's start comes from the closed form; 1 is a placeholder.
-  set(0, options.focal, 1.0, options.focal.value);
-  set(1, options.aspect, 1.0, options.aspect.value);
-  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift);
+  set(0, options.focal, 1.0, options.focal.value, "");
+  set(1, options.aspect, 1.0, options.aspect.value, "default: square pixels");
+  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift,
+      "default: image centre");
   set(3, options.principal_point, 0.5 * (size.height - 1.0),
-      options.principal_point.value2 + shift);
-  set(4, options.skew, 0.0, options.skew.value);
-  set(5, options.k1, 0.0, options.k1.value);
-  set(6, options.k2, 0.0, options.k2.value);
-  // The principal point is one choice, described once.
-  if (!options.principal_point.IsFree()) {
-    auto& d = model.fixed_descriptions;
-    const auto cx = std::find_if(d.begin(), d.end(), [](const std::string& s) { return s.rfind("cx", 0) == 0; });
-    const auto cy = std::find_if(d.begin(), d.end(), [](const std::string& s) { return s.rfind("cy", 0) == 0; });
-    if (cx != d.end() && cy != d.end()) {
-      *cx = internal::Concat("principal point = (", model.value[2], ", ", model.value[3], ") (",
-                             options.principal_point.kind == ParameterMode::Kind::kFixed
-                                 ? "given" : "default: image centre", ")");
-      d.erase(cy);
-    }
-  }
+      options.principal_point.value2 + shift, "");
+  set(4, options.skew, 0.0, options.skew.value, "default: no skew");
+  set(5, options.k1, 0.0, options.k1.value, "default: no distortion");
+  set(6, options.k2, 0.0, options.k2.value, "default: no distortion");
   return model;
 }
 
@@ -557,7 +553,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     if (model.free[slot]) names.push_back(user_slot_names[slot]);
   }
   result.free_parameters = names;
-  result.fixed_parameters = model.fixed_descriptions;
+  result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
   const Eigen::MatrixXd jacobian = UserJacobian(points, rotation_matrix, center, model, num_params);

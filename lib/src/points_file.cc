@@ -157,9 +157,12 @@ class CsvParser {
                          " is also " + Printable(fields_[i]));
       }
     }
+    // Without required pixels, u and v may be absent together (a points-only file).
+    has_pixels_ = limits_.require_pixels || index_of_name.count("u") > 0 ||
+                  index_of_name.count("v") > 0;
     std::string missing;
     int missing_count = 0;
-    for (size_t c = 0; c < kRequiredColumns.size(); ++c) {
+    for (size_t c = 0; c < (has_pixels_ ? kRequiredColumns.size() : 3); ++c) {
       const auto it = index_of_name.find(kRequiredColumns[c]);
       if (it == index_of_name.end()) {
         missing += (missing.empty() ? "" : ",") + std::string(kRequiredColumns[c]);
@@ -217,7 +220,7 @@ class CsvParser {
       FailLine(line_, "more than " + std::to_string(limits_.max_points) + " data rows");
     }
     std::array<double, 5> values{};
-    for (size_t c = 0; c < values.size(); ++c) values[c] = Number(column_[c]);
+    for (size_t c = 0; c < (has_pixels_ ? values.size() : 3); ++c) values[c] = Number(column_[c]);
     std::string id;
     if (id_column_) {
       const std::string_view text = fields_[*id_column_];
@@ -262,6 +265,7 @@ class CsvParser {
   int64_t header_line_ = 0;  // 0 until the header is read
   std::vector<std::string> names_;
   std::array<size_t, 5> column_{};  // index of X, Y, Z, u, v in a row
+  bool has_pixels_ = true;
   std::optional<size_t> id_column_;
   std::unordered_map<std::string, int> line_of_id_;
   std::vector<std::string_view> fields_;  // reused: one allocation for all rows

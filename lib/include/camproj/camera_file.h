@@ -5,6 +5,8 @@
 #define CAMPROJ_CAMERA_FILE_H_
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "camproj/camera.h"
 #include "camproj/conventions.h"
@@ -19,6 +21,23 @@ struct CameraFileOptions {
   void Check() const;
 };
 
+// The camera file's "fit" object: how the camera was fitted (docs/camera-file.md).
+struct FitRecord {
+  double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
+  double median_px = 0.0;  // median |residual|
+  double max_px = 0.0;
+  int num_points = 0;
+  std::string start;        // closed-form start: dlt | homography | pnp | pnp-focal-sweep
+  std::vector<std::string> free;                                 // estimated parameters
+  std::vector<std::pair<std::string, std::string>> fixed;        // name, "value (why)"
+  std::vector<std::pair<std::string, std::string>> left_out;     // name, why
+  std::vector<std::pair<std::string, double>> sigma;             // name, standard deviation
+  double pixel_sigma = 0.0;            // px per axis, used for the sigmas
+  bool pixel_sigma_estimated = true;   // from the residuals (else given)
+  int iterations = 0;
+  double time_ms = 0.0;
+};
+
 // Parses camera-file text. `source` names the text in messages ("camera.json"). Throws
 // InputError naming the source, the line and column of a JSON syntax error, or the key path
 // ("intrinsics.fx") of a missing or invalid value.
@@ -27,9 +46,15 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source);
 // ReadWholeFile + CameraFromJsonText.
 Camera ReadCameraFile(const std::string& path);
 
-// The camera file text: all keys of docs/camera-file.md except `fit`, doubles at full precision
-// (they round-trip exactly).
-std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options = {});
+// The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
+// skew, k1, k2]} and optionally "pixel_origin": returned in kCenter. Throws InputError.
+Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source);
+Intrinsics ReadIntrinsicsFile(const std::string& path);
+
+// The camera file text: all keys of docs/camera-file.md, `fit` only when given, doubles at full
+// precision (they round-trip exactly).
+std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options = {},
+                             const FitRecord* fit = nullptr);
 
 }  // namespace camproj
 

@@ -1,22 +1,72 @@
-// Text exports of a camera for other tools. Conventions: docs/conventions.md.
+// Text exports of a camera for other tools: `camproj export CAMERA.json --to FORMAT`.
+// Conventions: docs/conventions.md; each format, with how to load it: docs/exports.md.
+//
+// Every number is printed so that it reads back bit for bit (17 significant digits, or the
+// shortest form that round-trips). What each format holds:
+//   gl           `projection` (clip_from_gl_eye) and `view` (gl_eye_from_world) lines of 16
+//                numbers, column-major unless row_major, after '#' comment lines.
+//   glm          a C++ snippet defining `const glm::dmat4 projection(...)` and `view(...)` with the
+//                same numbers (glm's 16-scalar constructor takes column 0 first), with the upload
+//                call and the depth state (glClipControl, glDepthFunc) in comments.
+//   opencv-yaml  a cv::FileStorage YAML file: image_width, image_height, camera_matrix (3x3),
+//                distortion_coefficients (1x5: k1 k2 0 0 0), rvec and tvec (3x1: cam_from_world
+//                as cv::solvePnP returns it, rvec = Rodrigues vector of R) and R (3x3). cx, cy in
+//                OpenCV's kCenter origin.
+//   colmap       the lines of a COLMAP text model: cameras.txt (PINHOLE, or OPENCV when k1 or k2
+//                is set; cx, cy in COLMAP's kCorner origin), images.txt (QW QX QY QZ TX TY TZ of
+//                cam_from_world, then the empty POINTS2D line) and an empty points3D.txt, each
+//                section opened by a "# ==> FILE <==" line.
+//   three        a JSON object for a three.js PerspectiveCamera: projectionMatrix and matrixWorld
+//                (world_from_gl_eye, the inverse of the view matrix) as Matrix4.fromArray takes
+//                them (column-major), position, quaternion (x, y, z, w), fov / aspect / near /
+//                far and, for an off-axis principal point, the setViewOffset `view` that makes
+//                three's own updateProjectionMatrix() rebuild the same matrix; a `note` says when
+//                that is impossible (skew, infinite far, reversed-Z).
+//   json         the camera file (docs/camera-file.md), as CameraToJsonText writes it.
+// gl, glm and three hold the pinhole part only: a comment or note says when k1, k2 are dropped
+// (a projection matrix is linear).
 #ifndef CAMPROJ_EXPORT_H_
 #define CAMPROJ_EXPORT_H_
 
 #include <string>
 
 #include "camproj/camera.h"
+#include "camproj/conventions.h"
 #include "camproj/gl.h"
 
 namespace camproj {
 
+enum class ExportFormat { kGl, kGlm, kOpenCvYaml, kColmap, kThree, kJson };
+
+// "gl" | "glm" | "opencv-yaml" | "colmap" | "three" | "json".
+const char* ToString(ExportFormat format);
+
+// The inverse of ToString; throws std::invalid_argument naming the text and listing the choices.
+ExportFormat ExportFormatFromString(const std::string& text);
+
+struct ExportOptions {
+  // gl, glm, three, json: depth convention of the projection matrix. An infinite far plane is
+  // the Camera's z_far = kInfinity.
+  GlDepth depth;
+  // gl: print each matrix row by row instead of GL's column-major order.
+  bool row_major = false;
+  // json: pixel origin of the cx, cy written (the other formats use their tool's own origin).
+  PixelOrigin pixel_origin = PixelOrigin::kCenter;
+};
+
+// The text of `camera` in `format` (see the file comment), ending in a newline.
+// Throws std::invalid_argument on an invalid camera, or when the format cannot represent it,
+// saying why: opencv-yaml and colmap refuse skew != 0 (OpenCV's projectPoints ignores
+// camera_matrix(0,1), and no COLMAP camera model has skew).
+std::string ExportCamera(const Camera& camera, ExportFormat format,
+                         const ExportOptions& options = {});
+
+// Deprecated: ExportCamera(camera, ExportFormat::kGl, {options.depth, options.row_major}).
+// Kept until the command line switches to ExportCamera.
 struct GlExportOptions {
   GlDepth depth;
   bool row_major = false;  // print rows instead of GL's column-major order
 };
-
-// "projection" and "view" lines of 16 numbers each (column-major unless row_major, 17 significant
-// digits), preceded by comment lines ('#') naming the conventions used. The projection is the
-// pinhole part: a comment says so when the camera has distortion.
 std::string ExportGl(const Camera& camera, const GlExportOptions& options = {});
 
 }  // namespace camproj

@@ -120,6 +120,14 @@ struct ParameterSigma {
   std::string unit;  // "px", "deg", "world", ""
 };
 
+// An intrinsic the fit did not estimate: its value (in kCenter pixels) and why: "given" (fixed
+// by the caller), "default: ..." (left at its default), "given: pose only" (known intrinsics).
+struct FixedParameter {
+  std::string name;   // "aspect", "principal point", "skew", "k1", ...
+  std::string value;
+  std::string why;
+};
+
 struct Correlation {
   std::string first;
   std::string second;
@@ -139,7 +147,7 @@ struct FitResult {
   std::string start_method;  // "dlt", "homography", "pnp", "pnp-focal-sweep"
   bool planar = false;       // the points are (numerically) coplanar
   std::vector<std::string> free_parameters;   // names in the covariance's order
-  std::vector<std::string> fixed_parameters;  // "aspect = 1 (default)", ...
+  std::vector<FixedParameter> fixed_parameters;
 
   int iterations = 0;
   std::string termination;  // Ceres' termination type and message

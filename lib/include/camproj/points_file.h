@@ -39,6 +39,8 @@ struct Correspondences {
 struct CorrespondencesLimits {
   size_t max_line_bytes = size_t{1} << 20;  // per line, without the line ending
   size_t max_points = 50'000'000;           // data rows
+  // false: a file without both u and v columns is read as points only, with pixels (0, 0).
+  bool require_pixels = true;
   void Check() const;  // throws std::invalid_argument unless both are positive
 };
 

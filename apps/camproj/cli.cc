@@ -1,0 +1,57 @@
+#include "cli.h"
+
+#include <charconv>
+#include <cmath>
+
+namespace camproj::cli {
+
+namespace {
+
+bool ParseDouble(const std::string& text, double* value) {
+  const char* begin = text.data();
+  const char* end = text.data() + text.size();
+  if (begin != end && *begin == '+') ++begin;
+  const auto [ptr, error] = std::from_chars(begin, end, *value);
+  return error == std::errc() && ptr == end && std::isfinite(*value);
+}
+
+}  // namespace
+
+ImageSize ParseImageSize(const std::string& text, const std::string& option) {
+  const size_t x = text.find('x');
+  int width = 0;
+  int height = 0;
+  if (x != std::string::npos) {
+    const auto [w_end, w_error] = std::from_chars(text.data(), text.data() + x, width);
+    const auto [h_end, h_error] = std::from_chars(text.data() + x + 1, text.data() + text.size(), height);
+    if (w_error == std::errc() && h_error == std::errc() && w_end == text.data() + x &&
+        h_end == text.data() + text.size() && width > 0 && height > 0) {
+      return {width, height};
+    }
+  }
+  throw UsageError(option + ": expected WIDTHxHEIGHT in pixels (e.g. 1920x1080), got \"" + text + "\"");
+}
+
+std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
+  std::vector<double> numbers;
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    size_t end = text.find(',', begin);
+    if (end == std::string::npos) end = text.size();
+    double value = 0.0;
+    if (!ParseDouble(text.substr(begin, end - begin), &value)) {
+      throw UsageError(option + ": \"" + text.substr(begin, end - begin) +
+                       "\" is not a finite number (in \"" + text + "\")");
+    }
+    numbers.push_back(value);
+    begin = end + 1;
+  }
+  if (numbers.size() != count) {
+    throw UsageError(option + ": expected " + std::to_string(count) +
+                     " comma-separated numbers, got " + std::to_string(numbers.size()) + " in \"" +
+                     text + "\"");
+  }
+  return numbers;
+}
+
+}  // namespace camproj::cli

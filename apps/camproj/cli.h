@@ -1,0 +1,48 @@
+// Shared pieces of the camproj command line: exit codes, value parsing, subcommand registration.
+#ifndef CAMPROJ_APPS_CLI_H_
+#define CAMPROJ_APPS_CLI_H_
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "camproj/conventions.h"
+
+namespace camproj::cli {
+
+// Documented in README.md and `camproj --help`.
+constexpr int kExitOk = 0;
+constexpr int kExitUsage = 1;
+constexpr int kExitBadInput = 2;
+constexpr int kExitScene = 3;
+
+// A bad command-line value: exit code 1 with the message.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// "1920x1080" -> {1920, 1080}; throws UsageError naming `option`.
+ImageSize ParseImageSize(const std::string& text, const std::string& option);
+
+// "a,b,c" -> exactly `count` finite numbers; throws UsageError naming `option`.
+std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option);
+
+// A registered subcommand: Run() is called when it was selected.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command AddFitCommand(CLI::App& root);
+Command AddExportCommand(CLI::App& root);
+Command AddProjectCommand(CLI::App& root);
+Command AddConvertCommand(CLI::App& root);
+Command AddSynthCommand(CLI::App& root);
+Command AddOverlayCommand(CLI::App& root);
+
+}  // namespace camproj::cli
+
+#endif  // CAMPROJ_APPS_CLI_H_

@@ -1,0 +1,74 @@
+// camproj export: a camera file in another tool's terms.
+#include <iostream>
+#include <memory>
+
+#include "camproj/camera_file.h"
+#include "camproj/export.h"
+#include "cli.h"
+
+namespace camproj::cli {
+
+namespace {
+
+struct ExportArgs {
+  std::string camera_path;
+  std::string to = "gl";
+  std::string depth = "no";
+  bool reversed_z = false;
+  bool infinite_far = false;
+  double z_near = 0.0;
+  double z_far = 0.0;
+  bool row_major = false;
+  std::string pixel_origin = "center";
+};
+
+}  // namespace
+
+Command AddExportCommand(CLI::App& root) {
+  auto args = std::make_shared<ExportArgs>();
+  CLI::App* app = root.add_subcommand(
+      "export",
+      "Write a camera in another tool's terms (docs/exports.md).\n\n"
+      "  gl           projection and view matrices, 16 numbers each (column-major)\n"
+      "  glm          a C++ snippet building them as glm::dmat4\n"
+      "  opencv-yaml  cv::FileStorage YAML: camera_matrix, distortion_coefficients, rvec, tvec\n"
+      "  colmap       cameras.txt and images.txt lines (COLMAP's corner pixel convention)\n"
+      "  three        JSON for a three.js PerspectiveCamera (projectionMatrix, matrixWorld)\n"
+      "  json         the camera file itself\n\n"
+      "Examples:\n"
+      "  camproj export camera.json --to gl --depth zo --reversed-z\n"
+      "  camproj export camera.json --to opencv-yaml > camera.yaml");
+  app->add_option("CAMERA", args->camera_path, "camera file (docs/camera-file.md)")->required();
+  app->add_option("--to", args->to, "format")
+      ->check(CLI::IsMember({"gl", "glm", "opencv-yaml", "colmap", "three", "json"}));
+  app->add_option("--depth", args->depth, "clip depth: no = [-1,1] (GL default), zo = [0,1]")
+      ->check(CLI::IsMember({"no", "zo"}));
+  app->add_flag("--reversed-z", args->reversed_z, "near maps to 1, far to 0 (zo) or -1 (no)");
+  app->add_flag("--infinite-far", args->infinite_far, "far plane at infinity");
+  app->add_option("--near", args->z_near, "override the near plane")->check(CLI::PositiveNumber);
+  app->add_option("--far", args->z_far, "override the far plane")->check(CLI::PositiveNumber);
+  app->add_flag("--row-major", args->row_major, "gl: print rows instead of column-major order");
+  app->add_option("--pixel-origin", args->pixel_origin, "json: convention of cx, cy written")
+      ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args]() {
+            Camera camera = ReadCameraFile(args->camera_path);
+            if (args->z_near > 0.0) camera.z_near = args->z_near;
+            if (args->z_far > 0.0) camera.z_far = args->z_far;
+            if (args->infinite_far) {
+              if (args->z_far > 0.0) throw UsageError("give --far or --infinite-far, not both");
+              camera.z_far = kInfinity;
+            }
+            if (!(camera.z_far > camera.z_near)) {
+              throw UsageError("far must be greater than near");
+            }
+            ExportOptions options;
+            options.depth.clip_depth = ClipDepthFromString(args->depth);
+            options.depth.reversed_z = args->reversed_z;
+            options.row_major = args->row_major;
+            options.pixel_origin = PixelOriginFromString(args->pixel_origin);
+            std::cout << ExportCamera(camera, ExportFormatFromString(args->to), options);
+            return kExitOk;
+          }};
+}
+
+}  // namespace camproj::cli

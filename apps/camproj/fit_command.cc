@@ -1,0 +1,181 @@
+// camproj fit: correspondences -> camera file and a summary.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "camproj/camera_file.h"
+#include "camproj/file_io.h"
+#include "camproj/fit.h"
+#include "camproj/fit_report.h"
+#include "camproj/points_file.h"
+#include "cli.h"
+
+namespace camproj::cli {
+
+namespace {
+
+struct FitArgs {
+  std::string points_path;
+  std::string image_size;
+  std::string output_path;
+  bool json = false;
+  bool trace = false;
+  std::vector<std::string> free;
+  std::vector<std::string> fix;
+  double focal = 0.0;
+  double fovy_deg = 0.0;
+  double aspect = 0.0;
+  std::string principal_point;
+  double skew = NAN;
+  double k1 = NAN;
+  double k2 = NAN;
+  std::string intrinsics_path;
+  std::string pixel_origin = "center";
+  std::string loss = "none";
+  double sigma = 0.0;
+  double z_near = 0.0;
+  double z_far = 0.0;
+  int max_iterations = 100;
+};
+
+const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
+                                                  "skew",  "k1",     "k2"};
+
+ParameterMode* ModeOf(FitOptions& options, const std::string& name) {
+  if (name == "focal") return &options.focal;
+  if (name == "aspect") return &options.aspect;
+  if (name == "principal-point") return &options.principal_point;
+  if (name == "skew") return &options.skew;
+  if (name == "k1") return &options.k1;
+  if (name == "k2") return &options.k2;
+  throw UsageError("unknown parameter \"" + name +
+                   "\": expected focal, aspect, principal-point, skew, k1 or k2");
+}
+
+FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
+  FitOptions options;
+  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+  for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
+  for (const std::string& name : args.fix) {
+    if (name == "focal") throw UsageError("--fix focal needs a value: use --focal PX or --fovy DEG");
+    *ModeOf(options, name) = ParameterMode::Default();
+  }
+  if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
+  if (args.focal > 0.0 && args.fovy_deg > 0.0) throw UsageError("give --focal or --fovy, not both");
+  if (args.focal > 0.0) options.focal = ParameterMode::Fixed(args.focal);
+  if (args.fovy_deg > 0.0) {
+    if (!(args.fovy_deg < 180.0)) throw UsageError("--fovy must be in (0, 180) degrees");
+    // fovy fixes fy = H / (2 tan(fovy / 2)); fx = fy / aspect (1 unless --aspect).
+    const double fy = 0.5 * size.height / std::tan(0.5 * args.fovy_deg * M_PI / 180.0);
+    const double aspect = args.aspect > 0.0 ? args.aspect : 1.0;
+    options.focal = ParameterMode::Fixed(fy / aspect);
+    if (options.aspect.IsFree()) options.aspect = ParameterMode::Default();
+  }
+  if (!args.principal_point.empty()) {
+    const std::vector<double> c = ParseNumbers(args.principal_point, 2, "--principal-point");
+    options.principal_point = ParameterMode::Fixed(c[0], c[1]);
+  }
+  if (!std::isnan(args.skew)) options.skew = ParameterMode::Fixed(args.skew);
+  if (!std::isnan(args.k1)) options.k1 = ParameterMode::Fixed(args.k1);
+  if (!std::isnan(args.k2)) options.k2 = ParameterMode::Fixed(args.k2);
+  if (!args.intrinsics_path.empty()) {
+    // The file's intrinsics come back in kCenter; the fitter reads known_intrinsics in
+    // options.pixel_origin.
+    options.known_intrinsics = ConvertPixelOrigin(ReadIntrinsicsFile(args.intrinsics_path),
+                                                  PixelOrigin::kCenter, options.pixel_origin);
+  }
+  if (args.loss != "none") {
+    const size_t colon = args.loss.find(':');
+    const std::string kind = args.loss.substr(0, colon);
+    if (kind != "huber" && kind != "cauchy") {
+      throw UsageError("--loss: expected none, huber:SCALE or cauchy:SCALE (px), got \"" + args.loss + "\"");
+    }
+    options.loss = kind == "huber" ? LossType::kHuber : LossType::kCauchy;
+    options.loss_scale_px =
+        colon == std::string::npos ? 1.0 : ParseNumbers(args.loss.substr(colon + 1), 1, "--loss scale")[0];
+  }
+  if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
+  if (args.z_near > 0.0) options.z_near = args.z_near;
+  if (args.z_far > 0.0) options.z_far = args.z_far;
+  options.max_iterations = args.max_iterations;
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return options;
+}
+
+}  // namespace
+
+Command AddFitCommand(CLI::App& root) {
+  auto args = std::make_shared<FitArgs>();
+  CLI::App* app = root.add_subcommand(
+      "fit",
+      "Fit a camera (or projector) to 2D-3D correspondences.\n\n"
+      "POINTS.csv has a header naming X,Y,Z,u,v (any order, extra columns ignored, optional id,\n"
+      "'#' comments). By default focal length, aspect (fx != fy) and principal point are free,\n"
+      "skew is 0 and there is no distortion; --free/--fix/--focal/... change that.\n"
+      "Prints a summary (parameters +- 1 sigma, residuals, worst points, time); -o writes the\n"
+      "camera file (docs/camera-file.md) atomically.\n\n"
+      "Examples:\n"
+      "  camproj fit points.csv --image-size 1920x1080 -o camera.json\n"
+      "  camproj fit plane.csv --image-size 640x480 --fix aspect,principal-point --free k1\n"
+      "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json --loss huber:2");
+  app->add_option("POINTS", args->points_path, "correspondences CSV")->required();
+  app->add_option("--image-size", args->image_size, "image size WIDTHxHEIGHT in pixels")->required();
+  app->add_option("-o,--output", args->output_path, "write the camera file here");
+  app->add_flag("--json", args->json, "print the camera file to stdout instead of the summary");
+  app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
+  app->add_option("--free", args->free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
+      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
+  app->add_option("--fix", args->fix, "hold these at their defaults (aspect 1, principal point at "
+                                      "the image centre, skew 0, k 0)")
+      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
+  app->add_option("--focal", args->focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
+  app->add_option("--fovy", args->fovy_deg, "fix the focal length by the vertical field of view (degrees)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--aspect", args->aspect, "fix fy/fx")->check(CLI::PositiveNumber);
+  app->add_option("--principal-point", args->principal_point, "fix cx,cy (px)");
+  app->add_option("--skew", args->skew, "fix the skew (px)");
+  app->add_option("--k1", args->k1, "fix k1");
+  app->add_option("--k2", args->k2, "fix k2");
+  app->add_option("--intrinsics", args->intrinsics_path,
+                  "known intrinsics (a camera file or {\"intrinsics\": {...}}): fit the pose only");
+  app->add_option("--pixel-origin", args->pixel_origin,
+                  "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
+                  "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
+  app->add_option("--loss", args->loss, "none, huber:SCALE or cauchy:SCALE (px)");
+  app->add_option("--sigma", args->sigma, "pixel noise sigma (px) for the uncertainties; default: "
+                                          "estimated from the residuals")->check(CLI::PositiveNumber);
+  app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--far", args->z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
+  app->add_option("--max-iterations", args->max_iterations, "refinement iterations")
+      ->check(CLI::NonNegativeNumber);
+
+  return {app, [args]() {
+            const ImageSize size = ParseImageSize(args->image_size, "--image-size");
+            const FitOptions options = OptionsFrom(*args, size);
+            const Correspondences data = ReadCorrespondencesFile(args->points_path);
+            const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
+            CameraFileOptions file_options;
+            file_options.pixel_origin = options.pixel_origin;
+            file_options.target_distance =
+                (fit.views.look_at.target - fit.views.look_at.eye).norm();
+            const FitRecord record = FitRecordOf(fit);
+            const std::string text = CameraToJsonText(fit.camera, file_options, &record);
+            if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
+            if (args->json) {
+              std::cout << text;
+            } else {
+              std::cout << FitSummaryText(fit, data.ids);
+              if (!args->output_path.empty()) std::cout << "wrote " << args->output_path << "\n";
+            }
+            if (args->trace) std::cout << FitTraceText(fit);
+            return kExitOk;
+          }};
+}
+
+}  // namespace camproj::cli

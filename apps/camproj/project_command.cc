@@ -1,0 +1,67 @@
+// camproj project: world points -> pixels (and depth) through a camera file.
+#include <charconv>
+#include <iostream>
+#include <memory>
+
+#include "camproj/camera_file.h"
+#include "camproj/points_file.h"
+#include "cli.h"
+
+namespace camproj::cli {
+
+namespace {
+
+std::string Number(double value) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  (void)error;
+  return std::string(buffer, end);
+}
+
+struct ProjectArgs {
+  std::string camera_path;
+  std::string points_path;
+  std::string pixel_origin = "center";
+};
+
+}  // namespace
+
+Command AddProjectCommand(CLI::App& root) {
+  auto args = std::make_shared<ProjectArgs>();
+  CLI::App* app = root.add_subcommand(
+      "project",
+      "Project world points through a camera: prints id,X,Y,Z,u,v,depth as CSV (depth = z in the\n"
+      "camera frame, world units; u, v empty for points behind the camera). POINTS.csv needs\n"
+      "X,Y,Z; u,v columns are ignored.\n\n"
+      "Example:\n"
+      "  camproj project camera.json points.csv");
+  app->add_option("CAMERA", args->camera_path, "camera file")->required();
+  app->add_option("POINTS", args->points_path, "CSV with X,Y,Z")->required();
+  app->add_option("--pixel-origin", args->pixel_origin, "convention of the printed pixels")
+      ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args]() {
+            const Camera camera = ReadCameraFile(args->camera_path);
+            CorrespondencesLimits limits;
+            limits.require_pixels = false;
+            const Correspondences points = ReadCorrespondencesFile(args->points_path, limits);
+            const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
+            std::cout << "id,X,Y,Z,u,v,depth\n";
+            for (size_t i = 0; i < points.points_in_world.size(); ++i) {
+              const Eigen::Vector3d& x = points.points_in_world[i];
+              const double depth = (camera.cam_from_world * x).z();
+              const std::optional<Eigen::Vector2d> pixel = PixelFromWorld(camera, x);
+              std::cout << points.ids[i] << ',' << Number(x.x()) << ',' << Number(x.y()) << ','
+                        << Number(x.z()) << ',';
+              if (pixel) {
+                const Eigen::Vector2d p = ConvertPixelOrigin(*pixel, PixelOrigin::kCenter, origin);
+                std::cout << Number(p.x()) << ',' << Number(p.y());
+              } else {
+                std::cout << ',';
+              }
+              std::cout << ',' << Number(depth) << '\n';
+            }
+            return kExitOk;
+          }};
+}
+
+}  // namespace camproj::cli

@@ -1,0 +1,132 @@
+#include "camproj/fit_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <sstream>
+
+namespace camproj {
+
+namespace {
+
+std::string Format(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, value);
+  return buffer;
+}
+
+// Enough significant digits to show the sigma's second digit.
+std::string WithSigma(double value, double sigma) {
+  if (!(sigma > 0.0) || !std::isfinite(sigma)) return Format("%.6g", value);
+  const int decimals = std::clamp(1 - static_cast<int>(std::floor(std::log10(sigma))), 0, 12);
+  char buffer[96];
+  std::snprintf(buffer, sizeof buffer, "%.*f +- %.*f", decimals, value, decimals, sigma);
+  return buffer;
+}
+
+}  // namespace
+
+FitRecord FitRecordOf(const FitResult& fit) {
+  FitRecord record;
+  record.rms_px = fit.rms_px;
+  record.median_px = fit.median_px;
+  record.max_px = fit.max_px;
+  record.num_points = static_cast<int>(fit.residuals_px.size());
+  record.start = fit.start_method;
+  record.free = fit.free_parameters;
+  for (const FixedParameter& p : fit.fixed_parameters) {
+    record.fixed.emplace_back(p.name, p.value + " (" + p.why + ")");
+    if (p.why.rfind("default", 0) == 0) record.left_out.emplace_back(p.name, p.why);
+  }
+  for (const ParameterSigma& s : fit.sigmas) record.sigma.emplace_back(s.name, s.sigma);
+  record.pixel_sigma = fit.pixel_sigma;
+  record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
+  record.iterations = fit.iterations;
+  record.time_ms = fit.time_ms;
+  return record;
+}
+
+std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {
+  std::ostringstream out;
+  const int n = static_cast<int>(fit.residuals_px.size());
+  out << "model: " << fit.free_parameters.size() << " free parameters (pose";
+  for (size_t i = 6; i < fit.free_parameters.size(); ++i) out << ", " << fit.free_parameters[i];
+  out << "), " << n << " points" << (fit.planar ? " (coplanar)" : "") << ", start "
+      << fit.start_method << "\n";
+  for (const FixedParameter& p : fit.fixed_parameters) {
+    out << "  fixed " << p.name << " = " << p.value << " (" << p.why << ")\n";
+  }
+  if (fit.covariance_available) {
+    out << "parameters (+- 1 sigma, pixel noise " << Format("%.3g", fit.pixel_sigma) << " px "
+        << (fit.pixel_sigma_estimated ? "estimated from the residuals" : "given") << "):\n";
+    for (const ParameterSigma& s : fit.sigmas) {
+      if (s.name.rfind("rotation", 0) == 0) continue;
+      out << "  " << s.name << " = " << WithSigma(s.value, s.sigma) << (s.unit.empty() ? "" : " ")
+          << (s.unit == "world" ? "(world units)" : s.unit) << "\n";
+    }
+    double rotation_sigma = 0.0;
+    for (const ParameterSigma& s : fit.sigmas) {
+      if (s.name.rfind("rotation", 0) == 0) rotation_sigma = std::max(rotation_sigma, s.sigma);
+    }
+    out << "  rotation +- " << Format("%.2g", rotation_sigma) << " deg (largest about a camera axis)\n";
+    for (const Correlation& c : fit.strong_correlations) {
+      out << "  strongly correlated: " << c.first << ", " << c.second << " ("
+          << Format("%+.3f", c.correlation) << ")\n";
+    }
+  } else {
+    out << "parameters: no uncertainty (as many equations as unknowns and no --sigma given)\n";
+  }
+  const Intrinsics& k = fit.camera.intrinsics;
+  out << "intrinsics: fx " << Format("%.6g", k.fx) << " fy " << Format("%.6g", k.fy) << " cx "
+      << Format("%.6g", k.cx) << " cy " << Format("%.6g", k.cy);
+  if (k.skew != 0.0) out << " skew " << Format("%.6g", k.skew);
+  if (k.HasDistortion()) out << " k1 " << Format("%.6g", k.k1) << " k2 " << Format("%.6g", k.k2);
+  out << " (px, pixel centres at integers)\n";
+  const LookAt& look = fit.views.look_at;
+  auto vec = [](const Eigen::Vector3d& v) {
+    return Format("%.6g", v.x()) + " " + Format("%.6g", v.y()) + " " + Format("%.6g", v.z());
+  };
+  out << "look-at: eye " << vec(look.eye) << ", target " << vec(look.target) << ", up "
+      << vec(look.up) << "\n";
+  if (fit.views.perspective) {
+    out << "perspective: fovy " << Format("%.6g", fit.views.perspective->fovy_deg) << " deg, aspect "
+        << Format("%.6g", fit.views.perspective->aspect) << "\n";
+  } else if (fit.views.frustum) {
+    const Frustum& f = *fit.views.frustum;
+    out << "frustum (off-axis): left " << Format("%.6g", f.left) << " right " << Format("%.6g", f.right)
+        << " bottom " << Format("%.6g", f.bottom) << " top " << Format("%.6g", f.top) << "\n";
+  }
+  out << "near " << Format("%.6g", fit.camera.z_near) << ", far " << Format("%.6g", fit.camera.z_far)
+      << " (points' depth range + 10 %)\n";
+  out << "residuals: rms " << Format("%.3f", fit.rms_px) << " px, median "
+      << Format("%.3f", fit.median_px) << " px, max " << Format("%.3f", fit.max_px) << " px\n";
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return fit.residuals_px[a].norm() > fit.residuals_px[b].norm();
+  });
+  out << "worst points:";
+  for (int i = 0; i < std::min(worst, n); ++i) {
+    const int index = order[i];
+    out << " " << (index < static_cast<int>(ids.size()) ? ids[index] : std::to_string(index + 1))
+        << " (" << Format("%.2f", fit.residuals_px[index].norm()) << " px)";
+  }
+  out << "\n";
+  out << "time: " << Format("%.3f", fit.time_ms) << " ms, " << fit.iterations << " iterations ("
+      << fit.termination << ")\n";
+  return out.str();
+}
+
+std::string FitTraceText(const FitResult& fit) {
+  std::ostringstream out;
+  out << "iteration  elapsed_us  rms_px\n";
+  for (const TraceEntry& e : fit.trace) {
+    char line[96];
+    std::snprintf(line, sizeof line, "%9d  %10.1f  %.9g\n", e.iteration, e.elapsed_us, e.rms_px);
+    out << line;
+  }
+  return out.str();
+}
+
+}  // namespace camproj

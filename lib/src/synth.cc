@@ -1,0 +1,149 @@
+#include "camproj/synth.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "check.h"
+
+namespace camproj {
+
+using internal::Require;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Uniform and standard normal draws from the raw 64-bit engine, so the numbers do not depend on
+// the standard library's distribution implementations.
+double Uniform01(std::mt19937_64& rng) { return (rng() >> 11) * 0x1.0p-53; }
+double Uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * Uniform01(rng); }
+double Normal(std::mt19937_64& rng) {
+  // Box-Muller; 1 - u keeps the logarithm finite.
+  const double u = 1.0 - Uniform01(rng);
+  const double v = Uniform01(rng);
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kPi * v);
+}
+
+}  // namespace
+
+void SynthOptions::Check() const {
+  Require(num_points >= 1 && num_points <= 100000000, "points must be in [1, 1e8], got ", num_points);
+  Require(std::isfinite(noise_px) && noise_px >= 0.0, "noise must be >= 0 px, got ", noise_px);
+  image_size.Check();
+  Require(std::isfinite(fovy_deg) && fovy_deg > 0.0 && fovy_deg < 180.0,
+          "fovy must be in (0, 180) degrees, got ", fovy_deg);
+  Require(principal_point_offset.allFinite() && principal_point_offset.cwiseAbs().maxCoeff() <= 2.0,
+          "principal point offset must be within +-2 image sizes, got ",
+          principal_point_offset.transpose());
+  Require(std::isfinite(aspect) && aspect > 0.0, "aspect must be positive, got ", aspect);
+  Require(std::isfinite(object_size) && object_size > 0.0, "object size must be positive, got ",
+          object_size);
+}
+
+SynthObject SynthObjectFromString(const std::string& text) {
+  if (text == "cloud") return SynthObject::kCloud;
+  if (text == "box") return SynthObject::kBox;
+  if (text == "plane") return SynthObject::kPlane;
+  throw std::invalid_argument("object must be cloud, box or plane, got \"" + text + "\"");
+}
+
+SynthScene SynthesizeScene(const SynthOptions& options) {
+  options.Check();
+  std::mt19937_64 rng(options.seed);
+  const ImageSize& size = options.image_size;
+  Intrinsics k;
+  k.fy = 0.5 * size.height / std::tan(0.5 * options.fovy_deg * kPi / 180.0);
+  k.fx = k.fy / options.aspect;
+  k.cx = 0.5 * (size.width - 1) + options.principal_point_offset.x() * size.width;
+  k.cy = 0.5 * (size.height - 1) + options.principal_point_offset.y() * size.height;
+
+  // Viewing direction: azimuth all round, elevation 15..45 degrees above the object (y up).
+  const double azimuth = Uniform(rng, 0.0, 2.0 * kPi);
+  const double elevation = Uniform(rng, 15.0, 45.0) * kPi / 180.0;
+  const Eigen::Vector3d to_eye(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                               std::cos(elevation) * std::cos(azimuth));
+
+  // The object, centred on the origin: box half extents (1, 0.6, 0.8) * size / 2.
+  const Eigen::Vector3d half = 0.5 * options.object_size * Eigen::Vector3d(1.0, 0.6, 0.8);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(options.num_points);
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitY();
+  if (options.object == SynthObject::kPlane) {
+    // A plane through the origin tilted 25..60 degrees away from facing the camera.
+    const double tilt = Uniform(rng, 25.0, 60.0) * kPi / 180.0;
+    const Eigen::Vector3d side = to_eye.cross(Eigen::Vector3d::UnitY()).normalized();
+    plane_normal = Eigen::AngleAxisd(tilt, side) * to_eye;
+  }
+  const Eigen::Vector3d plane_u = plane_normal.unitOrthogonal();
+  const Eigen::Vector3d plane_v = plane_normal.cross(plane_u);
+  while (static_cast<int>(points.size()) < options.num_points) {
+    Eigen::Vector3d x(Uniform(rng, -1, 1), Uniform(rng, -1, 1), Uniform(rng, -1, 1));
+    if (options.object == SynthObject::kCloud) {
+      points.push_back(x.cwiseProduct(half));
+    } else if (options.object == SynthObject::kPlane) {
+      points.push_back(0.5 * options.object_size * (x.x() * plane_u + x.y() * plane_v));
+    } else {
+      // Push the point onto one face of the box; keep it if that face looks towards the eye.
+      const int axis = static_cast<int>(rng() % 3);
+      x[axis] = x[axis] < 0 ? -1.0 : 1.0;
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      normal[axis] = x[axis];
+      if (normal.dot(to_eye) <= 0.1) continue;
+      points.push_back(x.cwiseProduct(half));
+    }
+  }
+
+  // Aim the image centre's ray (not the optical axis: the principal point may be off-centre)
+  // at the object's centre, with the world's y up, then back off until every point is inside.
+  const Eigen::Vector3d centre_ray =
+      CamRayFromPixel(k, Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1))).normalized();
+  const Eigen::Matrix3d tilt_to_centre_ray =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), centre_ray).toRotationMatrix();
+  double distance = 0.4 * options.object_size / std::tan(0.5 * options.fovy_deg * kPi / 180.0);
+  SynthScene scene;
+  Camera& camera = scene.truth;
+  camera.image_size = size;
+  camera.intrinsics = k;
+  for (int attempt = 0;; ++attempt) {
+    Require(attempt < 400, "cannot fit the object into the image with these options");
+    const LookAt look_at{distance * to_eye, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY()};
+    const Rigid3 aimed = CamFromWorldFromLookAt(look_at);
+    camera.cam_from_world.rotation = tilt_to_centre_ray * aimed.rotation;
+    camera.cam_from_world.translation = -camera.cam_from_world.rotation * look_at.eye;
+    bool inside = true;
+    for (const auto& x : points) {
+      const Eigen::Vector3d p = camera.cam_from_world * x;
+      if (!(p.z() > 0.0)) { inside = false; break; }
+      const Eigen::Vector2d pixel = PixelFromCam(k, p);
+      // A 2 % margin keeps noisy pixels inside the image too.
+      if (pixel.x() < 0.02 * size.width || pixel.x() > 0.98 * size.width - 1 ||
+          pixel.y() < 0.02 * size.height || pixel.y() > 0.98 * size.height - 1) {
+        inside = false;
+        break;
+      }
+    }
+    if (inside) break;
+    distance *= 1.05;
+  }
+
+  double min_depth = kInfinity;
+  double max_depth = 0.0;
+  Correspondences& c = scene.correspondences;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p = camera.cam_from_world * points[i];
+    min_depth = std::min(min_depth, p.z());
+    max_depth = std::max(max_depth, p.z());
+    const Eigen::Vector2d noise(Normal(rng), Normal(rng));
+    c.points_in_world.push_back(points[i]);
+    c.pixels.push_back(PixelFromCam(k, p) + options.noise_px * noise);
+    c.ids.push_back(std::to_string(i + 1));
+    c.line_numbers.push_back(static_cast<int>(i) + 2);
+  }
+  camera.z_near = min_depth / 1.1;
+  camera.z_far = max_depth * 1.1;
+  return scene;
+}
+
+}  // namespace camproj

@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of fuzz/ with clang in build/fuzz, replays each seed corpus, then
+# fuzzes each target for SECONDS seconds (default 30; or CAMPROJ_FUZZ_SECONDS) on a temporary
+# copy of its corpus (the committed corpus is never modified).
+# Usage: scripts/fuzz.sh [SECONDS]
+# Prints one line per target on success. On a crash, leak, UB, timeout or escaped exception it
+# prints the fuzzer's log and where the reproducer is saved, and exits non-zero.
+# Reproduce: build/fuzz/fuzz/<target> <reproducer file>
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build="$root/build/fuzz"
+seconds=${1:-${CAMPROJ_FUZZ_SECONDS:-30}}
+if ! [[ "$seconds" =~ ^[0-9]+$ ]] || ((seconds < 1)); then
+  echo "fuzz: SECONDS must be a positive integer, got '$seconds'" >&2
+  exit 1
+fi
+for tool in clang clang++ cmake ninja; do
+  if ! command -v "$tool" >/dev/null; then
+    echo "fuzz: $tool not found; run scripts/install-deps.sh" >&2
+    exit 1
+  fi
+done
+
+mkdir -p "$build"
+logs="$build/logs"
+mkdir -p "$logs"
+
+# A cache made with another compiler cannot be switched to clang in place: start it over.
+if [[ -f "$build/CMakeCache.txt" ]] && ! grep -q '^CMAKE_CXX_COMPILER:.*clang' "$build/CMakeCache.txt"; then
+  rm -rf "$build/CMakeCache.txt" "$build/CMakeFiles"
+fi
+if ! CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCAMPROJ_FUZZ=ON \
+    -DCAMPROJ_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo >"$logs/configure.log" 2>&1; then
+  cat "$logs/configure.log" >&2
+  echo "fuzz: configuring $build failed" >&2
+  exit 1
+fi
+targets=(points_csv camera_json)
+if ! cmake --build "$build" --target "${targets[@]/%/_fuzzer}" >"$logs/build.log" 2>&1; then
+  cat "$logs/build.log" >&2
+  echo "fuzz: building the fuzzers failed" >&2
+  exit 1
+fi
+
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+run_id=$(date +%Y%m%d-%H%M%S)
+artifacts="$build/artifacts/$run_id"
+work=$(mktemp -d "${TMPDIR:-/tmp}/camproj-fuzz.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+# Bounds: -timeout reports an input that takes longer than that (a hang); -max_len 64 KiB.
+common=(-rss_limit_mb=2048 -timeout=10 -max_len=65536)
+
+# Prints a failed step's log and the reproducers it left; $1 target, $2 step, $3 exit code, $4 log.
+report_failure() {
+  local target=$1 step=$2 code=$3 log=$4
+  mkdir -p "$artifacts/$target"
+  cp "$log" "$artifacts/$target/"
+  {
+    echo "======== fuzz: $target: $step FAILED (exit $code); log (without progress lines) ========"
+    grep -v -E '^#[0-9]+[[:space:]]+(NEW|REDUCE|pulse|RELOAD)[[:space:]]' "$log" || true
+    echo "======== end of log ========"
+    echo "fuzz: $target: $step failed; log: $artifacts/$target/$(basename "$log")"
+    local found=0 file
+    for file in "$artifacts/$target"/{crash,leak,timeout,oom,slow-unit}-*; do
+      [[ -e "$file" ]] || continue
+      found=1
+      echo "fuzz: $target: reproducer: $file"
+      echo "fuzz: $target:   rerun: $build/fuzz/${target}_fuzzer $file"
+    done
+    # Replaying files one by one writes no artifact: the input is the last one the log names.
+    file=$(sed -n 's/^Running: //p' "$log" | tail -n 1)
+    if ((found == 0)) && [[ -n "$file" ]]; then
+      found=1
+      echo "fuzz: $target: reproducer: $file"
+      echo "fuzz: $target:   rerun: $build/fuzz/${target}_fuzzer $file"
+    fi
+    if ((found == 0)); then
+      echo "fuzz: $target: no reproducer file was written; see the log"
+    fi
+  } >&2
+}
+
+failed=0
+for target in "${targets[@]}"; do
+  fuzzer="$build/fuzz/${target}_fuzzer"
+  corpus="$root/fuzz/corpus/$target"
+  mkdir -p "$artifacts/$target"
+  prefix=(-artifact_prefix="$artifacts/$target/")
+
+  # Replay: every seed once, each on its own (a crashing seed is named in the log).
+  seeds=("$corpus"/*)
+  log="$logs/$target.replay.log"
+  code=0
+  "$fuzzer" -runs=0 "${common[@]}" "${prefix[@]}" "${seeds[@]}" >"$log" 2>&1 || code=$?
+  if ((code != 0)); then
+    report_failure "$target" "replaying the seed corpus" "$code" "$log"
+    failed=1
+    continue
+  fi
+
+  # Fuzz on a copy of the corpus, which libFuzzer grows with the inputs it finds.
+  mkdir -p "$work/$target"
+  cp "${seeds[@]}" "$work/$target/"
+  log="$logs/$target.fuzz.log"
+  code=0
+  "$fuzzer" "$work/$target" -max_total_time="$seconds" -print_final_stats=1 \
+    -dict="$root/fuzz/$target.dict" "${common[@]}" "${prefix[@]}" >"$log" 2>&1 || code=$?
+  if ((code != 0)); then
+    report_failure "$target" "fuzzing" "$code" "$log"
+    failed=1
+    continue
+  fi
+  done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -n 1 || true)
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+  per_second=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+  rss=$(sed -n 's/^stat::peak_rss_mb: *//p' "$log")
+  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$done_line")
+  ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$done_line")
+  corp=$(sed -n 's/.* corp: \([0-9]*\)\/.*/\1/p' <<<"$done_line")
+  echo "fuzz: $target: ok, ${seconds} s, ${execs:-?} execs (${per_second:-?}/s), cov ${cov:-?}," \
+       "ft ${ft:-?}, corpus ${#seeds[@]} seeds -> ${corp:-?}, rss ${rss:-?} MB"
+  rmdir "$artifacts/$target" 2>/dev/null || true
+done
+rmdir "$artifacts" "$build/artifacts" 2>/dev/null || true
+exit "$failed"

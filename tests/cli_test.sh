@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# End-to-end tests of the built `camproj` binary: outputs, messages and exit codes.
+# Usage: cli_test.sh CAMPROJ_BINARY DATA_DIR CASE   (ctest runs one CASE per test)
+set -u
+bin=$1
+data=$2
+case=$3
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+fail() { echo "FAIL [$case]: $*" >&2; exit 1; }
+# expect_exit CODE CMD...: runs CMD, keeps stdout/stderr in $work/out, $work/err.
+expect_exit() {
+  local want=$1; shift
+  "$@" >"$work/out" 2>"$work/err"
+  local got=$?
+  [[ $got -eq $want ]] || fail "exit $got, expected $want: $*\n--- stdout\n$(cat "$work/out")\n--- stderr\n$(cat "$work/err")"
+}
+expect_in() { grep -q -- "$2" "$work/$1" || fail "$1 lacks '$2':\n$(cat "$work/$1")"; }
+
+case $case in
+  fit_projector)
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cam.json" --trace
+    expect_in out "model: 10 free parameters"
+    expect_in out "residuals: rms"
+    expect_in out "worst points:"
+    expect_in out "iteration  elapsed_us  rms_px"
+    [[ -f "$work/cam.json" ]] || fail "no camera file"
+    grep -q '"fit"' "$work/cam.json" || fail "camera file lacks fit"
+    # The fit is within a few sigma of the truth the data was made from.
+    expect_exit 0 "$bin" export "$work/cam.json" --to gl
+    expect_in out "^projection "
+    ;;
+  fit_json_stdout)
+    expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --json
+    expect_in out '"rms_px"'
+    expect_in out '"cam_from_world"'
+    ;;
+  fit_planar_refused_then_fixed)
+    expect_exit 3 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 -o "$work/cam.json"
+    expect_in err "coplanar"
+    expect_in err "principal point"
+    [[ ! -e "$work/cam.json" ]] || fail "a refused fit wrote a camera file"
+    expect_exit 0 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 --fix aspect,principal-point -o "$work/cam.json"
+    expect_in out "coplanar"
+    ;;
+  fit_known_intrinsics)
+    expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --intrinsics "$data/synthetic/truth.json"
+    expect_in out "model: 6 free parameters"
+    expect_in out "given: pose only"
+    ;;
+  fit_bad_csv_names_line_and_column)
+    printf 'X,Y,Z,u,v\n1,2,3,4,5\n1,2,abc,4,5\n' >"$work/bad.csv"
+    expect_exit 2 "$bin" fit "$work/bad.csv" --image-size 640x480
+    expect_in err "bad.csv: line 3, column 3 (Z)"
+    printf '' >"$work/empty.csv"
+    expect_exit 2 "$bin" fit "$work/empty.csv" --image-size 640x480
+    expect_in err "empty file"
+    printf 'X,Y,Z,u\n1,2,3,4\n' >"$work/missing.csv"
+    expect_exit 2 "$bin" fit "$work/missing.csv" --image-size 640x480
+    expect_in err "header lacks column v"
+    printf 'X,Y,Z,u,v\n1,2,nan,4,5\n' >"$work/nan.csv"
+    expect_exit 2 "$bin" fit "$work/nan.csv" --image-size 640x480
+    expect_in err "not finite"
+    printf 'X,Y,Z,u,X\n1,2,3,4,5\n' >"$work/dup.csv"
+    expect_exit 2 "$bin" fit "$work/dup.csv" --image-size 640x480
+    expect_in err "duplicate column"
+    # A 2 MB line stands for the 3 GB one: refused after ~1 MiB, whatever the file's size.
+    { printf 'X,Y,Z,u,v\n'; head -c 2000000 /dev/zero | tr '\0' 1; printf '\n'; } >"$work/long.csv"
+    expect_exit 2 "$bin" fit "$work/long.csv" --image-size 640x480
+    expect_in err "line 2 is longer than 1048576 bytes"
+    ;;
+  fit_failure_keeps_existing_camera_file)
+    cp "$data/projector/truth.json" "$work/cam.json"
+    printf 'X,Y,Z,u,v\n1,2,3,4,5\n' >"$work/few.csv"
+    expect_exit 3 "$bin" fit "$work/few.csv" --image-size 640x480 -o "$work/cam.json"
+    expect_in err "add points"
+    cmp -s "$data/projector/truth.json" "$work/cam.json" || fail "the old camera file was changed"
+    [[ $(ls "$work" | grep -c tmp) -eq 0 ]] || fail "a temporary file was left behind"
+    ;;
+  usage_errors)
+    expect_exit 1 "$bin"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920by1080
+    expect_in err "WIDTHxHEIGHT"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --free focus
+    expect_exit 1 "$bin" export "$data/projector/truth.json" --to vrml
+    expect_exit 0 "$bin" --help
+    expect_in out "Exit codes"
+    expect_exit 0 "$bin" fit --help
+    expect_in out "Examples"
+    ;;
+  export_formats)
+    for to in gl glm opencv-yaml colmap three json; do
+      expect_exit 0 "$bin" export "$data/projector/truth.json" --to "$to"
+      [[ -s "$work/out" ]] || fail "empty $to export"
+    done
+    expect_exit 0 "$bin" export "$data/projector/truth.json" --to gl --depth zo --reversed-z --infinite-far
+    expect_in out "reversed-Z"
+    expect_exit 2 "$bin" export "$work/none.json"
+    expect_in err "none.json"
+    printf '{"image_size": [640, 480],\n "intrinsics": {"fx": 1e400}}' >"$work/bad.json"
+    expect_exit 2 "$bin" export "$work/bad.json"
+    expect_in err "bad.json"
+    ;;
+  project_points)
+    expect_exit 0 "$bin" project "$data/projector/truth.json" "$data/projector/points.csv"
+    expect_in out "^id,X,Y,Z,u,v,depth"
+    [[ $(wc -l <"$work/out") -eq 21 ]] || fail "expected 20 rows"
+    printf 'X,Y,Z\n0,0,0\n' >"$work/xyz.csv"
+    expect_exit 0 "$bin" project "$data/projector/truth.json" "$work/xyz.csv"
+    ;;
+  convert_round_trip)
+    expect_exit 0 "$bin" convert --intrinsics 1000,1000,959.5,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum
+    expect_in out "left -0.096"
+    expect_exit 0 "$bin" convert --frustum -0.096,0.096,-0.054,0.054,0.1,100 --image-size 1920x1080 --to intrinsics
+    expect_in out "fx 1000"
+    expect_in out "cx 959.5"
+    expect_exit 2 "$bin" convert --intrinsics 1000,1000,900,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to perspective
+    expect_in err "off-axis"
+    expect_exit 1 "$bin" convert --intrinsics 1000,1000 --image-size 1920x1080 --near 0.1 --far 100 --to frustum
+    ;;
+  synth_reproducible)
+    expect_exit 0 "$bin" synth --seed 5 --points 12 --noise 0.5 -o "$work/a.csv" --truth "$work/a.json"
+    expect_exit 0 "$bin" synth --seed 5 --points 12 --noise 0.5 -o "$work/b.csv" --truth "$work/b.json"
+    cmp -s "$work/a.csv" "$work/b.csv" || fail "same seed, different points"
+    cmp -s "$work/a.json" "$work/b.json" || fail "same seed, different truth"
+    ;;
+  overlay_png)
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/o.png"
+    [[ $(head -c 8 "$work/o.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] || fail "not a PNG"
+    expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
+    [[ ! -e "$work/p.png" ]] || fail "partial output"
+    ;;
+  *) fail "unknown case" ;;
+esac
+echo "ok [$case]"
