@@ -5,7 +5,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 if [[ "${1:-}" == "--sanitize" ]]; then
   build="$root/build/sanitize"
-  bash "$root/scripts/build.sh" "$build" -DCAMPROJ_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  # -O1 -g1: line tables for readable reports at a fraction of -O2 -g's compile time.
+  bash "$root/scripts/build.sh" "$build" -DCAMPROJ_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
+    "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g1"
 else
   build="$root/build/release"
   bash "$root/scripts/build.sh" "$build"
