@@ -474,29 +474,32 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   }
 
   FitResult result;
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.num_threads = 1;
-  solver_options.update_state_every_iteration = true;
-  TraceCallback trace_callback(points, pixels, rotation.coeffs().data(), center.data(),
-                               intrinsics.data(), start_time, &result.trace);
-  solver_options.callbacks.push_back(&trace_callback);
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (summary.termination_type == ceres::FAILURE) {
-    throw SceneError(SceneError::Reason::kDegenerate,
-                     "the refinement failed: " + summary.message +
-                         ": check the correspondences");
+  if (options.refine) {
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = options.function_tolerance;
+    solver_options.gradient_tolerance = options.gradient_tolerance;
+    solver_options.parameter_tolerance = options.parameter_tolerance;
+    solver_options.logging_type = ceres::SILENT;
+    solver_options.num_threads = 1;
+    solver_options.update_state_every_iteration = true;
+    TraceCallback trace_callback(points, pixels, rotation.coeffs().data(), center.data(),
+                                 intrinsics.data(), start_time, &result.trace);
+    solver_options.callbacks.push_back(&trace_callback);
+    ceres::Solve(solver_options, &problem, &summary);
+    if (summary.termination_type == ceres::FAILURE) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "the refinement failed: " + summary.message +
+                           ": check the correspondences");
+    }
+
   }
   model.value = intrinsics;
   rotation.normalize();
   Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
-  if (options.loss == LossType::kNone) {
+  if (options.refine && options.loss == LossType::kNone) {
     PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model);
   }
 
@@ -533,9 +536,13 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.max_px = *std::max_element(norms.begin(), norms.end());
   result.start_method = start_method;
   result.planar = planar;
-  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
-                       ": " + summary.message;
+  if (options.refine) {
+    result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
+                         ": " + summary.message;
+  } else {
+    result.termination = "not refined (closed-form start only)";
+  }
 
   // Depth range and views.
   const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
@@ -582,7 +589,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   } else if (dof > 0) {
     result.pixel_sigma = std::sqrt(sum_squares / dof);
   }
-  if (options.pixel_sigma || dof > 0) {
+  if (options.compute_uncertainty && (options.pixel_sigma || dof > 0)) {
     const Eigen::MatrixXd scaled_inverse =
         eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
         eigen.eigenvectors().transpose();

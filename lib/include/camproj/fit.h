@@ -67,6 +67,12 @@ struct FitOptions {
   // as sqrt(sum of squared residuals / (2N - p)).
   std::optional<double> pixel_sigma;
 
+  // false: return the closed-form start (DLT / homography / PnP, projected onto the model)
+  // without Ceres refinement; the residuals, views and uncertainty are those of the start.
+  bool refine = true;
+  // false: skip the covariance (sigmas, correlations); saves its cost in batch use.
+  bool compute_uncertainty = true;
+
   int max_iterations = 100;
   double function_tolerance = 1e-16;   // Ceres' relative cost change
   double gradient_tolerance = 1e-16;
