@@ -8,7 +8,6 @@
 #include <numeric>
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 #include <Eigen/Dense>
 
 #include "check.h"
@@ -162,50 +161,36 @@ class TraceCallback : public ceres::IterationCallback {
 };
 
 // The Jacobian of all residuals with respect to the user parameterization u = [omega (3, rad,
-// R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots], by Jets.
-constexpr int kMaxParams = 6 + internal::kFitIntrinsicsSize;
-using Jet = ceres::Jet<double, kMaxParams>;
-
-// Also fills `residuals` (predicted - observed, 2N) when given.
-Eigen::MatrixXd UserJacobian(const std::vector<Eigen::Vector3d>& points,
-                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                             const Model& model, int num_params,
-                             const std::vector<Eigen::Vector2d>* pixels = nullptr,
-                             Eigen::VectorXd* residuals = nullptr) {
+// R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots]: at omega = 0,
+// dp/domega = -[p]x and dp/dC = -R_hat. Also fills `residuals` (predicted - observed, 2N)
+// when given. Returns false if a point is not in front of the camera.
+bool UserJacobian(const std::vector<Eigen::Vector3d>& points,
+                  const std::vector<Eigen::Vector2d>& pixels, const Eigen::Matrix3d& rotation,
+                  const Eigen::Vector3d& center, const Model& model, int num_params,
+                  Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals) {
   const int n = static_cast<int>(points.size());
-  Eigen::MatrixXd jacobian(2 * n, num_params);
-  if (residuals != nullptr) residuals->resize(2 * n);
-  Jet omega[3];
-  Jet c[3];
-  Jet k[internal::kFitIntrinsicsSize];
-  for (int i = 0; i < 3; ++i) {
-    omega[i] = Jet(0.0, i);
-    c[i] = Jet(center[i], 3 + i);
-  }
-  int next = 6;
-  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-    k[slot] = model.free[slot] ? Jet(model.value[slot], next++) : Jet(model.value[slot]);
-  }
+  jacobian->resize(2 * n, num_params);
+  residuals->resize(2 * n);
+  const Eigen::Quaterniond q(rotation);
+  Eigen::Matrix<double, 2, 7, Eigen::RowMajor> jk;
+  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
   for (int i = 0; i < n; ++i) {
-    Jet p0[3];
-    for (int r = 0; r < 3; ++r) {
-      p0[r] = Jet(0.0);
-      for (int col = 0; col < 3; ++col) p0[r] += rotation(r, col) * (points[i][col] - c[col]);
+    if (!internal::ProjectPointWithJacobian(q.coeffs().data(), center.data(), model.value.data(),
+                                            points[i], pixels[i], residuals->data() + 2 * i,
+                                            nullptr, nullptr, jk.data(), jp.data())) {
+      return false;
     }
-    Jet p[3];
-    ceres::AngleAxisRotatePoint(omega, p0, p);
-    Jet pixel[2];
-    internal::PixelFromFitIntrinsics(k, p[0] / p[2], p[1] / p[2], pixel);
-    for (int j = 0; j < num_params; ++j) {
-      jacobian(2 * i, j) = pixel[0].v[j];
-      jacobian(2 * i + 1, j) = pixel[1].v[j];
-    }
-    if (residuals != nullptr) {
-      (*residuals)(2 * i) = pixel[0].a - (*pixels)[i].x();
-      (*residuals)(2 * i + 1) = pixel[1].a - (*pixels)[i].y();
+    const Eigen::Vector3d p = rotation * (points[i] - center);
+    Eigen::Matrix3d skew_p;
+    skew_p << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
+    jacobian->block<2, 3>(2 * i, 0) = -jp * skew_p;
+    jacobian->block<2, 3>(2 * i, 3) = -jp * rotation;
+    int next = 6;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model.free[slot]) jacobian->block<2, 1>(2 * i, next++) = jk.col(slot);
     }
   }
-  return jacobian;
+  return true;
 }
 
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
@@ -214,13 +199,21 @@ Eigen::MatrixXd UserJacobian(const std::vector<Eigen::Vector3d>& points,
 void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels, int num_params,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model) {
-  constexpr int kMaxSteps = 4;
+  constexpr int kMaxSteps = 6;
   Eigen::VectorXd residuals;
-  Eigen::MatrixXd jacobian =
-      UserJacobian(points, *rotation, *center, *model, num_params, &pixels, &residuals);
+  Eigen::MatrixXd jacobian;
+  if (!UserJacobian(points, pixels, *rotation, *center, *model, num_params, &jacobian, &residuals)) {
+    return;
+  }
   double cost = residuals.squaredNorm();
   for (int step = 0; step < kMaxSteps; ++step) {
-    const Eigen::VectorXd delta = -jacobian.colPivHouseholderQr().solve(residuals);
+    // Normal equations with Jacobi scaling: p <= 13 unknowns, so this is O(N p^2).
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    const Eigen::VectorXd scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+    const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+    const Eigen::VectorXd delta =
+        -(scale.asDiagonal() *
+          (scale.asDiagonal() * normal * scale.asDiagonal()).ldlt().solve(scale.asDiagonal() * gradient));
     if (!delta.allFinite()) return;
     Eigen::Matrix3d new_rotation = *rotation;
     const double angle = delta.head<3>().norm();
@@ -234,17 +227,23 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       if (new_model.free[slot]) new_model.value[slot] += delta(next++);
     }
     Eigen::VectorXd new_residuals;
-    const Eigen::MatrixXd new_jacobian = UserJacobian(points, new_rotation, new_center, new_model,
-                                                      num_params, &pixels, &new_residuals);
+    Eigen::MatrixXd new_jacobian;
+    if (!UserJacobian(points, pixels, new_rotation, new_center, new_model, num_params,
+                      &new_jacobian, &new_residuals)) {
+      return;
+    }
+    // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
+    // ~1e-16), so accept rounding-level increases and stop on the step's size instead: in
+    // Jacobi-scaled units it is the change it makes to the residuals, in px.
     const double new_cost = new_residuals.squaredNorm();
-    if (!(new_cost <= cost)) return;
+    if (!(new_cost <= cost * (1.0 + 1e-12) + 1e-300)) return;
     *rotation = new_rotation;
     *center = new_center;
     *model = new_model;
-    const bool settled = cost - new_cost <= 1e-15 * cost;
+    const bool settled = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff() <= 1e-12;
     cost = new_cost;
-    jacobian = new_jacobian;
-    residuals = new_residuals;
+    jacobian.swap(new_jacobian);
+    residuals.swap(new_residuals);
     if (settled) return;
   }
 }
@@ -457,9 +456,15 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   ceres::LossFunction* loss = nullptr;
   if (options.loss == LossType::kHuber) loss = new ceres::HuberLoss(options.loss_scale_px);
   if (options.loss == LossType::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale_px);
-  for (int i = 0; i < n; ++i) {
-    problem.AddResidualBlock(internal::ReprojectionError::Create(points[i], pixels[i]), loss,
+  if (loss == nullptr) {
+    problem.AddResidualBlock(new internal::AllPointsReprojectionCost(points, pixels), nullptr,
                              rotation.coeffs().data(), center.data(), intrinsics.data());
+  } else {
+    // A robust loss weighs each point's squared distance, so each point has its own block.
+    for (int i = 0; i < n; ++i) {
+      problem.AddResidualBlock(new internal::PointReprojectionCost(points[i], pixels[i]), loss,
+                               rotation.coeffs().data(), center.data(), intrinsics.data());
+    }
   }
   problem.SetManifold(rotation.coeffs().data(), new ceres::EigenQuaternionManifold);
   std::vector<int> constant_slots;
@@ -477,7 +482,8 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   ceres::Solver::Summary summary;
   if (options.refine) {
     ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::DENSE_QR;
+    // p <= 13 unknowns: the normal equations (O(N p^2)) beat QR of the 2N x p Jacobian.
+    solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
     solver_options.max_num_iterations = options.max_iterations;
     solver_options.function_tolerance = options.function_tolerance;
     solver_options.gradient_tolerance = options.gradient_tolerance;
@@ -563,7 +569,10 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
-  const Eigen::MatrixXd jacobian = UserJacobian(points, rotation_matrix, center, model, num_params);
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd final_residuals;
+  UserJacobian(points, pixels, rotation_matrix, center, model, num_params, &jacobian,
+               &final_residuals);
   const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
   const Eigen::VectorXd column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
   const Eigen::MatrixXd scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();

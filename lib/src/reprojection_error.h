@@ -2,7 +2,11 @@
 #ifndef CAMPROJ_SRC_REPROJECTION_ERROR_H_
 #define CAMPROJ_SRC_REPROJECTION_ERROR_H_
 
+#include <vector>
+
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -51,6 +55,124 @@ struct ReprojectionError {
  private:
   Eigen::Vector3d point_;
   Eigen::Vector2d observed_;
+};
+
+// The same residual with analytic derivatives, for one point; the blocks are as above. Any
+// Jacobian pointer may be null. Returns false where the point is not in front (z <= 0).
+//   p = q * (X - C), Eigen's rotation of v by q: t = 2 u x v, p = v + w t + u x t (u = q.vec());
+//   dp/dw = t, dp/du = -2w [v]x - [t]x - 2 [u]x [v]x, dp/dC = -R.
+// jacobian_p, if given, receives d pixel / d p (2 x 3, row-major) for the caller's own chain rule.
+inline bool ProjectPointWithJacobian(const double* q, const double* c, const double* k,
+                                     const Eigen::Vector3d& point, const Eigen::Vector2d& observed,
+                                     double* residual, double* jacobian_q, double* jacobian_c,
+                                     double* jacobian_k, double* jacobian_p = nullptr) {
+  const Eigen::Vector3d u(q[0], q[1], q[2]);
+  const double w = q[3];
+  const Eigen::Vector3d v = point - Eigen::Vector3d(c[0], c[1], c[2]);
+  const Eigen::Vector3d t = 2.0 * u.cross(v);
+  const Eigen::Vector3d p = v + w * t + u.cross(t);
+  if (!(p.z() > 0.0)) return false;
+  const double inv_z = 1.0 / p.z();
+  const double x = p.x() * inv_z;
+  const double y = p.y() * inv_z;
+  const double f = k[0], a = k[1], s = k[4], k1 = k[5], k2 = k[6];
+  const double r2 = x * x + y * y;
+  const double d = 1.0 + r2 * (k1 + r2 * k2);
+  const double xd = d * x;
+  const double yd = d * y;
+  residual[0] = f * xd + s * yd + k[2] - observed.x();
+  residual[1] = a * f * yd + k[3] - observed.y();
+  if (jacobian_k != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> jk(jacobian_k);
+    const double pu = f * x + s * y;  // d u / d d, divided by nothing: u = d (f x + s y) + cx
+    jk << xd, 0.0, 1.0, 0.0, yd, pu * r2, pu * r2 * r2,  //
+        a * yd, f * yd, 0.0, 1.0, 0.0, a * f * y * r2, a * f * y * r2 * r2;
+  }
+  if (jacobian_q == nullptr && jacobian_c == nullptr && jacobian_p == nullptr) return true;
+  // d pixel / d (x, y), then / d p.
+  const double dd = 2.0 * (k1 + 2.0 * k2 * r2);  // d d / d x = dd x, d d / d y = dd y
+  const double dxd_dx = d + x * dd * x, dxd_dy = x * dd * y;
+  const double dyd_dx = y * dd * x, dyd_dy = d + y * dd * y;
+  Eigen::Matrix2d d_pixel_d_xy;
+  d_pixel_d_xy << f * dxd_dx + s * dyd_dx, f * dxd_dy + s * dyd_dy,  //
+      a * f * dyd_dx, a * f * dyd_dy;
+  Eigen::Matrix<double, 2, 3> d_xy_d_p;
+  d_xy_d_p << inv_z, 0.0, -x * inv_z, 0.0, inv_z, -y * inv_z;
+  const Eigen::Matrix<double, 2, 3> d_pixel_d_p = d_pixel_d_xy * d_xy_d_p;
+  if (jacobian_p != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jacobian_p);
+    jp = d_pixel_d_p;
+  }
+  if (jacobian_q == nullptr && jacobian_c == nullptr) return true;
+  auto skew = [](const Eigen::Vector3d& e) {
+    Eigen::Matrix3d m;
+    m << 0.0, -e.z(), e.y(), e.z(), 0.0, -e.x(), -e.y(), e.x(), 0.0;
+    return m;
+  };
+  const Eigen::Matrix3d skew_u = skew(u);
+  const Eigen::Matrix3d skew_v = skew(v);
+  if (jacobian_q != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 4, Eigen::RowMajor>> jq(jacobian_q);
+    const Eigen::Matrix3d dp_du = -2.0 * w * skew_v - skew(t) - 2.0 * skew_u * skew_v;
+    jq.leftCols<3>() = d_pixel_d_p * dp_du;
+    jq.col(3) = d_pixel_d_p * t;
+  }
+  if (jacobian_c != nullptr) {
+    // dp/dv is the rotation (for the unit quaternion); dv/dC = -I.
+    const Eigen::Matrix3d dp_dv = Eigen::Matrix3d::Identity() + 2.0 * w * skew_u + 2.0 * skew_u * skew_u;
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jc(jacobian_c);
+    jc = -d_pixel_d_p * dp_dv;
+  }
+  return true;
+}
+
+// One point, analytic: for per-point blocks (robust losses apply per point).
+class PointReprojectionCost : public ceres::SizedCostFunction<2, 4, 3, kFitIntrinsicsSize> {
+ public:
+  PointReprojectionCost(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
+      : point_(point), observed_(observed) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return ProjectPointWithJacobian(parameters[0], parameters[1], parameters[2], point_, observed_,
+                                    residuals, jacobians ? jacobians[0] : nullptr,
+                                    jacobians ? jacobians[1] : nullptr,
+                                    jacobians ? jacobians[2] : nullptr);
+  }
+
+ private:
+  Eigen::Vector3d point_;
+  Eigen::Vector2d observed_;
+};
+
+// All points in one block (2N residuals): without a robust loss, one block keeps Ceres' per-block
+// bookkeeping out of the inner loop. The points and pixels are referenced, not copied.
+class AllPointsReprojectionCost : public ceres::CostFunction {
+ public:
+  AllPointsReprojectionCost(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<Eigen::Vector2d>& observed)
+      : points_(points), observed_(observed) {
+    set_num_residuals(2 * static_cast<int>(points.size()));
+    mutable_parameter_block_sizes()->assign({4, 3, kFitIntrinsicsSize});
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const size_t n = points_.size();
+    for (size_t i = 0; i < n; ++i) {
+      // Ceres' Jacobian blocks are row-major (residuals x block size).
+      double* jq = jacobians && jacobians[0] ? jacobians[0] + 2 * i * 4 : nullptr;
+      double* jc = jacobians && jacobians[1] ? jacobians[1] + 2 * i * 3 : nullptr;
+      double* jk = jacobians && jacobians[2] ? jacobians[2] + 2 * i * kFitIntrinsicsSize : nullptr;
+      if (!ProjectPointWithJacobian(parameters[0], parameters[1], parameters[2], points_[i],
+                                    observed_[i], residuals + 2 * i, jq, jc, jk)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& observed_;
 };
 
 }  // namespace internal
