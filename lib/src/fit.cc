@@ -34,6 +34,9 @@ constexpr double kPlanarStartRatio = 1e-2;
 // Below this reciprocal condition number of the Jacobi-scaled normal equations the parameters
 // are not determined by the points (double precision leaves ~1e-16; 1e-12 keeps a margin).
 constexpr double kSingularRcond = 1e-12;
+// Re-solve the DLT's pose by PnP when projecting its K onto the model moves an intrinsic by more
+// than this fraction of the focal length (below it, LM corrects the pose in an iteration or two).
+constexpr double kPoseResolveChange = 0.02;
 
 using Clock = std::chrono::steady_clock;
 
@@ -130,12 +133,20 @@ class TraceCallback : public ceres::IterationCallback {
   TraceCallback(const std::vector<Eigen::Vector3d>& points,
                 const std::vector<Eigen::Vector2d>& pixels, const double* rotation,
                 const double* center, const double* intrinsics, Clock::time_point start,
-                std::vector<TraceEntry>* trace)
+                bool plain_least_squares, std::vector<TraceEntry>* trace)
       : points_(points), pixels_(pixels), rotation_(rotation), center_(center),
-        intrinsics_(intrinsics), start_(start), trace_(trace) {}
+        intrinsics_(intrinsics), start_(start), plain_least_squares_(plain_least_squares),
+        trace_(trace) {}
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     if (summary.iteration > 0 && !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    const double n = static_cast<double>(points_.size());
+    if (plain_least_squares_) {
+      // Ceres' cost is half the sum of squared residuals.
+      trace_->push_back({summary.iteration, MicrosecondsSince(start_), std::sqrt(2.0 * summary.cost / n)});
+      return ceres::SOLVER_CONTINUE;
+    }
+    // With a robust loss the cost is robustified: recompute the plain RMS.
     const Eigen::Map<const Eigen::Quaterniond> q(rotation_);
     const Eigen::Map<const Eigen::Vector3d> c(center_);
     double sum = 0.0;
@@ -145,8 +156,7 @@ class TraceCallback : public ceres::IterationCallback {
       internal::PixelFromFitIntrinsics(intrinsics_, p.x() / p.z(), p.y() / p.z(), pixel);
       sum += (Eigen::Vector2d(pixel[0], pixel[1]) - pixels_[i]).squaredNorm();
     }
-    trace_->push_back({summary.iteration, MicrosecondsSince(start_),
-                       std::sqrt(sum / static_cast<double>(points_.size()))});
+    trace_->push_back({summary.iteration, MicrosecondsSince(start_), std::sqrt(sum / n)});
     return ceres::SOLVER_CONTINUE;
   }
 
@@ -157,6 +167,7 @@ class TraceCallback : public ceres::IterationCallback {
   const double* center_;
   const double* intrinsics_;
   Clock::time_point start_;
+  bool plain_least_squares_;
   std::vector<TraceEntry>* trace_;
 };
 
@@ -196,12 +207,14 @@ bool UserJacobian(const std::vector<Eigen::Vector3d>& points,
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level.
+// Leaves in `jacobian` and `residuals` those of the final parameters (UserJacobian's).
 void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels, int num_params,
-                       Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model) {
+                       Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
+                       Eigen::MatrixXd* jacobian_out, Eigen::VectorXd* residuals_out) {
   constexpr int kMaxSteps = 6;
-  Eigen::VectorXd residuals;
-  Eigen::MatrixXd jacobian;
+  Eigen::MatrixXd& jacobian = *jacobian_out;
+  Eigen::VectorXd& residuals = *residuals_out;
   if (!UserJacobian(points, pixels, *rotation, *center, *model, num_params, &jacobian, &residuals)) {
     return;
   }
@@ -425,18 +438,24 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     if (model.free[3]) model.value[3] = k0.cy;
     if (model.free[4]) model.value[4] = k0.skew;
   }
-  if (start_method == "dlt" && model.NumFreeLinear() < 5) {
-    // With intrinsics held, the DLT's pose belongs to another K: re-solve it for this one and
-    // keep whichever reprojects better.
+  const Intrinsics projected = model.ToIntrinsics();
+  const double projection_change =
+      std::max({std::abs(projected.fx - k0.fx), std::abs(projected.fy - k0.fy),
+                std::abs(projected.cx - k0.cx), std::abs(projected.cy - k0.cy),
+                std::abs(projected.skew - k0.skew)}) / k0.fx;
+  if (start_method == "dlt" && projection_change > kPoseResolveChange) {
+    // Holding intrinsics moved K away from the DLT's: its pose belongs to another K. Re-solve
+    // the pose for this one and keep whichever reprojects better.
     internal::StartCamera pnp;
-    Intrinsics projected = model.ToIntrinsics();
     if (internal::PnpStart(points, pixels, projected, &pnp)) {
       auto sum_squares = [&](const internal::StartCamera& camera) {
         double sum = 0.0;
         for (int i = 0; i < n; ++i) {
           const Eigen::Vector3d p = camera.rotation * (points[i] - camera.center);
           if (!(p.z() > 0.0)) return std::numeric_limits<double>::infinity();
-          sum += (PixelFromCam(projected, p) - pixels[i]).squaredNorm();
+          double pixel[2];
+          internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
+          sum += (Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i]).squaredNorm();
         }
         return sum;
       };
@@ -490,9 +509,9 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     solver_options.parameter_tolerance = options.parameter_tolerance;
     solver_options.logging_type = ceres::SILENT;
     solver_options.num_threads = 1;
-    solver_options.update_state_every_iteration = true;
+    solver_options.update_state_every_iteration = loss != nullptr;
     TraceCallback trace_callback(points, pixels, rotation.coeffs().data(), center.data(),
-                                 intrinsics.data(), start_time, &result.trace);
+                                 intrinsics.data(), start_time, loss == nullptr, &result.trace);
     solver_options.callbacks.push_back(&trace_callback);
     ceres::Solve(solver_options, &problem, &summary);
     if (summary.termination_type == ceres::FAILURE) {
@@ -505,8 +524,14 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   model.value = intrinsics;
   rotation.normalize();
   Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd final_residuals;
   if (options.refine && options.loss == LossType::kNone) {
-    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model);
+    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model, &jacobian,
+                      &final_residuals);
+  } else {
+    UserJacobian(points, pixels, rotation_matrix, center, model, num_params, &jacobian,
+                 &final_residuals);
   }
 
   // Residuals and depths.
@@ -527,7 +552,9 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
       ++behind;
       continue;
     }
-    result.residuals_px[i] = PixelFromCam(camera.intrinsics, p) - pixels[i];
+    double pixel[2];
+    internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
+    result.residuals_px[i] = Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i];
     norms[i] = result.residuals_px[i].norm();
     sum_squares += norms[i] * norms[i];
   }
@@ -569,10 +596,6 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
-  Eigen::MatrixXd jacobian;
-  Eigen::VectorXd final_residuals;
-  UserJacobian(points, pixels, rotation_matrix, center, model, num_params, &jacobian,
-               &final_residuals);
   const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
   const Eigen::VectorXd column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
   const Eigen::MatrixXd scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();

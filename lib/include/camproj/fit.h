@@ -73,10 +73,13 @@ struct FitOptions {
   // false: skip the covariance (sigmas, correlations); saves its cost in batch use.
   bool compute_uncertainty = true;
 
+  // Ceres' Levenberg-Marquardt stopping rules. LM only needs to get close: a few undamped
+  // Gauss-Newton steps with the exact Jacobian follow it (without a robust loss) and stop when a
+  // step changes the residuals by less than 1e-12 px.
   int max_iterations = 100;
-  double function_tolerance = 1e-16;   // Ceres' relative cost change
+  double function_tolerance = 1e-10;   // relative cost change
   double gradient_tolerance = 1e-16;
-  double parameter_tolerance = 1e-14;  // relative step
+  double parameter_tolerance = 1e-10;  // relative step
 
   // Depth range of the result's GL matrices. Unset: tight around the points' depths, near =
   // min depth / (1 + depth_margin), far = max depth * (1 + depth_margin).
