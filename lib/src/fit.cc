@@ -171,62 +171,75 @@ class TraceCallback : public ceres::IterationCallback {
   std::vector<TraceEntry>* trace_;
 };
 
-// The Jacobian of all residuals with respect to the user parameterization u = [omega (3, rad,
-// R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots]: at omega = 0,
-// dp/domega = -[p]x and dp/dC = -R_hat. Also fills `residuals` (predicted - observed, 2N)
-// when given. Returns false if a point is not in front of the camera.
-bool UserJacobian(const std::vector<Eigen::Vector3d>& points,
-                  const std::vector<Eigen::Vector2d>& pixels, const Eigen::Matrix3d& rotation,
-                  const Eigen::Vector3d& center, const Model& model, int num_params,
-                  Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals) {
-  const int n = static_cast<int>(points.size());
-  jacobian->resize(2 * n, num_params);
-  residuals->resize(2 * n);
+// The Gauss-Newton normal equations of all residuals in the user parameterization u = [omega
+// (3, rad, R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots]: at
+// omega = 0, dp/domega = -[p]x and dp/dC = -R_hat. Accumulated point by point (J^T J, J^T r and
+// r^T r) so that no 2N x p matrix is formed. Returns false if a point is not in front.
+struct NormalEquations {
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
+  double cost = 0.0;  // sum of squared residuals
+};
+
+bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<Eigen::Vector2d>& pixels,
+                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                            const Model& model, int num_params, NormalEquations* out) {
+  constexpr int kMax = 6 + internal::kFitIntrinsicsSize;
+  Eigen::Matrix<double, kMax, kMax> jtj = Eigen::Matrix<double, kMax, kMax>::Zero();
+  Eigen::Matrix<double, kMax, 1> jtr = Eigen::Matrix<double, kMax, 1>::Zero();
+  double cost = 0.0;
   const Eigen::Quaterniond q(rotation);
   Eigen::Matrix<double, 2, 7, Eigen::RowMajor> jk;
   Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
-  for (int i = 0; i < n; ++i) {
+  Eigen::Matrix<double, 2, kMax> j = Eigen::Matrix<double, 2, kMax>::Zero();
+  int free_slots[internal::kFitIntrinsicsSize];
+  int num_free = 0;
+  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+    if (model.free[slot]) free_slots[num_free++] = slot;
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    Eigen::Vector2d r;
     if (!internal::ProjectPointWithJacobian(q.coeffs().data(), center.data(), model.value.data(),
-                                            points[i], pixels[i], residuals->data() + 2 * i,
-                                            nullptr, nullptr, jk.data(), jp.data())) {
+                                            points[i], pixels[i], r.data(), nullptr, nullptr,
+                                            jk.data(), jp.data())) {
       return false;
     }
     const Eigen::Vector3d p = rotation * (points[i] - center);
-    Eigen::Matrix3d skew_p;
-    skew_p << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
-    jacobian->block<2, 3>(2 * i, 0) = -jp * skew_p;
-    jacobian->block<2, 3>(2 * i, 3) = -jp * rotation;
-    int next = 6;
-    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-      if (model.free[slot]) jacobian->block<2, 1>(2 * i, next++) = jk.col(slot);
-    }
+    // -jp [p]x, column by column: row k of -[p]x is -(e_k x p)... written out.
+    j.col(0) = jp.col(2) * p.y() - jp.col(1) * p.z();
+    j.col(1) = jp.col(0) * p.z() - jp.col(2) * p.x();
+    j.col(2) = jp.col(1) * p.x() - jp.col(0) * p.y();
+    j.block<2, 3>(0, 3) = -jp * rotation;
+    for (int f = 0; f < num_free; ++f) j.col(6 + f) = jk.col(free_slots[f]);
+    jtj.noalias() += j.transpose() * j;
+    jtr.noalias() += j.transpose() * r;
+    cost += r.squaredNorm();
   }
+  out->jtj = jtj.topLeftCorner(num_params, num_params);
+  out->jtr = jtr.head(num_params);
+  out->cost = cost;
   return true;
 }
 
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
-// flat directions; undamped steps with the exact Jacobian take it to rounding level.
-// Leaves in `jacobian` and `residuals` those of the final parameters (UserJacobian's).
+// flat directions; undamped steps with the exact Jacobian take it to rounding level. Leaves in
+// `normal` the normal equations at the final parameters.
 void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels, int num_params,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
-                       Eigen::MatrixXd* jacobian_out, Eigen::VectorXd* residuals_out) {
+                       NormalEquations* normal) {
   constexpr int kMaxSteps = 6;
-  Eigen::MatrixXd& jacobian = *jacobian_out;
-  Eigen::VectorXd& residuals = *residuals_out;
-  if (!UserJacobian(points, pixels, *rotation, *center, *model, num_params, &jacobian, &residuals)) {
+  if (!ComputeNormalEquations(points, pixels, *rotation, *center, *model, num_params, normal)) {
     return;
   }
-  double cost = residuals.squaredNorm();
   for (int step = 0; step < kMaxSteps; ++step) {
-    // Normal equations with Jacobi scaling: p <= 13 unknowns, so this is O(N p^2).
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
-    const Eigen::VectorXd scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-    const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+    const Eigen::VectorXd scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
     const Eigen::VectorXd delta =
-        -(scale.asDiagonal() *
-          (scale.asDiagonal() * normal * scale.asDiagonal()).ldlt().solve(scale.asDiagonal() * gradient));
+        -(scale.asDiagonal() * (scale.asDiagonal() * normal->jtj * scale.asDiagonal())
+                                   .ldlt()
+                                   .solve(scale.asDiagonal() * normal->jtr));
     if (!delta.allFinite()) return;
     Eigen::Matrix3d new_rotation = *rotation;
     const double angle = delta.head<3>().norm();
@@ -239,24 +252,20 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
       if (new_model.free[slot]) new_model.value[slot] += delta(next++);
     }
-    Eigen::VectorXd new_residuals;
-    Eigen::MatrixXd new_jacobian;
-    if (!UserJacobian(points, pixels, new_rotation, new_center, new_model, num_params,
-                      &new_jacobian, &new_residuals)) {
+    NormalEquations new_normal;
+    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_model, num_params,
+                                &new_normal)) {
       return;
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
     // ~1e-16), so accept rounding-level increases and stop on the step's size instead: in
     // Jacobi-scaled units it is the change it makes to the residuals, in px.
-    const double new_cost = new_residuals.squaredNorm();
-    if (!(new_cost <= cost * (1.0 + 1e-12) + 1e-300)) return;
+    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) return;
     *rotation = new_rotation;
     *center = new_center;
     *model = new_model;
     const bool settled = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff() <= 1e-12;
-    cost = new_cost;
-    jacobian.swap(new_jacobian);
-    residuals.swap(new_residuals);
+    *normal = std::move(new_normal);
     if (settled) return;
   }
 }
@@ -524,14 +533,13 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   model.value = intrinsics;
   rotation.normalize();
   Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
-  Eigen::MatrixXd jacobian;
-  Eigen::VectorXd final_residuals;
+  NormalEquations normal_equations;
   if (options.refine && options.loss == LossType::kNone) {
-    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model, &jacobian,
-                      &final_residuals);
+    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model,
+                      &normal_equations);
   } else {
-    UserJacobian(points, pixels, rotation_matrix, center, model, num_params, &jacobian,
-                 &final_residuals);
+    ComputeNormalEquations(points, pixels, rotation_matrix, center, model, num_params,
+                           &normal_equations);
   }
 
   // Residuals and depths.
@@ -596,7 +604,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
-  const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+  const Eigen::MatrixXd& normal = normal_equations.jtj;
   const Eigen::VectorXd column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
   const Eigen::MatrixXd scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
