@@ -8,6 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   clang libclang-rt-dev llvm  # scripts/fuzz.sh: clang, libFuzzer runtime, llvm-symbolizer
+  python3-matplotlib  # scripts/plot_bench.py: the benchmark's plots (docs/bench/)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -111,7 +111,7 @@ Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& po
     const Eigen::RowVector4d x = points[i].homogeneous().transpose();
     const Eigen::Vector3d u = t_pixel * pixels[i].homogeneous();
     rows << x, Eigen::RowVector4d::Zero(), -u.x() * x, Eigen::RowVector4d::Zero(), x, -u.y() * x;
-    normal.noalias() += rows.transpose() * rows;
+    normal.noalias() += rows.transpose().lazyProduct(rows);  // far below GEMM size
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(normal);
   const Eigen::Matrix<double, 12, 1> p = eigen.eigenvectors().col(0);

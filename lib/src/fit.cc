@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include <ceres/ceres.h>
+#include <ceres/tiny_solver.h>
 #include <Eigen/Dense>
 
 #include "check.h"
@@ -133,19 +134,13 @@ class TraceCallback : public ceres::IterationCallback {
   TraceCallback(const std::vector<Eigen::Vector3d>& points,
                 const std::vector<Eigen::Vector2d>& pixels, const double* rotation,
                 const double* center, const double* intrinsics, Clock::time_point start,
-                bool plain_least_squares, std::vector<TraceEntry>* trace)
+                std::vector<TraceEntry>* trace)
       : points_(points), pixels_(pixels), rotation_(rotation), center_(center),
-        intrinsics_(intrinsics), start_(start), plain_least_squares_(plain_least_squares),
-        trace_(trace) {}
+        intrinsics_(intrinsics), start_(start), trace_(trace) {}
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     if (summary.iteration > 0 && !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
     const double n = static_cast<double>(points_.size());
-    if (plain_least_squares_) {
-      // Ceres' cost is half the sum of squared residuals.
-      trace_->push_back({summary.iteration, MicrosecondsSince(start_), std::sqrt(2.0 * summary.cost / n)});
-      return ceres::SOLVER_CONTINUE;
-    }
     // With a robust loss the cost is robustified: recompute the plain RMS.
     const Eigen::Map<const Eigen::Quaterniond> q(rotation_);
     const Eigen::Map<const Eigen::Vector3d> c(center_);
@@ -167,9 +162,156 @@ class TraceCallback : public ceres::IterationCallback {
   const double* center_;
   const double* intrinsics_;
   Clock::time_point start_;
-  bool plain_least_squares_;
   std::vector<TraceEntry>* trace_;
 };
+
+// All residuals for ceres::TinySolver, in the parameterization u = [omega (3), center (3), free
+// intrinsic slots] with R = exp(omega) R_start. At omega != 0, dp/domega = -[p]x J_l(omega), J_l
+// the left Jacobian of SO(3). Each evaluation with a Jacobian is an accepted iterate (TinySolver
+// evaluates candidates without one): it is recorded in the trace.
+class TinyReprojection {
+ public:
+  using Scalar = double;
+  enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = Eigen::Dynamic };
+
+  TinyReprojection(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<Eigen::Vector2d>& pixels, const Eigen::Matrix3d& rotation,
+                   const Model& model, int num_params, Clock::time_point start,
+                   std::vector<TraceEntry>* trace)
+      : points_(points), pixels_(pixels), start_rotation_(rotation), model_(model),
+        num_params_(num_params), start_(start), trace_(trace) {}
+
+  int NumResiduals() const { return 2 * static_cast<int>(points_.size()); }
+  int NumParameters() const { return num_params_; }
+
+  Eigen::VectorXd Pack(const Eigen::Vector3d& center) const {
+    Eigen::VectorXd u(num_params_);
+    u.head<3>().setZero();
+    u.segment<3>(3) = center;
+    int next = 6;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) u(next++) = model_.value[slot];
+    }
+    return u;
+  }
+
+  void Unpack(const Eigen::VectorXd& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
+              Model* model) const {
+    *rotation = Rotation(u.data()) * start_rotation_;
+    *center = u.segment<3>(3);
+    *model = model_;
+    int next = 6;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model->free[slot]) model->value[slot] = u(next++);
+    }
+  }
+
+  double StartSumOfSquares(const Eigen::VectorXd& u) const {
+    Eigen::VectorXd residuals(NumResiduals());
+    return Evaluate(u.data(), residuals.data(), nullptr) ? residuals.squaredNorm() : 0.0;
+  }
+
+  bool operator()(const double* u, double* residuals, double* jacobian) const {
+    if (!Evaluate(u, residuals, jacobian)) return false;
+    if (jacobian != nullptr) {
+      const double sum = Eigen::Map<const Eigen::VectorXd>(residuals, NumResiduals()).squaredNorm();
+      trace_->push_back({static_cast<int>(trace_->size()), MicrosecondsSince(start_),
+                         std::sqrt(sum / static_cast<double>(points_.size()))});
+    }
+    return true;
+  }
+
+ private:
+  static Eigen::Matrix3d Rotation(const double* omega) {
+    const Eigen::Vector3d w(omega[0], omega[1], omega[2]);
+    const double angle = w.norm();
+    return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                       : Eigen::Matrix3d::Identity();
+  }
+
+  static Eigen::Matrix3d Skew(const Eigen::Vector3d& e) {
+    Eigen::Matrix3d m;
+    m << 0.0, -e.z(), e.y(), e.z(), 0.0, -e.x(), -e.y(), e.x(), 0.0;
+    return m;
+  }
+
+  // J_l(w) = I + (1 - cos t)/t^2 [w]x + (t - sin t)/t^3 [w]x^2, t = |w| (series near 0).
+  static Eigen::Matrix3d LeftJacobian(const double* omega) {
+    const Eigen::Vector3d w(omega[0], omega[1], omega[2]);
+    const double t2 = w.squaredNorm();
+    const Eigen::Matrix3d k = Skew(w);
+    double a, b;
+    if (t2 < 1e-8) {
+      a = 0.5 - t2 / 24.0;
+      b = 1.0 / 6.0 - t2 / 120.0;
+    } else {
+      const double t = std::sqrt(t2);
+      a = (1.0 - std::cos(t)) / t2;
+      b = (t - std::sin(t)) / (t2 * t);
+    }
+    return Eigen::Matrix3d::Identity() + a * k + b * k * k;
+  }
+
+  bool Evaluate(const double* u, double* residuals, double* jacobian) const {
+    const Eigen::Matrix3d rotation = Rotation(u) * start_rotation_;
+    const Eigen::Quaterniond q(rotation);
+    const Eigen::Vector3d center(u[3], u[4], u[5]);
+    std::array<double, internal::kFitIntrinsicsSize> k = model_.value;
+    int free_slots[internal::kFitIntrinsicsSize];
+    int num_free = 0;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) {
+        k[slot] = u[6 + num_free];
+        free_slots[num_free++] = slot;
+      }
+    }
+    const int rows = NumResiduals();
+    const Eigen::Matrix3d left_jacobian = jacobian != nullptr ? LeftJacobian(u) : Eigen::Matrix3d();
+    Eigen::Matrix<double, 2, 7, Eigen::RowMajor> jk;
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
+    for (size_t i = 0; i < points_.size(); ++i) {
+      if (!internal::ProjectPointWithJacobian(q.coeffs().data(), center.data(), k.data(),
+                                              points_[i], pixels_[i], residuals + 2 * i, nullptr,
+                                              nullptr, jacobian ? jk.data() : nullptr,
+                                              jacobian ? jp.data() : nullptr)) {
+        return false;
+      }
+      if (jacobian == nullptr) continue;
+      // Column-major 2N x p: entry (row, col) at col * rows + row.
+      const Eigen::Vector3d p = rotation * (points_[i] - center);
+      const Eigen::Matrix<double, 2, 3> j_omega = -jp * Skew(p) * left_jacobian;
+      const Eigen::Matrix<double, 2, 3> j_center = -jp * rotation;
+      for (int r = 0; r < 2; ++r) {
+        const int row = 2 * static_cast<int>(i) + r;
+        for (int c = 0; c < 3; ++c) {
+          jacobian[c * rows + row] = j_omega(r, c);
+          jacobian[(3 + c) * rows + row] = j_center(r, c);
+        }
+        for (int f = 0; f < num_free; ++f) jacobian[(6 + f) * rows + row] = jk(r, free_slots[f]);
+      }
+    }
+    return true;
+  }
+
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& pixels_;
+  Eigen::Matrix3d start_rotation_;
+  Model model_;
+  int num_params_;
+  Clock::time_point start_;
+  std::vector<TraceEntry>* trace_;
+};
+
+std::string TinySolverStatusText(int status) {
+  using Solver = ceres::TinySolver<TinyReprojection>;
+  switch (status) {
+    case Solver::GRADIENT_TOO_SMALL: return "CONVERGENCE: gradient below tolerance";
+    case Solver::RELATIVE_STEP_SIZE_TOO_SMALL: return "CONVERGENCE: relative step below tolerance";
+    case Solver::COST_TOO_SMALL: return "CONVERGENCE: cost below threshold";
+    case Solver::COST_CHANGE_TOO_SMALL: return "CONVERGENCE: cost change below tolerance";
+    default: return "NO_CONVERGENCE: maximum number of iterations reached";
+  }
+}
 
 // The Gauss-Newton normal equations of all residuals in the user parameterization u = [omega
 // (3, rad, R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots]: at
@@ -212,8 +354,9 @@ bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
     j.col(2) = jp.col(1) * p.x() - jp.col(0) * p.y();
     j.block<2, 3>(0, 3) = -jp * rotation;
     for (int f = 0; f < num_free; ++f) j.col(6 + f) = jk.col(free_slots[f]);
-    jtj.noalias() += j.transpose() * j;
-    jtr.noalias() += j.transpose() * r;
+    // lazyProduct: a 13 x 2 by 2 x 13 product is far below GEMM's break-even size.
+    jtj.noalias() += j.transpose().lazyProduct(j);
+    jtr.noalias() += j.transpose().lazyProduct(r);
     cost += r.squaredNorm();
   }
   out->jtj = jtj.topLeftCorner(num_params, num_params);
@@ -234,6 +377,7 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   if (!ComputeNormalEquations(points, pixels, *rotation, *center, *model, num_params, normal)) {
     return;
   }
+  double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
     const Eigen::VectorXd scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
     const Eigen::VectorXd delta =
@@ -264,7 +408,11 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     *rotation = new_rotation;
     *center = new_center;
     *model = new_model;
-    const bool settled = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff() <= 1e-12;
+    // Settled when a step moves the residuals by under 1e-9 px (parameters then move by under
+    // 1e-9 of their pixel-noise sigma per px of noise), or stops shrinking (rounding floor).
+    const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
+    const bool settled = step_px <= 1e-9 || step_px > 0.5 * previous_step_px;
+    previous_step_px = step_px;
     *normal = std::move(new_normal);
     if (settled) return;
   }
@@ -475,40 +623,52 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     }
   }
 
-  // Refinement.
-  Eigen::Quaterniond rotation(start.rotation);
-  rotation.normalize();
+  // Refinement: without a loss, ceres::TinySolver (Ceres' dense Levenberg-Marquardt for small
+  // problems: no problem setup, one 2N x p Jacobian) on the chart R = exp(omega) R_start; with a
+  // robust loss, a ceres::Problem with one block per point, the rotation on
+  // EigenQuaternionManifold and fixed intrinsics held by a SubsetManifold.
+  FitResult result;
+  Eigen::Matrix3d rotation_matrix = start.rotation;
   Eigen::Vector3d center = start.center;
-  std::array<double, internal::kFitIntrinsicsSize> intrinsics = model.value;
-  ceres::Problem problem;
-  ceres::LossFunction* loss = nullptr;
-  if (options.loss == LossType::kHuber) loss = new ceres::HuberLoss(options.loss_scale_px);
-  if (options.loss == LossType::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale_px);
-  if (loss == nullptr) {
-    problem.AddResidualBlock(new internal::AllPointsReprojectionCost(points, pixels), nullptr,
-                             rotation.coeffs().data(), center.data(), intrinsics.data());
-  } else {
+  if (options.refine && options.loss == LossType::kNone) {
+    const TinyReprojection function(points, pixels, start.rotation, model, num_params,
+                                    start_time, &result.trace);
+    Eigen::VectorXd u = function.Pack(start.center);
+    ceres::TinySolver<TinyReprojection> solver;
+    solver.options.max_num_iterations = std::max(1, options.max_iterations + 1);
+    solver.options.gradient_tolerance = options.gradient_tolerance;
+    solver.options.parameter_tolerance = options.parameter_tolerance;
+    // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
+    solver.options.function_tolerance =
+        options.function_tolerance * std::max(function.StartSumOfSquares(u), 1e-300);
+    const auto& summary = solver.Solve(function, &u);
+    function.Unpack(u, &rotation_matrix, &center, &model);
+    result.iterations = summary.iterations;
+    result.termination = TinySolverStatusText(summary.status);
+  } else if (options.refine) {
+    Eigen::Quaterniond rotation(start.rotation);
+    rotation.normalize();
+    std::array<double, internal::kFitIntrinsicsSize> intrinsics = model.value;
+    ceres::Problem problem;
+    ceres::LossFunction* loss = options.loss == LossType::kHuber
+                                    ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale_px))
+                                    : new ceres::CauchyLoss(options.loss_scale_px);
     // A robust loss weighs each point's squared distance, so each point has its own block.
     for (int i = 0; i < n; ++i) {
       problem.AddResidualBlock(new internal::PointReprojectionCost(points[i], pixels[i]), loss,
                                rotation.coeffs().data(), center.data(), intrinsics.data());
     }
-  }
-  problem.SetManifold(rotation.coeffs().data(), new ceres::EigenQuaternionManifold);
-  std::vector<int> constant_slots;
-  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-    if (!model.free[slot]) constant_slots.push_back(slot);
-  }
-  if (constant_slots.size() == internal::kFitIntrinsicsSize) {
-    problem.SetParameterBlockConstant(intrinsics.data());
-  } else if (!constant_slots.empty()) {
-    problem.SetManifold(intrinsics.data(),
-                        new ceres::SubsetManifold(internal::kFitIntrinsicsSize, constant_slots));
-  }
-
-  FitResult result;
-  ceres::Solver::Summary summary;
-  if (options.refine) {
+    problem.SetManifold(rotation.coeffs().data(), new ceres::EigenQuaternionManifold);
+    std::vector<int> constant_slots;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (!model.free[slot]) constant_slots.push_back(slot);
+    }
+    if (constant_slots.size() == internal::kFitIntrinsicsSize) {
+      problem.SetParameterBlockConstant(intrinsics.data());
+    } else if (!constant_slots.empty()) {
+      problem.SetManifold(intrinsics.data(),
+                          new ceres::SubsetManifold(internal::kFitIntrinsicsSize, constant_slots));
+    }
     ceres::Solver::Options solver_options;
     // p <= 13 unknowns: the normal equations (O(N p^2)) beat QR of the 2N x p Jacobian.
     solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -518,21 +678,26 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     solver_options.parameter_tolerance = options.parameter_tolerance;
     solver_options.logging_type = ceres::SILENT;
     solver_options.num_threads = 1;
-    solver_options.update_state_every_iteration = loss != nullptr;
+    solver_options.update_state_every_iteration = true;
     TraceCallback trace_callback(points, pixels, rotation.coeffs().data(), center.data(),
-                                 intrinsics.data(), start_time, loss == nullptr, &result.trace);
+                                 intrinsics.data(), start_time, &result.trace);
     solver_options.callbacks.push_back(&trace_callback);
+    ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     if (summary.termination_type == ceres::FAILURE) {
       throw SceneError(SceneError::Reason::kDegenerate,
                        "the refinement failed: " + summary.message +
                            ": check the correspondences");
     }
-
+    model.value = intrinsics;
+    rotation.normalize();
+    rotation_matrix = rotation.toRotationMatrix();
+    result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
+                         ": " + summary.message;
+  } else {
+    result.termination = "not refined (closed-form start only)";
   }
-  model.value = intrinsics;
-  rotation.normalize();
-  Eigen::Matrix3d rotation_matrix = rotation.toRotationMatrix();
   NormalEquations normal_equations;
   if (options.refine && options.loss == LossType::kNone) {
     PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model,
@@ -577,13 +742,6 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.max_px = *std::max_element(norms.begin(), norms.end());
   result.start_method = start_method;
   result.planar = planar;
-  if (options.refine) {
-    result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-    result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
-                         ": " + summary.message;
-  } else {
-    result.termination = "not refined (closed-form start only)";
-  }
 
   // Depth range and views.
   const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());

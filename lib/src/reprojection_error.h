@@ -144,37 +144,6 @@ class PointReprojectionCost : public ceres::SizedCostFunction<2, 4, 3, kFitIntri
   Eigen::Vector2d observed_;
 };
 
-// All points in one block (2N residuals): without a robust loss, one block keeps Ceres' per-block
-// bookkeeping out of the inner loop. The points and pixels are referenced, not copied.
-class AllPointsReprojectionCost : public ceres::CostFunction {
- public:
-  AllPointsReprojectionCost(const std::vector<Eigen::Vector3d>& points,
-                            const std::vector<Eigen::Vector2d>& observed)
-      : points_(points), observed_(observed) {
-    set_num_residuals(2 * static_cast<int>(points.size()));
-    mutable_parameter_block_sizes()->assign({4, 3, kFitIntrinsicsSize});
-  }
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const size_t n = points_.size();
-    for (size_t i = 0; i < n; ++i) {
-      // Ceres' Jacobian blocks are row-major (residuals x block size).
-      double* jq = jacobians && jacobians[0] ? jacobians[0] + 2 * i * 4 : nullptr;
-      double* jc = jacobians && jacobians[1] ? jacobians[1] + 2 * i * 3 : nullptr;
-      double* jk = jacobians && jacobians[2] ? jacobians[2] + 2 * i * kFitIntrinsicsSize : nullptr;
-      if (!ProjectPointWithJacobian(parameters[0], parameters[1], parameters[2], points_[i],
-                                    observed_[i], residuals + 2 * i, jq, jc, jk)) {
-        return false;
-      }
-    }
-    return true;
-  }
-
- private:
-  const std::vector<Eigen::Vector3d>& points_;
-  const std::vector<Eigen::Vector2d>& observed_;
-};
-
 }  // namespace internal
 }  // namespace camproj
 
