@@ -417,7 +417,12 @@ TEST_F(RefusalTest, BadOptionsAreInvalidArguments) {
 }
 
 TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
-  const FitResult fit = FitCamera(scene_.points_in_world, scene_.observed_pixels, camera_.size, {});
+  std::mt19937_64 rng(9);
+  SceneOptions options;
+  options.num_points = 20;
+  options.pixel_noise = 1.0;
+  const Scene noisy = MakeScene(rng, camera_, options);
+  const FitResult fit = FitCamera(noisy.points_in_world, noisy.observed_pixels, camera_.size, {});
   ASSERT_GE(fit.trace.size(), 2u);
   EXPECT_EQ(fit.trace.front().iteration, 0);
   EXPECT_LE(fit.trace.back().rms_px, fit.trace.front().rms_px);

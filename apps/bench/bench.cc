@@ -542,7 +542,8 @@ std::string FormatTime(double us) {
 }
 
 std::string FormatPercent(double fraction) {
-  return std::isnan(fraction) ? "-" : Format(100.0 * fraction, "%.0f") + " %";
+  if (std::isnan(fraction)) return "-";
+  return fraction == 0.0 ? "0 %" : Format(100.0 * fraction, "%.1f") + " %";
 }
 
 nlohmann::json JsonNumber(double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); }
