@@ -702,6 +702,9 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   if (options.refine && options.loss == LossType::kNone) {
     PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model,
                       &normal_equations);
+    // The polish's result closes the trace, so it ends at the reported RMS.
+    result.trace.push_back({static_cast<int>(result.trace.size()), MicrosecondsSince(start_time),
+                            std::sqrt(normal_equations.cost / n)});
   } else {
     ComputeNormalEquations(points, pixels, rotation_matrix, center, model, num_params,
                            &normal_equations);

@@ -114,7 +114,9 @@ class SceneError : public std::runtime_error {
   Reason reason_;
 };
 
-// One LM iteration: elapsed wall time since FitCamera started, and the RMS reprojection error.
+// One accepted LM iterate (entry 0 is the closed-form start; without a robust loss the last entry
+// is the Gauss-Newton polish): elapsed wall time since FitCamera started, and the RMS
+// reprojection error there.
 struct TraceEntry {
   int iteration = 0;
   double elapsed_us = 0.0;
