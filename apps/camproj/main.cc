@@ -4,7 +4,6 @@
 #include <iostream>
 #include <vector>
 
-#include "camproj/errors.h"
 #include "camproj/fit.h"
 #include "cli.h"
 
@@ -43,13 +42,9 @@ int main(int argc, char** argv) {
   } catch (const camproj::SceneError& e) {
     std::cerr << "camproj: cannot fit: " << e.what() << '\n';
     return kExitScene;
-  } catch (const camproj::InputError& e) {
-    std::cerr << "camproj: error: " << e.what() << '\n';
-    return kExitBadInput;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "camproj: error: " << e.what() << '\n';
-    return kExitBadInput;
   } catch (const std::exception& e) {
+    // InputError (a file), std::invalid_argument (a value the library refused), or anything
+    // else a library call threw: bad input, never an abort.
     std::cerr << "camproj: error: " << e.what() << '\n';
     return kExitBadInput;
   }
