@@ -78,6 +78,14 @@ case $case in
     cmp -s "$data/projector/truth.json" "$work/cam.json" || fail "the old camera file was changed"
     [[ $(ls "$work" | grep -c tmp) -eq 0 ]] || fail "a temporary file was left behind"
     ;;
+  fit_ransac_lists_misclicked_points)
+    # Points 3 and 7 of the synthetic scene moved by 200 px: RANSAC names them.
+    awk -F, 'BEGIN { OFS = "," } /^[-0-9]/ { row++; if (row == 3 || row == 7) $4 += 200 } { print }' \
+      "$data/synthetic/points.csv" >"$work/clicked.csv"
+    expect_exit 0 "$bin" fit "$work/clicked.csv" --image-size 1280x800 --ransac 4 -o "$work/cam.json"
+    expect_in out "outliers (RANSAC, left out of the fit): 2: 3 7"
+    grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"
+    ;;
   usage_errors)
     expect_exit 1 "$bin"
     expect_exit 1 "$bin" fit "$data/projector/points.csv"

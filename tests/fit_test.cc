@@ -492,5 +492,62 @@ TEST(FitTest, ReportsTheFocalDistanceCorrelationOfANarrowView) {
   EXPECT_GT(fovy_sigma, 0.0);
 }
 
+struct RansacCase {
+  const char* name;
+  double outlier_fraction;
+  bool planar;
+  bool known_intrinsics;
+};
+
+class RansacTest : public ::testing::TestWithParam<RansacCase> {};
+
+// Outliers are pixels anywhere in the image. With 0.5 px noise an inlier lies beyond the 4 px
+// threshold with probability exp(-32) and an outlier within it with probability ~1e-4 (a 4 px
+// disc in a 1280 x 800 image), so the outlier set must come back exactly; the camera then comes
+// from the inliers alone and must match the truth to a few sigma of 0.5 px noise on 40+ points.
+TEST_P(RansacTest, FindsTheOutliersAndTheCamera) {
+  const RansacCase& c = GetParam();
+  std::mt19937_64 rng(std::hash<std::string>{}(c.name));
+  for (int trial = 0; trial < 10; ++trial) {
+    RandomCamera camera = ProjectorLikeCamera(rng);
+    if (c.planar) camera.intrinsics.fy = camera.intrinsics.fx;
+    SceneOptions scene_options;
+    scene_options.num_points = 80;
+    scene_options.pixel_noise = 0.5;
+    scene_options.planar = c.planar;
+    Scene scene = MakeScene(rng, camera, scene_options);
+    std::vector<int> truth_outliers;
+    for (int i = 0; i < scene_options.num_points; ++i) {
+      if (testing::Uniform(rng, 0, 1) < c.outlier_fraction) {
+        scene.observed_pixels[i] = testing::RandomPixelInImage(rng, camera.size);
+        if ((scene.observed_pixels[i] - scene.true_pixels[i]).norm() > 8.0) truth_outliers.push_back(i);
+        else scene.observed_pixels[i] = scene.true_pixels[i];
+      }
+    }
+    FitOptions options;
+    options.ransac = true;
+    if (c.known_intrinsics) options.known_intrinsics = camera.intrinsics;
+    if (c.planar) {
+      options.aspect = ParameterMode::Default();
+      options.principal_point = ParameterMode::Fixed(camera.intrinsics.cx, camera.intrinsics.cy);
+    }
+    const FitResult fit = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+    EXPECT_EQ(fit.outliers, truth_outliers) << c.name << " trial " << trial;
+    EXPECT_LT(std::abs(fit.camera.intrinsics.fx / camera.intrinsics.fx - 1.0), 0.02) << c.name;
+    EXPECT_LT(RotationAngle(fit.camera.cam_from_world.rotation, camera.cam_from_world.rotation), 0.01)
+        << c.name;
+    EXPECT_LT(fit.rms_px, 1.0) << c.name;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    OutlierFractions, RansacTest,
+    ::testing::Values(RansacCase{"Outliers10", 0.1, false, false},
+                      RansacCase{"Outliers30", 0.3, false, false},
+                      RansacCase{"Outliers50", 0.5, false, false},
+                      RansacCase{"Planar30", 0.3, true, false},
+                      RansacCase{"KnownIntrinsics50", 0.5, false, true}),
+    [](const ::testing::TestParamInfo<RansacCase>& info) { return info.param.name; });
+
 }  // namespace
 }  // namespace camproj

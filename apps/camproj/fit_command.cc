@@ -33,6 +33,7 @@ struct FitArgs {
   std::string intrinsics_path;
   std::string pixel_origin = "center";
   std::string loss = "none";
+  double ransac_px = 0.0;
   double sigma = 0.0;
   double z_near = 0.0;
   double z_far = 0.0;
@@ -95,6 +96,10 @@ FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
     options.loss_scale_px =
         colon == std::string::npos ? 1.0 : ParseNumbers(args.loss.substr(colon + 1), 1, "--loss scale")[0];
   }
+  if (args.ransac_px > 0.0) {
+    options.ransac = true;
+    options.ransac_threshold_px = args.ransac_px;
+  }
   if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
@@ -147,6 +152,9 @@ Command AddFitCommand(CLI::App& root) {
                   "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
                   "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
   app->add_option("--loss", args->loss, "none, huber:SCALE or cauchy:SCALE (px)");
+  app->add_option("--ransac", args->ransac_px,
+                  "find mis-clicked points by RANSAC: inlier threshold in px (e.g. 4); they are "
+                  "left out and listed")->check(CLI::PositiveNumber);
   app->add_option("--sigma", args->sigma, "pixel noise sigma (px) for the uncertainties; default: "
                                           "estimated from the residuals")->check(CLI::PositiveNumber);
   app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")

@@ -231,6 +231,7 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["median_px"] = fit->median_px;
     record["max_px"] = fit->max_px;
     record["num_points"] = fit->num_points;
+    if (!fit->outliers.empty()) record["outliers"] = fit->outliers;
     record["start"] = fit->start;
     record["free"] = fit->free;
     record["fixed"] = json::array();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <random>
 
 #include <ceres/ceres.h>
 #include <ceres/tiny_solver.h>
@@ -115,6 +116,125 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
   set(5, options.k1, 0.0, options.k1.value, "default: no distortion");
   set(6, options.k2, 0.0, options.k2.value, "default: no distortion");
   return model;
+}
+
+// The model with its free slots set from a closed-form K, the fixed ones kept: DLT's K projected
+// onto the model (square pixels: the geometric mean of fx, fy).
+Model ProjectOntoModel(const Model& model, const Intrinsics& k0) {
+  Model projected = model;
+  if (projected.free[0]) {
+    projected.value[0] = projected.free[1] ? k0.fx : std::sqrt(k0.fx * k0.fy / projected.value[1]);
+  }
+  if (projected.free[1]) projected.value[1] = k0.fy / projected.value[0];
+  if (projected.free[2]) projected.value[2] = k0.cx;
+  if (projected.free[3]) projected.value[3] = k0.cy;
+  if (projected.free[4]) projected.value[4] = k0.skew;
+  return projected;
+}
+
+// Indices of the points within `threshold` px of the camera (rotation, center, model).
+std::vector<int> InliersOf(const std::vector<Eigen::Vector3d>& points,
+                           const std::vector<Eigen::Vector2d>& pixels,
+                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                           const Model& model, double threshold) {
+  std::vector<int> inliers;
+  const double threshold2 = threshold * threshold;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p = rotation * (points[i] - center);
+    if (!(p.z() > 0.0)) continue;
+    double pixel[2];
+    internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
+    if ((Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i]).squaredNorm() <= threshold2) {
+      inliers.push_back(static_cast<int>(i));
+    }
+  }
+  return inliers;
+}
+
+// A closed-form camera from the points `subset`: SQPnP for known intrinsics, the constrained
+// homography for a plane, the DLT otherwise. False where the subset is degenerate.
+bool SolveSubset(const std::vector<Eigen::Vector3d>& points,
+                 const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& subset,
+                 const Model& model, bool known, bool planar, const Eigen::Matrix3d& plane_basis,
+                 internal::StartCamera* camera, Model* fitted_model) {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Vector2d> u;
+  for (const int i : subset) {
+    x.push_back(points[i]);
+    u.push_back(pixels[i]);
+  }
+  const Intrinsics guess = model.ToIntrinsics();
+  bool ok = false;
+  if (known) {
+    ok = internal::PnpStart(x, u, guess, camera);
+  } else if (planar) {
+    ok = internal::HomographyStart(x, u, plane_basis, guess, model.free[0], model.free[1], camera);
+  } else {
+    try {
+      *camera = internal::DltStart(x, u);
+      ok = true;
+    } catch (const SceneError&) {
+      ok = false;
+    }
+  }
+  if (!ok || !camera->rotation.allFinite() || !camera->center.allFinite()) return false;
+  *fitted_model = known ? model : ProjectOntoModel(model, camera->intrinsics);
+  return std::all_of(fitted_model->value.begin(), fitted_model->value.end(),
+                     [](double v) { return std::isfinite(v); }) &&
+         fitted_model->value[0] > 0.0 && fitted_model->value[1] > 0.0;
+}
+
+// RANSAC on minimal closed-form samples (4 points for known intrinsics or a plane, 6 for the
+// DLT), with a local optimization (the closed form on all inliers) whenever the best consensus
+// grows, and the adaptive stopping rule k = log(1 - confidence) / log(1 - w^s).
+std::vector<int> RansacInliers(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<Eigen::Vector2d>& pixels, const Model& model,
+                               bool known, bool planar, const Eigen::Matrix3d& plane_basis,
+                               const FitOptions& options) {
+  const int n = static_cast<int>(points.size());
+  const int sample_size = known || planar ? 4 : 6;
+  std::mt19937_64 rng(options.ransac_seed);
+  std::vector<int> best;
+  long iterations_needed = options.ransac_max_iterations;
+  std::vector<int> sample(sample_size);
+  for (long iteration = 0; iteration < iterations_needed; ++iteration) {
+    for (int j = 0; j < sample_size; ++j) {
+      int candidate = 0;
+      do {
+        candidate = static_cast<int>(rng() % static_cast<uint64_t>(n));
+      } while (std::find(sample.begin(), sample.begin() + j, candidate) != sample.begin() + j);
+      sample[j] = candidate;
+    }
+    internal::StartCamera camera;
+    Model fitted;
+    if (!SolveSubset(points, pixels, sample, model, known, planar, plane_basis, &camera, &fitted)) {
+      continue;
+    }
+    std::vector<int> inliers =
+        InliersOf(points, pixels, camera.rotation, camera.center, fitted, options.ransac_threshold_px);
+    if (inliers.size() <= best.size()) continue;
+    // Local optimization: the closed form on the consensus, repeated while it grows.
+    for (int round = 0; round < 3 && static_cast<int>(inliers.size()) > sample_size; ++round) {
+      internal::StartCamera refit;
+      Model refit_model;
+      if (!SolveSubset(points, pixels, inliers, model, known, planar, plane_basis, &refit,
+                       &refit_model)) {
+        break;
+      }
+      std::vector<int> grown = InliersOf(points, pixels, refit.rotation, refit.center,
+                                         refit_model, options.ransac_threshold_px);
+      if (grown.size() <= inliers.size()) break;
+      inliers.swap(grown);
+    }
+    best.swap(inliers);
+    const double w = static_cast<double>(best.size()) / n;
+    const double all_inliers = std::pow(w, sample_size);
+    if (all_inliers >= 1.0) break;
+    const double needed = std::log(1.0 - options.ransac_confidence) / std::log(1.0 - all_inliers);
+    iterations_needed = std::min<long>(options.ransac_max_iterations,
+                                       static_cast<long>(std::ceil(needed)));
+  }
+  return best;
 }
 
 std::string FreeLinearNames(const Model& model) {
@@ -450,6 +570,11 @@ void FitOptions::Check() const {
   Require(aspect.kind != ParameterMode::Kind::kFixed || aspect.value > 0.0,
           "fixed aspect (fy/fx) must be positive, got ", aspect.value);
   if (known_intrinsics) known_intrinsics->Check();
+  Require(std::isfinite(ransac_threshold_px) && ransac_threshold_px > 0.0,
+          "RANSAC threshold must be positive (px), got ", ransac_threshold_px);
+  Require(ransac_confidence > 0.0 && ransac_confidence < 1.0,
+          "RANSAC confidence must be in (0, 1), got ", ransac_confidence);
+  Require(ransac_max_iterations >= 1, "RANSAC iterations must be >= 1, got ", ransac_max_iterations);
   Require(std::isfinite(loss_scale_px) && loss_scale_px > 0.0,
           "loss scale must be positive (px), got ", loss_scale_px);
   Require(!pixel_sigma || (std::isfinite(*pixel_sigma) && *pixel_sigma > 0.0),
@@ -529,6 +654,48 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
             "aspect (square pixels), or add points off the plane");
   }
 
+  const Eigen::Matrix3d plane_basis =
+      shape.matrixV().determinant() > 0
+          ? Eigen::Matrix3d(shape.matrixV())
+          : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal());
+
+  if (options.ransac) {
+    // Find the consensus, fit it without RANSAC, then report every point against that camera.
+    const std::vector<int> inliers = RansacInliers(points, pixels, start_model, known,
+                                                   planar_start, plane_basis, options);
+    const int minimum = std::max(known || planar_start ? 4 : 6, (num_params + 1) / 2);
+    if (static_cast<int>(inliers.size()) < minimum) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       internal::Concat("RANSAC found no camera that ", minimum,
+                                        " or more points agree on within ",
+                                        options.ransac_threshold_px,
+                                        " px: check the correspondences or raise the threshold"));
+    }
+    FitOptions inner = options;
+    inner.ransac = false;
+    std::vector<Eigen::Vector3d> inlier_points;
+    std::vector<Eigen::Vector2d> inlier_pixels;
+    for (const int i : inliers) {
+      inlier_points.push_back(points_in_world[i]);
+      inlier_pixels.push_back(observed_pixels[i]);
+    }
+    FitResult result = FitCamera(inlier_points, inlier_pixels, image_size, inner);
+    result.residuals_px.assign(n, Eigen::Vector2d::Constant(kInfinity));
+    std::vector<double> inlier_norms;
+    for (int i = 0; i < n; ++i) {
+      const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(result.camera, points_in_world[i]);
+      if (predicted) result.residuals_px[i] = *predicted - pixels[i];
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!(result.residuals_px[i].norm() <= options.ransac_threshold_px)) {
+        result.outliers.push_back(i);
+      }
+    }
+    result.start_method = "ransac+" + result.start_method;
+    result.time_ms = MicrosecondsSince(start_time) / 1000.0;
+    return result;
+  }
+
   // Closed-form start.
   internal::StartCamera start;
   std::string start_method;
@@ -548,10 +715,8 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     }
     Intrinsics plane_guess = guess;
     const bool focal_free = start_model.free[0];
-    if (internal::HomographyStart(points, pixels, shape.matrixV().determinant() > 0
-                                                      ? Eigen::Matrix3d(shape.matrixV())
-                                                      : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal()),
-                                  plane_guess, focal_free, start_model.free[1], &start)) {
+    if (internal::HomographyStart(points, pixels, plane_basis, plane_guess, focal_free,
+                                  start_model.free[1], &start)) {
       start_method = "homography";
     } else if (focal_free && internal::FocalSweepStart(points, pixels, guess, start_model.value[1],
                                                        image_size.width, &start)) {
@@ -586,15 +751,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   // Start values of the free slots from the closed form, fixed ones as given. DLT's K is
   // projected onto the model (square pixels: geometric mean of fx, fy).
   const Intrinsics& k0 = start.intrinsics;
-  if (!known) {
-    if (model.free[0]) {
-      model.value[0] = model.free[1] ? k0.fx : std::sqrt(k0.fx * k0.fy / model.value[1]);
-    }
-    if (model.free[1]) model.value[1] = k0.fy / model.value[0];
-    if (model.free[2]) model.value[2] = k0.cx;
-    if (model.free[3]) model.value[3] = k0.cy;
-    if (model.free[4]) model.value[4] = k0.skew;
-  }
+  if (!known) model = ProjectOntoModel(start_model, k0);
   const Intrinsics projected = model.ToIntrinsics();
   const double projection_change =
       std::max({std::abs(projected.fx - k0.fx), std::abs(projected.fy - k0.fy),

@@ -32,7 +32,7 @@ FitRecord FitRecordOf(const FitResult& fit) {
   record.rms_px = fit.rms_px;
   record.median_px = fit.median_px;
   record.max_px = fit.max_px;
-  record.num_points = static_cast<int>(fit.residuals_px.size());
+  record.num_points = static_cast<int>(fit.residuals_px.size() - fit.outliers.size());
   record.start = fit.start_method;
   record.free = fit.free_parameters;
   for (const FixedParameter& p : fit.fixed_parameters) {
@@ -40,6 +40,7 @@ FitRecord FitRecordOf(const FitResult& fit) {
     if (p.why.rfind("default", 0) == 0) record.left_out.emplace_back(p.name, p.why);
   }
   for (const ParameterSigma& s : fit.sigmas) record.sigma.emplace_back(s.name, s.sigma);
+  record.outliers = fit.outliers;
   record.pixel_sigma = fit.pixel_sigma;
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
@@ -101,13 +102,23 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
       << " (points' depth range + 10 %)\n";
   out << "residuals: rms " << Format("%.3f", fit.rms_px) << " px, median "
       << Format("%.3f", fit.median_px) << " px, max " << Format("%.3f", fit.max_px) << " px\n";
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
+  // The worst among the points used (outliers are listed above).
+  std::vector<int> order;
+  for (int i = 0; i < n; ++i) {
+    if (!std::binary_search(fit.outliers.begin(), fit.outliers.end(), i)) order.push_back(i);
+  }
   std::sort(order.begin(), order.end(), [&](int a, int b) {
     return fit.residuals_px[a].norm() > fit.residuals_px[b].norm();
   });
+  if (!fit.outliers.empty()) {
+    out << "outliers (RANSAC, left out of the fit): " << fit.outliers.size() << ":";
+    for (const int i : fit.outliers) {
+      out << " " << (i < static_cast<int>(ids.size()) ? ids[i] : std::to_string(i + 1));
+    }
+    out << "\n";
+  }
   out << "worst points:";
-  for (int i = 0; i < std::min(worst, n); ++i) {
+  for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {
     const int index = order[i];
     out << " " << (index < static_cast<int>(ids.size()) ? ids[index] : std::to_string(index + 1))
         << " (" << Format("%.2f", fit.residuals_px[index].norm()) << " px)";

@@ -26,7 +26,8 @@ struct FitRecord {
   double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;
-  int num_points = 0;
+  int num_points = 0;       // points used (without RANSAC's outliers)
+  std::vector<int> outliers;  // 0-based indices of points RANSAC left out
   std::string start;        // closed-form start: dlt | homography | pnp | pnp-focal-sweep
   std::vector<std::string> free;                                 // estimated parameters
   std::vector<std::pair<std::string, std::string>> fixed;        // name, "value (why)"

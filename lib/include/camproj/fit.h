@@ -9,6 +9,7 @@
 #ifndef CAMPROJ_FIT_H_
 #define CAMPROJ_FIT_H_
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,16 @@ struct FitOptions {
   // Convention of the observed pixels, of fixed principal-point values and of known_intrinsics;
   // the result is always in kCenter (Camera's convention) with residuals in pixels.
   PixelOrigin pixel_origin = PixelOrigin::kCenter;
+
+  // Outliers (mis-clicked points): RANSAC on minimal closed-form samples (6-point DLT; 4 points
+  // for known intrinsics (SQPnP) or a plane (homography)), with local optimization, then the
+  // fit on the consensus. Points farther than ransac_threshold_px from the result are listed in
+  // FitResult::outliers; the residual statistics are over the consensus.
+  bool ransac = false;
+  double ransac_threshold_px = 4.0;
+  double ransac_confidence = 0.9999;
+  long ransac_max_iterations = 20000;
+  uint64_t ransac_seed = 1;
 
   LossType loss = LossType::kNone;
   double loss_scale_px = 1.0;  // Huber / Cauchy scale, px, > 0
@@ -149,8 +160,10 @@ struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
 
-  // Per point: predicted - observed, px, in input order.
+  // Per point: predicted - observed, px, in input order (infinite for a point behind the camera,
+  // possible only among RANSAC's outliers).
   std::vector<Eigen::Vector2d> residuals_px;
+  std::vector<int> outliers;  // with FitOptions::ransac: indices of the points it left out
   double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;
