@@ -1,8 +1,11 @@
 // camproj export: a camera file in another tool's terms.
 #include <iostream>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include "camproj/camera_file.h"
+#include "camproj/depth_precision.h"
 #include "camproj/export.h"
 #include "cli.h"
 
@@ -20,6 +23,7 @@ struct ExportArgs {
   double z_far = 0.0;
   bool row_major = false;
   std::string pixel_origin = "center";
+  bool quiet = false;
 };
 
 }  // namespace
@@ -50,6 +54,8 @@ Command AddExportCommand(CLI::App& root) {
   app->add_flag("--row-major", args->row_major, "gl: print rows instead of column-major order");
   app->add_option("--pixel-origin", args->pixel_origin, "json: convention of cx, cy written")
       ->check(CLI::IsMember({"center", "corner"}));
+  app->add_flag("--quiet", args->quiet,
+                "gl, glm, three: no depth-precision notes on stderr (warnings still printed)");
   return {app, [args]() {
             Camera camera = ReadCameraFile(args->camera_path);
             if (args->z_near > 0.0) camera.z_near = args->z_near;
@@ -66,7 +72,22 @@ Command AddExportCommand(CLI::App& root) {
             options.depth.reversed_z = args->reversed_z;
             options.row_major = args->row_major;
             options.pixel_origin = PixelOriginFromString(args->pixel_origin);
-            std::cout << ExportCamera(camera, ExportFormatFromString(args->to), options);
+            const ExportFormat format = ExportFormatFromString(args->to);
+            // Depth-precision advice (docs/exports.md) on stderr, so stdout stays the export.
+            if (format == ExportFormat::kGl || format == ExportFormat::kGlm ||
+                format == ExportFormat::kThree) {
+              const DepthAdvice advice = AdviseDepth(camera.z_near, camera.z_far, options.depth);
+              for (const std::string& warning : advice.warnings) {
+                std::cerr << "camproj: warning: " << warning << '\n';
+              }
+              if (!args->quiet) {
+                std::istringstream table(advice.table + advice.advice);
+                for (std::string line; std::getline(table, line);) {
+                  std::cerr << "camproj: note: " << line << '\n';
+                }
+              }
+            }
+            std::cout << ExportCamera(camera, format, options);
             return kExitOk;
           }};
 }
