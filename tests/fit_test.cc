@@ -232,6 +232,8 @@ TEST_P(NoisyFitTest, ResidualsAndReportedSigmasMatchTheirDistributions) {
       << "mean RMS^2 " << mean_rms2 << " expected " << expected_rms2;
   const double mean_nees = sum_nees / c.trials;
   EXPECT_NEAR(mean_nees / p, 1.0, 0.10) << "mean NEES " << mean_nees << " for p = " << p;
+  RecordProperty("rms2_ratio", std::to_string(mean_rms2 / expected_rms2));
+  RecordProperty("nees_ratio", std::to_string(mean_nees / p));
 }
 
 INSTANTIATE_TEST_SUITE_P(SigmaOnePixel, NoisyFitTest,
