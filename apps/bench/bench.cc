@@ -86,8 +86,8 @@ const char* kUsage =
     "  --mapamok-literal-focal  start the 80-degree OpenCV method at mapamok's literal\n"
     "                           f = width * 80 * pi / 180 instead of the 80-degree field of view\n"
     "\n"
-    "Exit codes: 0 ok; 1 usage; 2 error; 3 a method failed on noise-free scenes (the results are\n"
-    "still written).\n"
+    "Exit codes: 0 ok; 1 usage; 2 error; 3 a camproj method failed on a noise-free scene (the\n"
+    "results are still written).\n"
     "\n"
     "Example:\n"
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
@@ -806,8 +806,9 @@ void WriteTable(const std::string& path, const std::vector<Row>& rows,
   bool any_error = false;
   for (const Row& r : rows) any_error = any_error || !r.errors.empty();
   if (any_error) {
-    out << "## Refusals and exceptions\n\n| N | σ | object | camera | method | count | message "
-           "(first 100 characters) |\n|---:|---:|---|---|---|---:|---|\n";
+    out << "## Refusals, exceptions and invalid answers\n\nNumbers in the messages are replaced "
+           "by '#'.\n\n| N | σ | object | camera | method | count | message (first 100 "
+           "characters) |\n|---:|---:|---|---|---|---:|---|\n";
     for (const Row& r : rows) {
       for (const auto& [message, count] : r.errors) {
         std::string text = message;
@@ -961,11 +962,13 @@ int Main(const BenchOptions& options) {
   }
   std::cerr << "bench: " << rows.size() << " rows in " << Format(total_seconds, "%.1f")
             << " s -> " << options.out_dir << "/{results.csv,results.json,table.md}\n";
-  // Self-check (what makes --quick a smoke test): on noise-free pixels every method must answer
-  // every scene at the truth.
+  // Self-check (what makes --quick a smoke test): on noise-free pixels camproj must answer every
+  // scene at the truth. OpenCV's failures are results, not errors (calibrateCamera from the 80
+  // degree guess can settle in a local minimum even without noise).
   int broken = 0;
   for (const Row& r : rows) {
-    if (r.cell.sigma == 0.0 && r.refused + r.outliers > 0) {
+    const bool ours = std::string(r.method->name).rfind("ours-", 0) == 0;
+    if (ours && r.cell.sigma == 0.0 && r.refused + r.outliers > 0) {
       std::cerr << "bench: check failed: " << r.method->name << " failed " << r.refused + r.outliers
                 << " of " << r.scenes << " noise-free scenes (N = " << r.cell.n << ", "
                 << Name(r.cell.object) << ", " << Name(r.cell.lens) << ")\n";
