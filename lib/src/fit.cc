@@ -39,6 +39,9 @@ constexpr double kSingularRcond = 1e-12;
 // Re-solve the DLT's pose by PnP when projecting its K onto the model moves an intrinsic by more
 // than this fraction of the focal length (below it, LM corrects the pose in an iteration or two).
 constexpr double kPoseResolveChange = 0.02;
+// Below this many points a DLT start with the principal point free gets a second start from
+// the image centre (the DLT's principal point is poorly determined there).
+constexpr int kSecondStartBelowPoints = 20;
 
 using Clock = std::chrono::steady_clock;
 
@@ -549,6 +552,48 @@ double Median(std::vector<double> values) {
   return median;
 }
 
+// One least-squares refinement: TinySolver's LM, then the Gauss-Newton polish, with its trace.
+struct LeastSquaresOutcome {
+  bool ok = false;
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d center;
+  Model model;
+  NormalEquations normal;
+  int iterations = 0;
+  std::string termination;
+  std::vector<TraceEntry> trace;
+};
+
+LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<Eigen::Vector2d>& pixels,
+                                       const Eigen::Matrix3d& start_rotation,
+                                       const Eigen::Vector3d& start_center, const Model& model,
+                                       int num_params, const FitOptions& options,
+                                       Clock::time_point start_time) {
+  LeastSquaresOutcome outcome;
+  const TinyReprojection function(points, pixels, start_rotation, model, num_params, start_time,
+                                  &outcome.trace);
+  Eigen::VectorXd u = function.Pack(start_center);
+  ceres::TinySolver<TinyReprojection> solver;
+  solver.options.max_num_iterations = std::max(1, options.max_iterations + 1);
+  solver.options.gradient_tolerance = options.gradient_tolerance;
+  solver.options.parameter_tolerance = options.parameter_tolerance;
+  // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
+  solver.options.function_tolerance =
+      options.function_tolerance * std::max(function.StartSumOfSquares(u), 1e-300);
+  const auto& summary = solver.Solve(function, &u);
+  function.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
+  outcome.iterations = summary.iterations;
+  outcome.termination = TinySolverStatusText(summary.status);
+  PolishGaussNewton(points, pixels, num_params, &outcome.rotation, &outcome.center,
+                    &outcome.model, &outcome.normal);
+  outcome.ok = outcome.normal.jtj.size() > 0 && std::isfinite(outcome.normal.cost);
+  // The polish's result closes the trace, so it ends at the reported RMS.
+  outcome.trace.push_back({static_cast<int>(outcome.trace.size()), MicrosecondsSince(start_time),
+                           std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
+  return outcome;
+}
+
 }  // namespace
 
 void FitOptions::Check() const {
@@ -787,21 +832,40 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   FitResult result;
   Eigen::Matrix3d rotation_matrix = start.rotation;
   Eigen::Vector3d center = start.center;
+  NormalEquations normal_equations;
   if (options.refine && options.loss == LossType::kNone) {
-    const TinyReprojection function(points, pixels, start.rotation, model, num_params,
-                                    start_time, &result.trace);
-    Eigen::VectorXd u = function.Pack(start.center);
-    ceres::TinySolver<TinyReprojection> solver;
-    solver.options.max_num_iterations = std::max(1, options.max_iterations + 1);
-    solver.options.gradient_tolerance = options.gradient_tolerance;
-    solver.options.parameter_tolerance = options.parameter_tolerance;
-    // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
-    solver.options.function_tolerance =
-        options.function_tolerance * std::max(function.StartSumOfSquares(u), 1e-300);
-    const auto& summary = solver.Solve(function, &u);
-    function.Unpack(u, &rotation_matrix, &center, &model);
-    result.iterations = summary.iterations;
-    result.termination = TinySolverStatusText(summary.status);
+    LeastSquaresOutcome best = RefineLeastSquares(points, pixels, start.rotation, start.center,
+                                                  model, num_params, options, start_time);
+    if (start_method == "dlt" && n < kSecondStartBelowPoints && start_model.free[2]) {
+      // With few points the DLT's principal point can be far off and LM stop in a local minimum
+      // (seen at 6 points: cy 96 px for 540). Refine also from the image centre (SQPnP pose for
+      // the DLT's focal length there) and keep the lower cost.
+      Model centred = model;
+      centred.value[2] = start_model.value[2];
+      centred.value[3] = start_model.value[3];
+      internal::StartCamera second;
+      if (internal::PnpStart(points, pixels, centred.ToIntrinsics(), &second)) {
+        LeastSquaresOutcome other = RefineLeastSquares(points, pixels, second.rotation,
+                                                       second.center, centred, num_params,
+                                                       options, start_time);
+        if (other.ok && (!best.ok || other.normal.cost < best.normal.cost * (1.0 - 1e-9))) {
+          best = std::move(other);
+        }
+      }
+    }
+    if (!best.ok) {
+      throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                       "the refined camera has points behind it: the correspondences are "
+                       "inconsistent (mismatched or mis-clicked points); check them or use "
+                       "--ransac");
+    }
+    rotation_matrix = best.rotation;
+    center = best.center;
+    model = best.model;
+    normal_equations = std::move(best.normal);
+    result.iterations = best.iterations;
+    result.termination = best.termination;
+    result.trace = std::move(best.trace);
   } else if (options.refine) {
     Eigen::Quaterniond rotation(start.rotation);
     rotation.normalize();
@@ -855,14 +919,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   } else {
     result.termination = "not refined (closed-form start only)";
   }
-  NormalEquations normal_equations;
-  if (options.refine && options.loss == LossType::kNone) {
-    PolishGaussNewton(points, pixels, num_params, &rotation_matrix, &center, &model,
-                      &normal_equations);
-    // The polish's result closes the trace, so it ends at the reported RMS.
-    result.trace.push_back({static_cast<int>(result.trace.size()), MicrosecondsSince(start_time),
-                            std::sqrt(normal_equations.cost / n)});
-  } else {
+  if (!(options.refine && options.loss == LossType::kNone)) {
     ComputeNormalEquations(points, pixels, rotation_matrix, center, model, num_params,
                            &normal_equations);
   }
