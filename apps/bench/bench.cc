@@ -15,7 +15,6 @@
 #include <iostream>
 #include <map>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
