@@ -1,4 +1,4 @@
-// The fitter's Ceres functor (private).
+// The fitter's reprojection residual (private): templated for Ceres' Jets, and analytic.
 #ifndef CAMPROJ_SRC_REPROJECTION_ERROR_H_
 #define CAMPROJ_SRC_REPROJECTION_ERROR_H_
 
@@ -25,8 +25,9 @@ void PixelFromFitIntrinsics(const T* fit, const T& x, const T& y, T* pixel) {
   PixelFromNormalized(k, x, y, pixel);
 }
 
-// Residual = predicted - observed pixel, for one point in the normalized world frame.
-// Parameter blocks: rotation, cam_from_world as an Eigen quaternion (x, y, z, w; on
+// Residual = predicted - observed pixel, for one point in the normalized world frame, by
+// automatic differentiation: the reference the analytic PointReprojectionCost below is tested
+// against (tests/reprojection_error_test.cc). Parameter blocks: rotation, cam_from_world as an Eigen quaternion (x, y, z, w; on
 // ceres::EigenQuaternionManifold); center, the camera centre (3); intrinsics (layout above).
 struct ReprojectionError {
   ReprojectionError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
