@@ -86,6 +86,23 @@ case $case in
     expect_in out "outliers (RANSAC, left out of the fit): 2: 3 7"
     grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"
     ;;
+  fit_batch_reports_every_file)
+    mkdir -p "$work/in"
+    cp "$data/projector/points.csv" "$work/in/projector.csv"
+    cp "$data/synthetic/points.csv" "$work/in/synthetic.csv"
+    cp "$data/plane/points.csv" "$work/in/plane.csv"          # default model: refused (exit 3)
+    printf 'X,Y,Z,u,v\n1,2,x,4,5\n' >"$work/in/broken.csv"     # bad input (exit 2)
+    expect_exit 3 "$bin" fit "$work/in" --image-size 1920x1080 -o "$work/out_cams" --jobs 2
+    expect_in out "projector.csv	ok	10 free"
+    expect_in out "synthetic.csv	ok"
+    expect_in out "plane.csv	refused	the points are coplanar"
+    expect_in out "broken.csv	bad input	.*line 2, column 3 (Z)"
+    expect_in out "2 of 4 fitted"
+    [[ -f "$work/out_cams/projector.json" && -f "$work/out_cams/synthetic.json" ]] || fail "missing camera files"
+    [[ ! -e "$work/out_cams/plane.json" && ! -e "$work/out_cams/broken.json" ]] || fail "camera file for a failed input"
+    expect_exit 1 "$bin" fit "$work/in/projector.csv" "$work/in/synthetic.csv" --image-size 1920x1080
+    expect_in err "needs -o"
+    ;;
   usage_errors)
     expect_exit 1 "$bin"
     expect_exit 1 "$bin" fit "$data/projector/points.csv"

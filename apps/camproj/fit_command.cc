@@ -1,8 +1,17 @@
 // camproj fit: correspondences -> camera file and a summary.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "camproj/camera_file.h"
 #include "camproj/file_io.h"
@@ -16,7 +25,8 @@ namespace camproj::cli {
 namespace {
 
 struct FitArgs {
-  std::string points_path;
+  std::vector<std::string> points_paths;
+  int jobs = 0;
   std::string image_size;
   std::string output_path;
   bool json = false;
@@ -112,6 +122,105 @@ FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
   return options;
 }
 
+// Files named on the command line, a folder standing for its *.csv files (sorted).
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {
+  std::vector<std::string> inputs;
+  for (const std::string& path : paths) {
+    if (!std::filesystem::is_directory(path)) {
+      inputs.push_back(path);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (const auto& entry : std::filesystem::directory_iterator(path)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".csv") {
+        found.push_back(entry.path().string());
+      }
+    }
+    if (found.empty()) throw UsageError(path + ": a folder without *.csv files");
+    std::sort(found.begin(), found.end());
+    inputs.insert(inputs.end(), found.begin(), found.end());
+  }
+  return inputs;
+}
+
+// One row of the batch summary.
+struct BatchRow {
+  std::string input;
+  std::string status = "ok";  // ok | refused | bad input
+  std::string detail;         // model and RMS, or the reason
+  int exit_code = kExitOk;
+};
+
+// Fits every input on `jobs` threads: one camera file per input in the -o folder, a progress
+// line on a terminal, a summary table; one bad file is reported and does not stop the others.
+// Exit code: the worst of the inputs' (0 ok, 2 bad input, 3 refused).
+int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
+             const FitOptions& options, const FitArgs& args) {
+  if (args.output_path.empty()) throw UsageError("batch fitting needs -o OUTPUT_FOLDER");
+  if (args.json || args.trace) throw UsageError("--json and --trace are for a single input");
+  std::filesystem::create_directories(args.output_path);
+  const int jobs = args.jobs > 0 ? args.jobs
+                                 : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<BatchRow> rows(inputs.size());
+  std::atomic<size_t> next{0};
+  std::atomic<size_t> done{0};
+  std::mutex progress_mutex;
+  const bool terminal = isatty(fileno(stderr)) != 0;
+  const auto begin = std::chrono::steady_clock::now();
+  auto work = [&]() {
+    for (size_t i = next++; i < inputs.size(); i = next++) {
+      BatchRow& row = rows[i];
+      row.input = inputs[i];
+      try {
+        const Correspondences data = ReadCorrespondencesFile(inputs[i]);
+        const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
+        CameraFileOptions file_options;
+        file_options.pixel_origin = options.pixel_origin;
+        file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
+        const FitRecord record = FitRecordOf(fit);
+        const std::filesystem::path output = std::filesystem::path(args.output_path) /
+                                             (std::filesystem::path(inputs[i]).stem().string() + ".json");
+        WriteFileAtomically(output.string(), CameraToJsonText(fit.camera, file_options, &record));
+        char detail[128];
+        std::snprintf(detail, sizeof detail, "%zu free, rms %.3f px, %zu points",
+                      fit.free_parameters.size(), fit.rms_px, data.pixels.size());
+        row.detail = detail;
+      } catch (const SceneError& e) {
+        row.status = "refused";
+        row.detail = e.what();
+        row.exit_code = kExitScene;
+      } catch (const std::exception& e) {
+        row.status = "bad input";
+        row.detail = e.what();
+        row.exit_code = kExitBadInput;
+      }
+      const size_t finished = ++done;
+      if (terminal) {
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        std::cerr << "\r[" << finished << "/" << inputs.size() << "] " << std::flush;
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < std::min<int>(jobs, static_cast<int>(inputs.size())); ++t) threads.emplace_back(work);
+  for (std::thread& thread : threads) thread.join();
+  if (terminal) std::cerr << "\r";
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  int exit_code = kExitOk;
+  int ok = 0;
+  std::cout << "file\tstatus\tdetail\n";
+  for (const BatchRow& row : rows) {
+    std::cout << row.input << '\t' << row.status << '\t' << row.detail << '\n';
+    exit_code = std::max(exit_code, row.exit_code);
+    ok += row.exit_code == kExitOk ? 1 : 0;
+  }
+  std::printf("%d of %zu fitted in %.3f s on %d threads (%.1f fits/s); cameras in %s\n", ok,
+              inputs.size(), seconds, std::min<int>(jobs, static_cast<int>(inputs.size())),
+              inputs.size() / std::max(seconds, 1e-9), args.output_path.c_str());
+  return exit_code;
+}
+
 }  // namespace
 
 Command AddFitCommand(CLI::App& root) {
@@ -128,7 +237,11 @@ Command AddFitCommand(CLI::App& root) {
       "  camproj fit points.csv --image-size 1920x1080 -o camera.json\n"
       "  camproj fit plane.csv --image-size 640x480 --fix aspect,principal-point --free k1\n"
       "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json --loss huber:2");
-  app->add_option("POINTS", args->points_path, "correspondences CSV")->required();
+  app->add_option("POINTS", args->points_paths,
+                  "correspondences CSV; several files or a folder of *.csv fit them all in "
+                  "parallel (-o names the output folder)")->required();
+  app->add_option("--jobs", args->jobs, "parallel fits in batch mode (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
   app->add_option("--image-size", args->image_size, "image size WIDTHxHEIGHT in pixels")->required();
   app->add_option("-o,--output", args->output_path, "write the camera file here");
   app->add_flag("--json", args->json, "print the camera file to stdout instead of the summary");
@@ -166,7 +279,11 @@ Command AddFitCommand(CLI::App& root) {
   return {app, [args]() {
             const ImageSize size = ParseImageSize(args->image_size, "--image-size");
             const FitOptions options = OptionsFrom(*args, size);
-            const Correspondences data = ReadCorrespondencesFile(args->points_path);
+            const std::vector<std::string> inputs = ExpandInputs(args->points_paths);
+            if (inputs.size() > 1 || std::filesystem::is_directory(args->points_paths.front())) {
+              return FitBatch(inputs, size, options, *args);
+            }
+            const Correspondences data = ReadCorrespondencesFile(inputs.front());
             const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
             CameraFileOptions file_options;
             file_options.pixel_origin = options.pixel_origin;
