@@ -122,6 +122,15 @@ FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
   return options;
 }
 
+// The camera file of a fit: its look-at target at the fit's distance, and the `fit` record.
+std::string CameraFileTextOf(const FitResult& fit, PixelOrigin pixel_origin) {
+  CameraFileOptions file_options;
+  file_options.pixel_origin = pixel_origin;
+  file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
+  const FitRecord record = FitRecordOf(fit);
+  return CameraToJsonText(fit.camera, file_options, &record);
+}
+
 // Files named on the command line, a folder standing for its *.csv files (sorted).
 std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {
   std::vector<std::string> inputs;
@@ -174,13 +183,9 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
       try {
         const Correspondences data = ReadCorrespondencesFile(inputs[i]);
         const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
-        CameraFileOptions file_options;
-        file_options.pixel_origin = options.pixel_origin;
-        file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
-        const FitRecord record = FitRecordOf(fit);
         const std::filesystem::path output = std::filesystem::path(args.output_path) /
                                              (std::filesystem::path(inputs[i]).stem().string() + ".json");
-        WriteFileAtomically(output.string(), CameraToJsonText(fit.camera, file_options, &record));
+        WriteFileAtomically(output.string(), CameraFileTextOf(fit, options.pixel_origin));
         char detail[128];
         std::snprintf(detail, sizeof detail, "%zu free, rms %.3f px, %zu points",
                       fit.free_parameters.size(), fit.rms_px, data.pixels.size());
@@ -285,12 +290,7 @@ Command AddFitCommand(CLI::App& root) {
             }
             const Correspondences data = ReadCorrespondencesFile(inputs.front());
             const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
-            CameraFileOptions file_options;
-            file_options.pixel_origin = options.pixel_origin;
-            file_options.target_distance =
-                (fit.views.look_at.target - fit.views.look_at.eye).norm();
-            const FitRecord record = FitRecordOf(fit);
-            const std::string text = CameraToJsonText(fit.camera, file_options, &record);
+            const std::string text = CameraFileTextOf(fit, options.pixel_origin);
             if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
             if (args->json) {
               std::cout << text;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <random>
 
 #include <ceres/ceres.h>
@@ -135,6 +136,15 @@ Model ProjectOntoModel(const Model& model, const Intrinsics& k0) {
   return projected;
 }
 
+// The pixel (kCenter) of a point in the cam frame under the model's intrinsics, or nothing if it
+// is not in front of the camera.
+std::optional<Eigen::Vector2d> PixelOfCamPoint(const Model& model, const Eigen::Vector3d& p) {
+  if (!(p.z() > 0.0)) return std::nullopt;
+  double pixel[2];
+  internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
+  return Eigen::Vector2d(pixel[0], pixel[1]);
+}
+
 // Indices of the points within `threshold` px of the camera (rotation, center, model).
 std::vector<int> InliersOf(const std::vector<Eigen::Vector3d>& points,
                            const std::vector<Eigen::Vector2d>& pixels,
@@ -143,11 +153,9 @@ std::vector<int> InliersOf(const std::vector<Eigen::Vector3d>& points,
   std::vector<int> inliers;
   const double threshold2 = threshold * threshold;
   for (size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d p = rotation * (points[i] - center);
-    if (!(p.z() > 0.0)) continue;
-    double pixel[2];
-    internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
-    if ((Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i]).squaredNorm() <= threshold2) {
+    const std::optional<Eigen::Vector2d> pixel =
+        PixelOfCamPoint(model, rotation * (points[i] - center));
+    if (pixel && (*pixel - pixels[i]).squaredNorm() <= threshold2) {
       inliers.push_back(static_cast<int>(i));
     }
   }
@@ -810,11 +818,10 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
       auto sum_squares = [&](const internal::StartCamera& camera) {
         double sum = 0.0;
         for (int i = 0; i < n; ++i) {
-          const Eigen::Vector3d p = camera.rotation * (points[i] - camera.center);
-          if (!(p.z() > 0.0)) return std::numeric_limits<double>::infinity();
-          double pixel[2];
-          internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
-          sum += (Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i]).squaredNorm();
+          const std::optional<Eigen::Vector2d> pixel =
+              PixelOfCamPoint(model, camera.rotation * (points[i] - camera.center));
+          if (!pixel) return std::numeric_limits<double>::infinity();
+          sum += (*pixel - pixels[i]).squaredNorm();
         }
         return sum;
       };
@@ -938,13 +945,12 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d p = rotation_matrix * (points[i] - center);
     depths[i] = p.z() * scale;
-    if (!(p.z() > 0.0)) {
+    const std::optional<Eigen::Vector2d> pixel = PixelOfCamPoint(model, p);
+    if (!pixel) {
       ++behind;
       continue;
     }
-    double pixel[2];
-    internal::PixelFromFitIntrinsics(model.value.data(), p.x() / p.z(), p.y() / p.z(), pixel);
-    result.residuals_px[i] = Eigen::Vector2d(pixel[0], pixel[1]) - pixels[i];
+    result.residuals_px[i] = *pixel - pixels[i];
     norms[i] = result.residuals_px[i].norm();
     sum_squares += norms[i] * norms[i];
   }
