@@ -181,11 +181,6 @@ TEST(ExportGlTest, NumbersReadBackBitForBitInBothOrders) {
       EXPECT_EQ(GlLineMatrix(text, "projection", row_major), projection) << text;
       EXPECT_EQ(GlLineMatrix(text, "view", row_major), view) << text;
       EXPECT_EQ(text.find("k1 = ") != std::string::npos, camera.intrinsics.HasDistortion());
-      // The deprecated entry point prints the same text.
-      GlExportOptions gl_options;
-      gl_options.depth = options.depth;
-      gl_options.row_major = row_major;
-      EXPECT_EQ(ExportGl(camera, gl_options), text);
     }
   }
 }

@@ -368,11 +368,4 @@ std::string ExportCamera(const Camera& camera, ExportFormat format, const Export
   throw std::invalid_argument(internal::Concat("unknown export format ", static_cast<int>(format)));
 }
 
-std::string ExportGl(const Camera& camera, const GlExportOptions& options) {
-  ExportOptions export_options;
-  export_options.depth = options.depth;
-  export_options.row_major = options.row_major;
-  return ExportCamera(camera, ExportFormat::kGl, export_options);
-}
-
 }  // namespace camproj

@@ -61,14 +61,6 @@ struct ExportOptions {
 std::string ExportCamera(const Camera& camera, ExportFormat format,
                          const ExportOptions& options = {});
 
-// Deprecated: ExportCamera(camera, ExportFormat::kGl, {options.depth, options.row_major}).
-// Kept until the command line switches to ExportCamera.
-struct GlExportOptions {
-  GlDepth depth;
-  bool row_major = false;  // print rows instead of GL's column-major order
-};
-std::string ExportGl(const Camera& camera, const GlExportOptions& options = {});
-
 }  // namespace camproj
 
 #endif  // CAMPROJ_EXPORT_H_
