@@ -243,6 +243,7 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["pixel_sigma"] = fit->pixel_sigma;
     record["pixel_sigma_estimated"] = fit->pixel_sigma_estimated;
     record["iterations"] = fit->iterations;
+    record["jacobian_condition"] = fit->jacobian_condition;
     record["time_ms"] = fit->time_ms;
     document["fit"] = record;
   }

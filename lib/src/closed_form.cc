@@ -162,16 +162,19 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
   Eigen::Matrix3d k;
   Eigen::Matrix3d r;
   RqDecomposition(m, &k, &r);
-  if (m.determinant() < 0.0) {
-    throw SceneError(SceneError::Reason::kMirroredWorld,
-                     "the points are seen as through a mirror: every point is in front of the "
-                     "camera but the world frame is left-handed (det < 0). Flip one world axis "
-                     "(e.g. negate Z of every point, and again in anything you render) and refit");
-  }
   StartCamera start;
   start.rotation = r;
   start.center = -m.inverse() * p.col(3);
   start.intrinsics = IntrinsicsFromK(k);
+  if (m.determinant() < 0.0) {
+    // K R (X - C) = K (R F) (F X - F C) with F = diag(1, 1, -1): a proper rotation R F in the
+    // world with z negated. Under noise a nearly degenerate scene can flip the sign, so the
+    // fitter decides (fit.cc) whether the world is really mirrored.
+    const Eigen::Vector3d flip(1.0, 1.0, -1.0);
+    start.rotation = r * flip.asDiagonal();
+    start.center = flip.asDiagonal() * start.center;
+    start.mirrored = true;
+  }
   return start;
 }
 

@@ -17,11 +17,15 @@ struct StartCamera {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Intrinsics intrinsics;  // kCenter, k1 = k2 = 0
+  // DltStart only: the DLT's 3x3 part has det < 0, i.e. the points are seen as through a
+  // mirror. rotation and center are then those of the world with z negated (z -> -z), where
+  // the same linear camera has a proper rotation.
+  bool mirrored = false;
 };
 
 // Hartley-normalized DLT (>= 6 non-coplanar points) and RQ decomposition: K with positive
-// diagonal, det(R) = +1. Throws SceneError kMirroredWorld when every point is in front but the
-// frame is left-handed, kPointsBehindCamera when no camera has all points in front.
+// diagonal, det(R) = +1; see StartCamera::mirrored for a left-handed reading. Throws SceneError
+// kPointsBehindCamera when no camera has all points in front.
 StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels);
 

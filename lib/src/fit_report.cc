@@ -44,6 +44,7 @@ FitRecord FitRecordOf(const FitResult& fit) {
   record.pixel_sigma = fit.pixel_sigma;
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
+  record.jacobian_condition = fit.jacobian_condition;
   record.time_ms = fit.time_ms;
   return record;
 }
@@ -125,7 +126,8 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   }
   out << "\n";
   out << "time: " << Format("%.3f", fit.time_ms) << " ms, " << fit.iterations << " iterations ("
-      << fit.termination << ")\n";
+      << fit.termination << "), Jacobian condition " << Format("%.3g", fit.jacobian_condition)
+      << "\n";
   return out.str();
 }
 

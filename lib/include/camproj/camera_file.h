@@ -36,6 +36,7 @@ struct FitRecord {
   double pixel_sigma = 0.0;            // px per axis, used for the sigmas
   bool pixel_sigma_estimated = true;   // from the residuals (else given)
   int iterations = 0;
+  double jacobian_condition = 0.0;     // of the column-scaled Jacobian at the solution
   double time_ms = 0.0;
 };
 

@@ -173,6 +173,11 @@ struct FitResult {
   std::vector<std::string> free_parameters;   // names in the covariance's order
   std::vector<FixedParameter> fixed_parameters;
 
+  // Condition number of the Jacobian at the solution, its columns scaled to unit norm (pose in
+  // the fitter's centred, unit-RMS world): sqrt(largest / smallest eigenvalue of the scaled
+  // J^T J). Refused as undetermined (SceneError kDegenerate) above 1e6.
+  double jacobian_condition = 0.0;
+
   int iterations = 0;
   std::string termination;  // Ceres' termination type and message
   double time_ms = 0.0;
