@@ -21,7 +21,12 @@ expect_in() { grep -q -- "$2" "$work/$1" || fail "$1 lacks '$2':\n$(cat "$work/$
 case $case in
   fit_projector)
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cam.json" --trace
-    expect_in out "model: 10 free parameters"
+    # The projector's principal point is at the bottom edge and its pixels are square: the
+    # automatic model frees the principal point and leaves the rest out, saying why.
+    expect_in out "model: pose+focal+principal-point, 9 free parameters"
+    expect_in out "fixed aspect = 1 (left out: delta BIC"
+    grep -q '"left_out"' "$work/cam.json" || fail "camera file lacks left_out"
+    grep -q '"selection"' "$work/cam.json" || fail "camera file lacks the model selection"
     expect_in out "residuals: rms"
     expect_in out "worst points:"
     expect_in out "iteration  elapsed_us  rms_px"
@@ -37,16 +42,19 @@ case $case in
     expect_in out '"cam_from_world"'
     ;;
   fit_planar_refused_then_fixed)
-    expect_exit 3 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 -o "$work/cam.json"
+    expect_exit 3 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 --model focal+aspect+principal-point -o "$work/cam.json"
     expect_in err "coplanar"
     expect_in err "principal point"
     [[ ! -e "$work/cam.json" ]] || fail "a refused fit wrote a camera file"
-    expect_exit 0 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 --fix aspect,principal-point -o "$work/cam.json"
+    expect_exit 0 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 --model focal -o "$work/cam.json"
     expect_in out "coplanar"
+    # Automatic: the plane cannot determine the principal point, and says so.
+    expect_exit 0 "$bin" fit "$data/plane/points.csv" --image-size 1280x720
+    expect_in out "fixed principal point = 639.5, 359.5 (left out: not determined"
     ;;
   fit_known_intrinsics)
     expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --intrinsics "$data/synthetic/truth.json"
-    expect_in out "model: 6 free parameters"
+    expect_in out "model: pose, 6 free parameters"
     expect_in out "given: pose only"
     ;;
   fit_bad_csv_names_line_and_column)
@@ -90,16 +98,18 @@ case $case in
     mkdir -p "$work/in"
     cp "$data/projector/points.csv" "$work/in/projector.csv"
     cp "$data/synthetic/points.csv" "$work/in/synthetic.csv"
-    cp "$data/plane/points.csv" "$work/in/plane.csv"          # default model: refused (exit 3)
+    cp "$data/plane/points.csv" "$work/in/plane.csv"
+    printf 'X,Y,Z,u,v\n0,0,0,1,1\n1,1,1,2,2\n2,2,2,3,3\n3,3,3,4,4\n4,4,4,5,5\n5,5,5,6,6\n7,7,7,8,8\n' >"$work/in/line.csv"  # collinear: refused (exit 3)
     printf 'X,Y,Z,u,v\n1,2,x,4,5\n' >"$work/in/broken.csv"     # bad input (exit 2)
     expect_exit 3 "$bin" fit "$work/in" --image-size 1920x1080 -o "$work/out_cams" --jobs 2
-    expect_in out "projector.csv	ok	10 free"
+    expect_in out "projector.csv	ok	pose+focal+principal-point"
     expect_in out "synthetic.csv	ok"
-    expect_in out "plane.csv	refused	the points are coplanar"
+    expect_in out "plane.csv	ok	pose+focal"
+    expect_in out "line.csv	refused	the 3D points are collinear"
     expect_in out "broken.csv	bad input	.*line 2, column 3 (Z)"
-    expect_in out "2 of 4 fitted"
+    expect_in out "3 of 5 fitted"
     [[ -f "$work/out_cams/projector.json" && -f "$work/out_cams/synthetic.json" ]] || fail "missing camera files"
-    [[ ! -e "$work/out_cams/plane.json" && ! -e "$work/out_cams/broken.json" ]] || fail "camera file for a failed input"
+    [[ ! -e "$work/out_cams/line.json" && ! -e "$work/out_cams/broken.json" ]] || fail "camera file for a failed input"
     expect_exit 1 "$bin" fit "$work/in/projector.csv" "$work/in/synthetic.csv" --image-size 1920x1080
     expect_in err "needs -o"
     ;;

@@ -17,6 +17,7 @@
 #include "camproj/file_io.h"
 #include "camproj/fit.h"
 #include "camproj/fit_report.h"
+#include "camproj/model_select.h"
 #include "camproj/points_file.h"
 #include "cli.h"
 
@@ -31,6 +32,8 @@ struct FitArgs {
   std::string output_path;
   bool json = false;
   bool trace = false;
+  std::string model = "auto";
+  std::string criterion = "bic";
   std::vector<std::string> free;
   std::vector<std::string> fix;
   double focal = 0.0;
@@ -64,13 +67,66 @@ ParameterMode* ModeOf(FitOptions& options, const std::string& name) {
                    "\": expected focal, aspect, principal-point, skew, k1 or k2");
 }
 
-FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
-  FitOptions options;
+// What `camproj fit` runs: FitCameraAuto (--model auto) or FitCamera with the given model.
+struct FitRequest {
+  bool automatic = true;
+  AutoFitOptions auto_options;  // its `fit` is the options in both cases
+  const FitOptions& options() const { return auto_options.fit; }
+};
+
+FitResult RunFit(const Correspondences& data, const ImageSize& size, const FitRequest& request) {
+  return request.automatic
+             ? FitCameraAuto(data.points_in_world, data.pixels, size, request.auto_options)
+             : FitCamera(data.points_in_world, data.pixels, size, request.options());
+}
+
+// Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none).
+std::vector<std::string> ModelNames(const std::string& model) {
+  std::vector<std::string> names;
+  if (model == "pose") return names;
+  size_t begin = 0;
+  for (;;) {
+    const size_t end = model.find('+', begin);
+    const std::string name = model.substr(begin, end == std::string::npos ? end : end - begin);
+    if (std::find(kParameterNames.begin(), kParameterNames.end(), name) == kParameterNames.end()) {
+      throw UsageError("--model: unknown parameter \"" + name + "\" in \"" + model +
+                       "\": expected auto, pose, or parameters joined by '+' among focal, aspect, "
+                       "principal-point, skew, k1, k2 (e.g. focal+principal-point)");
+    }
+    names.push_back(name);
+    if (end == std::string::npos) return names;
+    begin = end + 1;
+  }
+}
+
+FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
+  FitRequest request;
+  request.automatic = args.model == "auto" && args.intrinsics_path.empty();
+  FitOptions& options = request.auto_options.fit;
   options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+  if (args.model != "auto") {
+    // Exactly the listed intrinsics are free; the rest stay at their defaults.
+    for (const std::string& name : kParameterNames) *ModeOf(options, name) = ParameterMode::Default();
+    for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
+  }
+  if (args.criterion != "aic" && args.criterion != "bic") {
+    throw UsageError("--criterion: expected aic or bic, got \"" + args.criterion + "\"");
+  }
+  request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {
     if (name == "focal") throw UsageError("--fix focal needs a value: use --focal PX or --fovy DEG");
-    *ModeOf(options, name) = ParameterMode::Default();
+    // With --model auto a default-mode intrinsic is a candidate, so "fix" means given at its
+    // default value (in the input's pixel origin).
+    const double shift = PixelOriginShift(PixelOrigin::kCenter, options.pixel_origin);
+    ParameterMode mode = ParameterMode::Default();
+    if (request.automatic) {
+      mode = name == "aspect" ? ParameterMode::Fixed(1.0)
+             : name == "principal-point"
+                 ? ParameterMode::Fixed(0.5 * (size.width - 1) + shift, 0.5 * (size.height - 1) + shift)
+                 : ParameterMode::Fixed(0.0);
+    }
+    *ModeOf(options, name) = mode;
   }
   if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
   if (args.focal > 0.0 && args.fovy_deg > 0.0) throw UsageError("give --focal or --fovy, not both");
@@ -114,12 +170,17 @@ FitOptions OptionsFrom(const FitArgs& args, const ImageSize& size) {
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
   options.max_iterations = args.max_iterations;
+  if (request.automatic && options.loss != LossType::kNone) {
+    throw UsageError("--loss needs an explicit --model (automatic selection compares "
+                     "least-squares fits): e.g. --model focal+aspect+principal-point; for "
+                     "mis-clicked points use --ransac PX");
+  }
   try {
-    options.Check();
+    request.auto_options.Check();
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  return options;
+  return request;
 }
 
 // The camera file of a fit: its look-at target at the fit's distance, and the `fit` record.
@@ -164,7 +225,7 @@ struct BatchRow {
 // line on a terminal, a summary table; one bad file is reported and does not stop the others.
 // Exit code: the worst of the inputs' (0 ok, 2 bad input, 3 refused).
 int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
-             const FitOptions& options, const FitArgs& args) {
+             const FitRequest& request, const FitArgs& args) {
   if (args.output_path.empty()) throw UsageError("batch fitting needs -o OUTPUT_FOLDER");
   if (args.json || args.trace) throw UsageError("--json and --trace are for a single input");
   std::filesystem::create_directories(args.output_path);
@@ -182,13 +243,13 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
       row.input = inputs[i];
       try {
         const Correspondences data = ReadCorrespondencesFile(inputs[i]);
-        const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
+        const FitResult fit = RunFit(data, size, request);
         const std::filesystem::path output = std::filesystem::path(args.output_path) /
                                              (std::filesystem::path(inputs[i]).stem().string() + ".json");
-        WriteFileAtomically(output.string(), CameraFileTextOf(fit, options.pixel_origin));
-        char detail[128];
-        std::snprintf(detail, sizeof detail, "%zu free, rms %.3f px, %zu points",
-                      fit.free_parameters.size(), fit.rms_px, data.pixels.size());
+        WriteFileAtomically(output.string(), CameraFileTextOf(fit, request.options().pixel_origin));
+        char detail[256];
+        std::snprintf(detail, sizeof detail, "%s, rms %.3f px, %zu points", fit.model.c_str(),
+                      fit.rms_px, data.pixels.size());
         row.detail = detail;
       } catch (const SceneError& e) {
         row.status = "refused";
@@ -234,14 +295,19 @@ Command AddFitCommand(CLI::App& root) {
       "fit",
       "Fit a camera (or projector) to 2D-3D correspondences.\n\n"
       "POINTS.csv has a header naming X,Y,Z,u,v (any order, extra columns ignored, optional id,\n"
-      "'#' comments). By default focal length, aspect (fx != fy) and principal point are free,\n"
-      "skew is 0 and there is no distortion; --free/--fix/--focal/... change that.\n"
+      "'#' comments). The model is chosen automatically (--model auto): from pose + focal length\n"
+      "(square pixels, centred principal point) it frees principal point, aspect, skew, k1, k2\n"
+      "one at a time while the criterion (BIC by default) says the data support them and the\n"
+      "scene determines them, and lists what it left out and why. --model focal+principal-point\n"
+      "(any '+' list) forces a model; --free forces a parameter in, --fix (or a value: --focal,\n"
+      "--aspect, ...) keeps it out.\n"
       "Prints a summary (parameters +- 1 sigma, residuals, worst points, time); -o writes the\n"
       "camera file (docs/camera-file.md) atomically.\n\n"
       "Examples:\n"
       "  camproj fit points.csv --image-size 1920x1080 -o camera.json\n"
-      "  camproj fit plane.csv --image-size 640x480 --fix aspect,principal-point --free k1\n"
-      "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json --loss huber:2");
+      "  camproj fit plane.csv --image-size 640x480 --model focal+k1\n"
+      "  camproj fit points.csv --image-size 1920x1080 --model focal+aspect+principal-point --loss huber:2\n"
+      "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json");
   app->add_option("POINTS", args->points_paths,
                   "correspondences CSV; several files or a folder of *.csv fit them all in "
                   "parallel (-o names the output folder)")->required();
@@ -251,6 +317,13 @@ Command AddFitCommand(CLI::App& root) {
   app->add_option("-o,--output", args->output_path, "write the camera file here");
   app->add_flag("--json", args->json, "print the camera file to stdout instead of the summary");
   app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
+  app->add_option("--model", args->model,
+                  "auto (default): the simplest model the data support; or the free intrinsics "
+                  "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
+                  "pose: none (with --intrinsics or fixed values)");
+  app->add_option("--criterion", args->criterion,
+                  "model selection criterion: bic (default) or aic")
+      ->check(CLI::IsMember({"aic", "bic"}));
   app->add_option("--free", args->free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
       ->delimiter(',')->check(CLI::IsMember(kParameterNames));
   app->add_option("--fix", args->fix, "hold these at their defaults (aspect 1, principal point at "
@@ -283,14 +356,14 @@ Command AddFitCommand(CLI::App& root) {
 
   return {app, [args]() {
             const ImageSize size = ParseImageSize(args->image_size, "--image-size");
-            const FitOptions options = OptionsFrom(*args, size);
+            const FitRequest request = RequestFrom(*args, size);
             const std::vector<std::string> inputs = ExpandInputs(args->points_paths);
             if (inputs.size() > 1 || std::filesystem::is_directory(args->points_paths.front())) {
-              return FitBatch(inputs, size, options, *args);
+              return FitBatch(inputs, size, request, *args);
             }
             const Correspondences data = ReadCorrespondencesFile(inputs.front());
-            const FitResult fit = FitCamera(data.points_in_world, data.pixels, size, options);
-            const std::string text = CameraFileTextOf(fit, options.pixel_origin);
+            const FitResult fit = RunFit(data, size, request);
+            const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
             if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
             if (args->json) {
               std::cout << text;

@@ -233,6 +233,23 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["num_points"] = fit->num_points;
     if (!fit->outliers.empty()) record["outliers"] = fit->outliers;
     record["start"] = fit->start;
+    record["model"] = fit->model;
+    if (!fit->candidates.empty()) {
+      json selection;
+      selection["criterion"] = fit->criterion;
+      selection["sigma_px"] = fit->selection_sigma_px;
+      selection["candidates"] = json::array();
+      for (const FitRecord::Candidate& c : fit->candidates) {
+        json candidate = {{"name", c.name}, {"verdict", c.verdict}};
+        if (c.num_params > 0) {
+          candidate["num_params"] = c.num_params;
+          candidate["rms_px"] = c.rms_px;
+          candidate["criterion"] = c.criterion;
+        }
+        selection["candidates"].push_back(candidate);
+      }
+      record["selection"] = selection;
+    }
     record["free"] = fit->free;
     record["fixed"] = json::array();
     for (const auto& [name, value] : fit->fixed) record["fixed"].push_back({{"name", name}, {"value", value}});

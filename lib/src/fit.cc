@@ -1063,6 +1063,11 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     if (model.free[slot]) names.push_back(user_slot_names[slot]);
   }
   result.free_parameters = names;
+  result.model = "pose";
+  const char* model_slot_names[] = {"focal", "aspect", "principal-point", "", "skew", "k1", "k2"};
+  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+    if (model.free[slot] && slot != 3) result.model += std::string("+") + model_slot_names[slot];
+  }
   result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.

@@ -34,10 +34,18 @@ FitRecord FitRecordOf(const FitResult& fit) {
   record.max_px = fit.max_px;
   record.num_points = static_cast<int>(fit.residuals_px.size() - fit.outliers.size());
   record.start = fit.start_method;
+  record.model = fit.model;
+  record.criterion = fit.criterion;
+  record.selection_sigma_px = fit.selection_sigma_px;
+  for (const ModelCandidate& c : fit.candidates) {
+    record.candidates.push_back({c.name, c.fitted ? c.num_params : 0, c.rms_px, c.criterion, c.verdict});
+  }
   record.free = fit.free_parameters;
   for (const FixedParameter& p : fit.fixed_parameters) {
     record.fixed.emplace_back(p.name, p.value + " (" + p.why + ")");
-    if (p.why.rfind("default", 0) == 0) record.left_out.emplace_back(p.name, p.why);
+    if (p.why.rfind("default", 0) == 0 || p.why.rfind("left out", 0) == 0) {
+      record.left_out.emplace_back(p.name, p.why);
+    }
   }
   for (const ParameterSigma& s : fit.sigmas) record.sigma.emplace_back(s.name, s.sigma);
   record.outliers = fit.outliers;
@@ -52,10 +60,23 @@ FitRecord FitRecordOf(const FitResult& fit) {
 std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {
   std::ostringstream out;
   const int n = static_cast<int>(fit.residuals_px.size());
-  out << "model: " << fit.free_parameters.size() << " free parameters (pose";
+  out << "model: " << fit.model << ", " << fit.free_parameters.size()
+      << " free parameters (pose";
   for (size_t i = 6; i < fit.free_parameters.size(); ++i) out << ", " << fit.free_parameters[i];
   out << "), " << n << " points" << (fit.planar ? " (coplanar)" : "") << ", start "
       << fit.start_method << "\n";
+  if (!fit.candidates.empty()) {
+    out << "  chosen automatically by " << fit.criterion << " at pixel noise "
+        << Format("%.3g", fit.selection_sigma_px) << " px; models tried:\n";
+    for (const ModelCandidate& c : fit.candidates) {
+      out << "    " << c.name;
+      if (c.fitted) {
+        out << " (" << c.num_params << " parameters, rms " << Format("%.3f", c.rms_px) << " px, "
+            << fit.criterion << " " << Format("%.1f", c.criterion) << ")";
+      }
+      out << ": " << c.verdict << "\n";
+    }
+  }
   for (const FixedParameter& p : fit.fixed_parameters) {
     out << "  fixed " << p.name << " = " << p.value << " (" << p.why << ")\n";
   }

@@ -29,6 +29,18 @@ struct FitRecord {
   int num_points = 0;       // points used (without RANSAC's outliers)
   std::vector<int> outliers;  // 0-based indices of points RANSAC left out
   std::string start;        // closed-form start: dlt | homography | pnp | pnp-focal-sweep
+  std::string model;        // "pose+focal+principal-point": the free intrinsics
+  // Automatic model selection (empty otherwise): criterion, the noise it used, every model tried.
+  struct Candidate {
+    std::string name;
+    int num_params = 0;     // 0 when refused
+    double rms_px = 0.0;
+    double criterion = 0.0;
+    std::string verdict;
+  };
+  std::string criterion;    // "AIC" | "BIC"
+  double selection_sigma_px = 0.0;
+  std::vector<Candidate> candidates;
   std::vector<std::string> free;                                 // estimated parameters
   std::vector<std::pair<std::string, std::string>> fixed;        // name, "value (why)"
   std::vector<std::pair<std::string, std::string>> left_out;     // name, why

@@ -156,6 +156,17 @@ struct Correlation {
   double correlation = 0.0;
 };
 
+// One model FitCameraAuto (model_select.h) tried.
+struct ModelCandidate {
+  std::string name;          // as FitResult::model
+  int num_params = 0;        // pose 6 + free intrinsics
+  bool fitted = false;       // false: refused or not determined (see verdict)
+  double sum_squares_px2 = 0.0;
+  double rms_px = 0.0;
+  double criterion = 0.0;    // AIC or BIC with the selection's noise
+  std::string verdict;       // "chosen", "kept", "not supported ...", "not determined ...", ...
+};
+
 struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
@@ -167,6 +178,14 @@ struct FitResult {
   double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;
+
+  // The model: "pose" followed by its free intrinsics, e.g. "pose+focal+principal-point".
+  std::string model;
+  // FitCameraAuto only: every model tried in order, the criterion ("AIC" / "BIC") and the pixel
+  // noise it used.
+  std::vector<ModelCandidate> candidates;
+  std::string criterion;
+  double selection_sigma_px = 0.0;
 
   std::string start_method;  // "dlt", "homography", "pnp", "pnp-focal-sweep"
   bool planar = false;       // the points are (numerically) coplanar

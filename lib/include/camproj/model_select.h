@@ -1,0 +1,65 @@
+// Automatic model selection: fit only the intrinsics the scene determines and needs.
+//
+// Starting from pose + focal length (a gluPerspective camera: square pixels, principal point at
+// the image centre), FitCameraAuto frees one group at a time in the order principal point
+// (an off-axis frustum) -> aspect -> skew -> k1 -> k2 (k2 only after k1), each round keeping the
+// group that lowers the criterion most, and stops when none does. A group is never freed when
+// the scene does not determine it: when the fit is refused, or when 1 sigma of a freed parameter
+// moves the image corner by more than max_corner_sigma_fraction of the image half-diagonal.
+// Criterion (geometric AIC, Kanatani; the 3D points are exact, so it is J / sigma^2 + 2 p):
+//   AIC = J / sigma^2 + 2 p,   BIC = J / sigma^2 + p ln(2 N),
+// J the sum of squared reprojection errors (px^2), p the number of parameters (pose 6 + free
+// intrinsics), sigma the pixel noise: given, or estimated as sqrt(J / (2N - p)) from the richest
+// model the scene supports, floored at kMinNoisePx. Details: docs/model-selection.md.
+#ifndef CAMPROJ_MODEL_SELECT_H_
+#define CAMPROJ_MODEL_SELECT_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/fit.h"
+
+namespace camproj {
+
+enum class ModelCriterion { kAic, kBic };
+
+// Noise below this is not believed (subpixel detectors reach ~0.01 px): on exact synthetic data
+// rounding would otherwise count as evidence for every extra parameter.
+inline constexpr double kMinNoisePx = 1e-4;
+
+struct AutoFitOptions {
+  // Everything but the model: pixel origin, RANSAC, sigma, near/far, stopping rules. Its
+  // intrinsics decide what the ladder may change: kDefault = a candidate (left at its default
+  // unless freed), kFree = free in every model (forced), kFixed = given, never freed. Unlike
+  // FitOptions' own defaults, aspect and principal point start as candidates here. A robust loss
+  // is refused (the criterion is for least squares; use RANSAC for outliers). known_intrinsics:
+  // pose only, nothing to select.
+  FitOptions fit = [] {
+    FitOptions o;
+    o.aspect = ParameterMode::Default();
+    o.principal_point = ParameterMode::Default();
+    return o;
+  }();
+  // BIC by default: it keeps a parameter that does not matter with probability P(chi2_1 >
+  // ln 2N) (5 % at N = 20, 1 % at N = 500), AIC with P(chi2_1 > 2) = 16 % per candidate.
+  ModelCriterion criterion = ModelCriterion::kBic;
+  // A freed parameter is "not determined" when 1 sigma of it moves the image corner by more than
+  // this fraction of the image half-diagonal (0.05 of 1101 px = 55 px for 1920 x 1080).
+  double max_corner_sigma_fraction = 0.05;
+
+  void Check() const;  // throws std::invalid_argument naming the field
+};
+
+// Fits the simplest model the data support. The result is FitCamera's for the chosen model,
+// plus FitResult::model, ::candidates (every model tried, in order) and, in fixed_parameters,
+// every candidate left out with the reason ("left out: not determined: sigma would be 180 px
+// at the corner, bound 55 px"; "left out: delta AIC +3.1 against the chosen model: not
+// supported by the data"). Throws like FitCamera when even the simplest model is refused.
+FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
+                        const std::vector<Eigen::Vector2d>& observed_pixels,
+                        const ImageSize& image_size, const AutoFitOptions& options = {});
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_MODEL_SELECT_H_

@@ -1,0 +1,291 @@
+#include "camproj/model_select.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "check.h"
+
+namespace camproj {
+
+using internal::Require;
+
+namespace {
+
+// A group of intrinsics the ladder frees together, in ladder order.
+enum Group { kPrincipalPoint, kAspect, kSkew, kK1, kK2, kNumGroups };
+
+const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew", "k1", "k2"};
+// FitResult::fixed_parameters' name of each group.
+const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
+
+ParameterMode& ModeOf(FitOptions& options, int group) {
+  switch (group) {
+    case kPrincipalPoint: return options.principal_point;
+    case kAspect: return options.aspect;
+    case kSkew: return options.skew;
+    case kK1: return options.k1;
+    default: return options.k2;
+  }
+}
+
+// The free parameters' names in FitResult::sigmas that belong to a group.
+std::vector<std::string> SigmaNamesOf(int group) {
+  switch (group) {
+    case kPrincipalPoint: return {"cx", "cy"};
+    case kAspect: return {"fy"};
+    case kSkew: return {"skew"};
+    case kK1: return {"k1"};
+    default: return {"k2"};
+  }
+}
+
+struct Evaluation {
+  std::optional<FitResult> fit;  // empty: refused
+  std::string refusal;           // SceneError's message
+  double sum_squares = 0.0;
+  int num_params = 0;
+};
+
+Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                    const FitOptions& options) {
+  Evaluation e;
+  try {
+    e.fit = FitCamera(points, pixels, size, options);
+    e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
+    e.num_params = static_cast<int>(e.fit->free_parameters.size());
+  } catch (const SceneError& error) {
+    e.refusal = error.what();
+  }
+  return e;
+}
+
+// Pixels that 1 sigma of the parameter moves the image corner by: the principal point shifts
+// every pixel; focal, fy and skew scale offsets from the centre (fx: the half-diagonal, fy and
+// skew: the half-height); k1, k2 the radial displacement k r^2 (r^4) * r at the corner.
+double CornerEffectPx(const ParameterSigma& s, const Intrinsics& k, const ImageSize& size) {
+  const double half_width = 0.5 * size.width;
+  const double half_height = 0.5 * size.height;
+  const double corner_px = std::hypot(half_width, half_height);
+  const double corner_normalized = corner_px / std::sqrt(k.fx * k.fy);
+  const double r2 = corner_normalized * corner_normalized;
+  if (s.name == "fx") return s.sigma * corner_px / k.fx;
+  if (s.name == "fy" || s.name == "skew") return s.sigma * half_height / k.fy;
+  if (s.name == "k1") return s.sigma * r2 * corner_px;
+  if (s.name == "k2") return s.sigma * r2 * r2 * corner_px;
+  return s.sigma;  // cx, cy
+}
+
+std::string Fixed(double value, int digits = 3) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+  return buffer;
+}
+
+}  // namespace
+
+void AutoFitOptions::Check() const {
+  fit.Check();
+  Require(fit.loss == LossType::kNone,
+          "automatic model selection compares least-squares fits: use RANSAC for outliers, or "
+          "give the model explicitly to use a robust loss");
+  Require(std::isfinite(max_corner_sigma_fraction) && max_corner_sigma_fraction > 0.0,
+          "max_corner_sigma_fraction must be positive, got ", max_corner_sigma_fraction);
+}
+
+FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
+                        const std::vector<Eigen::Vector2d>& observed_pixels,
+                        const ImageSize& image_size, const AutoFitOptions& options) {
+  options.Check();
+  if (options.fit.known_intrinsics) {
+    FitResult fit = FitCamera(points_in_world, observed_pixels, image_size, options.fit);
+    fit.candidates.push_back({fit.model, static_cast<int>(fit.free_parameters.size()), true,
+                              fit.rms_px * fit.rms_px * points_in_world.size(), fit.rms_px, 0.0,
+                              "chosen (intrinsics given)"});
+    return fit;
+  }
+
+  // RANSAC once, with the richest candidate model, then select on its consensus.
+  std::vector<Eigen::Vector3d> points = points_in_world;
+  std::vector<Eigen::Vector2d> pixels = observed_pixels;
+  FitOptions base = options.fit;
+  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
+  std::vector<int> candidates;  // groups the ladder may free
+  for (int g = 0; g < kNumGroups; ++g) {
+    if (ModeOf(base, g).kind == ParameterMode::Kind::kDefault) candidates.push_back(g);
+  }
+  std::vector<int> outliers;
+  if (base.ransac) {
+    FitOptions consensus = base;
+    for (const int g : candidates) {
+      if (g == kPrincipalPoint || g == kAspect) ModeOf(consensus, g) = ParameterMode::Free();
+    }
+    FitResult ransac_fit;
+    try {
+      ransac_fit = FitCamera(points, pixels, image_size, consensus);
+    } catch (const SceneError&) {
+      // Too much freedom for the scene (a plane, few points): RANSAC on the simplest model.
+      ransac_fit = FitCamera(points, pixels, image_size, base);
+    }
+    outliers = ransac_fit.outliers;
+    points.clear();
+    pixels.clear();
+    for (size_t i = 0; i < points_in_world.size(); ++i) {
+      if (std::binary_search(outliers.begin(), outliers.end(), static_cast<int>(i))) continue;
+      points.push_back(points_in_world[i]);
+      pixels.push_back(observed_pixels[i]);
+    }
+    base.ransac = false;
+  }
+  const double num_equations = 2.0 * static_cast<double>(points.size());
+
+  // The pixel noise: given, or from the richest model the scene supports (dropping groups from
+  // the top of the ladder until one is fitted with residual degrees of freedom to spare).
+  double sigma = base.pixel_sigma.value_or(0.0);
+  if (!base.pixel_sigma) {
+    for (int top = static_cast<int>(candidates.size()); top >= 0 && sigma == 0.0; --top) {
+      FitOptions richest = base;
+      richest.compute_uncertainty = false;
+      for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
+      const Evaluation e = Evaluate(points, pixels, image_size, richest);
+      if (e.fit && num_equations > e.num_params) {
+        sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
+      }
+    }
+    if (sigma == 0.0) sigma = kMinNoisePx;  // no model leaves a residual: the simplest decides
+  }
+  const bool aic = options.criterion == ModelCriterion::kAic;
+  const char* criterion_name = aic ? "AIC" : "BIC";
+  auto criterion_of = [&](const Evaluation& e) {
+    const double penalty = aic ? 2.0 : std::log(num_equations);
+    return e.sum_squares / (sigma * sigma) + penalty * e.num_params;
+  };
+  const double corner_bound_px = options.max_corner_sigma_fraction *
+                                 std::hypot(0.5 * image_size.width, 0.5 * image_size.height);
+
+  std::vector<ModelCandidate> tried;
+  auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
+    ModelCandidate c;
+    c.name = name;
+    c.fitted = e.fit.has_value();
+    if (e.fit) {
+      c.name = e.fit->model;
+      c.num_params = e.num_params;
+      c.sum_squares_px2 = e.sum_squares;
+      c.rms_px = e.fit->rms_px;
+      c.criterion = criterion_of(e);
+    }
+    c.verdict = verdict;
+    tried.push_back(c);
+    return tried.size() - 1;
+  };
+
+  // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
+  base.pixel_sigma = sigma;
+  base.compute_uncertainty = true;
+
+  // The simplest model: pose + focal with the forced groups. Its refusal is the caller's.
+  FitOptions current_options = base;
+  Evaluation current = Evaluate(points, pixels, image_size, current_options);
+  if (!current.fit) FitCamera(points, pixels, image_size, current_options);  // rethrows
+  size_t current_index = record(current, "", "simplest model");
+  std::vector<int> included;
+  std::string why_left_out[kNumGroups];
+
+  for (;;) {
+    int best_group = -1;
+    size_t best_index = 0;
+    Evaluation best;
+    FitOptions best_options;
+    for (const int g : candidates) {
+      if (std::find(included.begin(), included.end(), g) != included.end()) continue;
+      if (g == kK2 && std::find(included.begin(), included.end(), kK1) == included.end() &&
+          std::find(candidates.begin(), candidates.end(), kK1) != candidates.end()) {
+        why_left_out[g] = "left out: not tried, k1 is not in the model";
+        continue;
+      }
+      FitOptions trial_options = current_options;
+      ModeOf(trial_options, g) = ParameterMode::Free();
+      Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
+      const std::string name = current.fit->model + "+" + kGroupNames[g];
+      if (!trial.fit) {
+        why_left_out[g] = "left out: not determined (the fit with it is refused: " +
+                          trial.refusal + ")";
+        record(trial, name, "not determined: refused");
+        continue;
+      }
+      double worst_effect = 0.0;
+      std::string worst_name;
+      for (const ParameterSigma& s : trial.fit->sigmas) {
+        for (const std::string& freed : SigmaNamesOf(g)) {
+          if (s.name != freed) continue;
+          const double effect = CornerEffectPx(s, trial.fit->camera.intrinsics, image_size);
+          if (!(effect <= worst_effect)) {
+            worst_effect = effect;
+            worst_name = s.name;
+          }
+        }
+      }
+      if (!(worst_effect <= corner_bound_px)) {
+        why_left_out[g] = "left out: not determined: 1 sigma of " + worst_name +
+                          " would move the image corner by " + Fixed(worst_effect) +
+                          " px (bound " + Fixed(corner_bound_px) + " px)";
+        record(trial, name, "not determined: sigma " + Fixed(worst_effect) + " px at the corner");
+        continue;
+      }
+      const double delta = criterion_of(trial) - criterion_of(current);
+      why_left_out[g] = "left out: delta " + std::string(criterion_name) + " " +
+                        (delta >= 0 ? "+" : "") + Fixed(delta) + " against " +
+                        current.fit->model + ": not supported by the data";
+      const size_t index =
+          record(trial, name, "delta " + std::string(criterion_name) + " " + Fixed(delta));
+      if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
+        best_group = g;
+        best_index = index;
+        best = std::move(trial);
+        best_options = trial_options;
+      }
+    }
+    if (best_group < 0) break;
+    included.push_back(best_group);
+    current = std::move(best);
+    current_options = best_options;
+    current_index = best_index;
+    tried[current_index].verdict += ": kept";
+  }
+
+  // The chosen model again with the caller's noise setting, so that its sigmas are reported as
+  // FitCamera reports them.
+  current_options.pixel_sigma = options.fit.pixel_sigma;
+  current_options.compute_uncertainty = options.fit.compute_uncertainty;
+  FitResult result = FitCamera(points, pixels, image_size, current_options);
+  tried[current_index].verdict = "chosen";
+  for (const int g : candidates) {
+    if (std::find(included.begin(), included.end(), g) != included.end()) continue;
+    for (FixedParameter& p : result.fixed_parameters) {
+      if (p.name == kFixedNames[g] && !why_left_out[g].empty()) p.why = why_left_out[g];
+    }
+  }
+  result.candidates = std::move(tried);
+  result.criterion = criterion_name;
+  result.selection_sigma_px = sigma;
+  if (options.fit.ransac) {
+    // Report every input point against the chosen camera, as FitCamera's RANSAC does.
+    const int n = static_cast<int>(points_in_world.size());
+    const double shift = PixelOriginShift(options.fit.pixel_origin, PixelOrigin::kCenter);
+    result.residuals_px.assign(n, Eigen::Vector2d::Constant(kInfinity));
+    for (int i = 0; i < n; ++i) {
+      const std::optional<Eigen::Vector2d> predicted =
+          PixelFromWorld(result.camera, points_in_world[i]);
+      if (predicted) result.residuals_px[i] = *predicted - observed_pixels[i] -
+                                              Eigen::Vector2d(shift, shift);
+    }
+    result.outliers = outliers;
+  }
+  return result;
+}
+
+}  // namespace camproj

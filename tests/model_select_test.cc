@@ -1,0 +1,153 @@
+#include "camproj/model_select.h"
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "camproj/synth.h"
+#include "test_scenes.h"
+
+namespace camproj {
+namespace {
+
+bool HasWhy(const FitResult& fit, const std::string& name, const std::string& why_prefix) {
+  for (const FixedParameter& p : fit.fixed_parameters) {
+    if (p.name == name) return p.why.rfind(why_prefix, 0) == 0;
+  }
+  return false;
+}
+
+SynthScene Projector(uint64_t seed, int num_points, double noise_px, double cy_offset,
+                     double aspect = 1.0) {
+  SynthOptions synth;
+  synth.seed = seed;
+  synth.num_points = num_points;
+  synth.noise_px = noise_px;
+  synth.principal_point_offset = Eigen::Vector2d(0.0, cy_offset);
+  synth.aspect = aspect;
+  return SynthesizeScene(synth);
+}
+
+FitResult Auto(const SynthScene& scene, const AutoFitOptions& options = {}) {
+  return FitCameraAuto(scene.correspondences.points_in_world, scene.correspondences.pixels,
+                       scene.truth.image_size, options);
+}
+
+// A gluPerspective camera (square pixels, centred principal point) with 1 px noise: every extra
+// group is null, so BIC frees one only when its chi-square(1) drop in J / sigma^2 exceeds
+// ln(2N) = ln 60 = 4.09: P = 4.3 % per candidate, at most 4 candidates in the first round, so
+// P(overfit) <= 17 % per scene (union bound; the noise estimate's own spread adds a little).
+// Over 200 scenes the count of overfits is binomial(200, <= 0.17): mean <= 34, sd 5.3; the
+// bound 55 is 4 sd above.
+TEST(ModelSelectTest, PerspectiveCameraKeepsTheSimplestModel) {
+  int simplest = 0;
+  for (uint64_t seed = 1; seed <= 200; ++seed) {
+    const FitResult fit = Auto(Projector(seed, 30, 1.0, 0.0));
+    if (fit.model == "pose+focal") ++simplest;
+    // Every candidate not in the model is listed with its reason.
+    for (const char* name : {"aspect", "principal point", "skew", "k1", "k2"}) {
+      if (fit.model.find(name == std::string("principal point") ? "principal-point" : name) ==
+          std::string::npos) {
+        EXPECT_TRUE(HasWhy(fit, name, "left out: ")) << "seed " << seed << " " << name;
+      }
+    }
+  }
+  EXPECT_GE(simplest, 200 - 55);
+  RecordProperty("simplest_of_200", simplest);
+}
+
+// Effects far above the noise are always kept: a principal point at the bottom edge moves every
+// pixel by ~540 px against 0.5 px noise; an aspect of 1.05 moves the image's top edge by ~27 px.
+TEST(ModelSelectTest, KeepsWhatTheDataNeed) {
+  for (uint64_t seed = 1; seed <= 50; ++seed) {
+    const FitResult projector = Auto(Projector(seed, 30, 0.5, 0.5));
+    EXPECT_NE(projector.model.find("principal-point"), std::string::npos)
+        << "seed " << seed << ": " << projector.model;
+    const FitResult stretched = Auto(Projector(seed, 30, 0.5, 0.0, 1.05));
+    EXPECT_NE(stretched.model.find("aspect"), std::string::npos)
+        << "seed " << seed << ": " << stretched.model;
+  }
+}
+
+// Radial distortion k1 = -0.2 at a 60 degree horizontal field of view in 1280 x 800 (corner at
+// normalized radius 0.68) moves the corner by ~70 px against 0.5 px noise: kept, and the fitted
+// k1 is within 5 of the reported sigmas of the truth (two-sided Gaussian 5 sigma: 6e-7 per
+// check).
+TEST(ModelSelectTest, KeepsRadialDistortionWhenTheLensHasIt) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    testing::RandomCamera camera = testing::MakeRandomCamera(rng);
+    camera.size = {1280, 800};
+    Intrinsics& k = camera.intrinsics;
+    k.fx = k.fy = 640.0 / std::tan(30.0 * M_PI / 180.0);
+    k.cx = 639.5;
+    k.cy = 399.5;
+    k.skew = 0.0;
+    k.k1 = -0.2;
+    testing::SceneOptions scene_options;
+    scene_options.num_points = 100;
+    scene_options.pixel_noise = 0.5;
+    const testing::Scene scene = testing::MakeScene(rng, camera, scene_options);
+    const FitResult fit =
+        FitCameraAuto(scene.points_in_world, scene.observed_pixels, camera.size);
+    ASSERT_NE(fit.model.find("k1"), std::string::npos) << "trial " << trial << ": " << fit.model;
+    for (const ParameterSigma& s : fit.sigmas) {
+      if (s.name == "k1") EXPECT_LE(std::abs(s.value - -0.2), 5.0 * s.sigma) << "trial " << trial;
+    }
+  }
+}
+
+// One view of a plane cannot determine the principal point with the focal length: it is left
+// out as not determined (the fit with it is refused), never fitted.
+TEST(ModelSelectTest, PlaneLeavesOutWhatItCannotDetermine) {
+  SynthOptions synth;
+  synth.object = SynthObject::kPlane;
+  synth.num_points = 30;
+  synth.noise_px = 0.5;
+  const SynthScene scene = SynthesizeScene(synth);
+  const FitResult fit = Auto(scene);
+  EXPECT_EQ(fit.model.find("principal-point"), std::string::npos) << fit.model;
+  EXPECT_TRUE(HasWhy(fit, "principal point", "left out: not determined")) << fit.model;
+}
+
+// The caller's choices bind: a forced parameter is in every model tried, a given one in none.
+TEST(ModelSelectTest, ForcedAndGivenParametersAreRespected) {
+  const SynthScene scene = Projector(3, 30, 0.5, 0.5);
+  AutoFitOptions options;
+  options.fit.skew = ParameterMode::Free();
+  options.fit.principal_point = ParameterMode::Fixed(959.5, 1079.5);
+  const FitResult fit = Auto(scene, options);
+  for (const ModelCandidate& c : fit.candidates) {
+    EXPECT_NE(c.name.find("skew"), std::string::npos) << c.name;
+    EXPECT_EQ(c.name.find("principal-point"), std::string::npos) << c.name;
+  }
+  EXPECT_TRUE(HasWhy(fit, "principal point", "given")) << fit.model;
+  EXPECT_EQ(fit.candidates.back().verdict.empty(), false);
+}
+
+// Noise-free data of an off-axis camera: the selection noise floors at kMinNoisePx, the
+// principal point is kept and the camera recovered exactly (1e-9 relative, as FitCamera).
+TEST(ModelSelectTest, ExactDataGiveTheExactCamera) {
+  const SynthScene scene = Projector(5, 20, 0.0, 0.5);
+  const FitResult fit = Auto(scene);
+  EXPECT_EQ(fit.model, "pose+focal+principal-point");
+  EXPECT_EQ(fit.selection_sigma_px, kMinNoisePx);
+  EXPECT_NEAR(fit.camera.intrinsics.fx, scene.truth.intrinsics.fx, 1e-9 * scene.truth.intrinsics.fx);
+  EXPECT_NEAR(fit.camera.intrinsics.cy, scene.truth.intrinsics.cy, 1e-9 * scene.truth.intrinsics.fx);
+}
+
+TEST(ModelSelectTest, RobustLossIsRefusedWithTheAlternative) {
+  AutoFitOptions options;
+  options.fit.loss = LossType::kHuber;
+  try {
+    options.Check();
+    ADD_FAILURE() << "a robust loss was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("RANSAC"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace camproj
