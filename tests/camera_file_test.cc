@@ -63,6 +63,28 @@ TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
   }
 }
 
+// An orthographic camera keeps its projection through the file; its glOrtho box is written, and
+// no frustum or perspective (they do not exist for it).
+TEST(CameraFileTest, OrthographicCameraRoundTrips) {
+  std::mt19937_64 rng(9);
+  Camera camera = RandomFileCamera(rng);
+  camera.projection = Projection::kOrthographic;
+  camera.intrinsics.k1 = 0.0;
+  camera.intrinsics.skew = 0.0;
+  const std::string text = CameraToJsonText(camera);
+  EXPECT_NE(text.find("\"orthographic\""), std::string::npos);
+  EXPECT_NE(text.find("\"ortho\""), std::string::npos);
+  EXPECT_EQ(text.find("\"perspective\": {"), std::string::npos);
+  const Camera back = CameraFromJsonText(text, "test");
+  EXPECT_EQ(back.projection, Projection::kOrthographic);
+  EXPECT_EQ(back.intrinsics.fx, camera.intrinsics.fx);
+  EXPECT_EQ(back.z_far, camera.z_far);
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "projection": "fisheye",
+    "intrinsics": {"fx": 500, "fy": 500, "cx": 319.5, "cy": 239.5},
+    "look_at": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "frustum": {"near": 0.1, "far": 10}})").find("projection"), std::string::npos);
+}
+
 TEST(CameraFileTest, InfiniteFarAndLookAtPoseAreRead) {
   const Camera camera = CameraFromJsonText(R"({
     "image_size": [640, 480],

@@ -621,6 +621,28 @@ TEST(ExportJsonTest, CameraFileReadsBackBitForBit) {
   }
 }
 
+// OpenCV's and COLMAP's camera models are perspective: an orthographic camera is refused by
+// name; the GL formats carry it (the matrix is tested in gl_test and render_test).
+TEST(ExportCameraTest, OrthographicCameraOnlyWhereTheFormatHasIt) {
+  Camera camera;
+  camera.image_size = {640, 480};
+  camera.projection = Projection::kOrthographic;
+  camera.intrinsics.fx = camera.intrinsics.fy = 100.0;
+  camera.intrinsics.cx = 319.5;
+  camera.intrinsics.cy = 239.5;
+  camera.cam_from_world.translation = Eigen::Vector3d(0, 0, 5);
+  for (const ExportFormat format : {ExportFormat::kOpenCvYaml, ExportFormat::kColmap}) {
+    try {
+      ExportCamera(camera, format);
+      ADD_FAILURE() << ToString(format) << " exported an orthographic camera";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("orthographic"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NE(ExportCamera(camera, ExportFormat::kThree).find("OrthographicCamera"), std::string::npos);
+  EXPECT_NE(ExportCamera(camera, ExportFormat::kGl).find("orthographic"), std::string::npos);
+}
+
 TEST(ExportCameraTest, InvalidCameraIsRefusedByEveryFormat) {
   Camera camera;
   camera.image_size = {640, 480};

@@ -9,6 +9,7 @@
 #include <glm/ext/matrix_clip_space.hpp>
 #include <gtest/gtest.h>
 
+#include "camproj/camera.h"
 #include "camproj/look_at.h"
 #include "glm_compare.h"
 #include "test_scenes.h"
@@ -95,6 +96,82 @@ TEST(GlTest, OrthoEqualsGlm) {
                   ClipFromGlEyeOrtho(o, ClipDepth::kZeroToOne),
                   testing::FromGlm(glm::orthoRH_ZO(o.left, o.right, o.bottom, o.top, o.z_near, o.z_far))),
               kExactRelative);
+  }
+}
+
+// An orthographic camera's matrix is glOrtho's (glm's orthoRH_NO / _ZO) of its box when skew is
+// 0, and through GL's pipeline it puts every point on camera.h's pixel (fx x + skew y + cx,
+// fy y + cy) with the window depth linear from near (0; 1 reversed) to far, for every depth
+// convention and pixel origin. Double arithmetic on O(1e3) px: 1e-9 px as above.
+TEST(GlTest, OrthographicCameraEqualsGlOrthoAndItsPixels) {
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 500; ++i) {
+    testing::RandomCamera camera = testing::MakeRandomCamera(rng);
+    Intrinsics& k = camera.intrinsics;
+    k.fx = testing::LogUniform(rng, 1e-2, 1e4);  // px per world unit
+    k.fy = k.fx * testing::LogUniform(rng, 0.5, 2.0);
+    const double z_near = testing::LogUniform(rng, 1e-3, 1.0);
+    const double z_far = z_near + testing::LogUniform(rng, 1e-2, 1e4);
+    Intrinsics unskewed = k;
+    unskewed.skew = 0.0;
+    const Ortho box = OrthoFromOrthographic(unskewed, camera.size, z_near, z_far);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEyeOrthographic(unskewed, camera.size, z_near, z_far),
+                  testing::FromGlm(glm::orthoRH_NO(box.left, box.right, box.bottom, box.top,
+                                                   box.z_near, box.z_far))),
+              kExactRelative);
+    EXPECT_LT(testing::RelativeDifference(
+                  ClipFromGlEyeOrthographic(unskewed, camera.size, z_near, z_far,
+                                            {ClipDepth::kZeroToOne, false}),
+                  testing::FromGlm(glm::orthoRH_ZO(box.left, box.right, box.bottom, box.top,
+                                                   box.z_near, box.z_far))),
+              kExactRelative);
+    Camera ortho;
+    ortho.image_size = camera.size;
+    ortho.projection = Projection::kOrthographic;
+    ortho.intrinsics = k;
+    ortho.cam_from_world = camera.cam_from_world;
+    ortho.z_near = z_near;
+    ortho.z_far = z_far;
+    const Eigen::Matrix4d view = GlEyeFromWorld(camera.cam_from_world);
+    for (int j = 0; j < 4; ++j) {
+      const Eigen::Vector2d pixel = testing::RandomPixelInImage(rng, camera.size);
+      const double depth = testing::Uniform(rng, z_near, z_far);
+      // The cam point at that pixel and depth: invert the affine map.
+      const double y = (pixel.y() - k.cy) / k.fy;
+      const double x = (pixel.x() - k.cx - k.skew * y) / k.fx;
+      const Eigen::Vector3d point_in_world = Inverse(camera.cam_from_world) * Eigen::Vector3d(x, y, depth);
+      const std::optional<Eigen::Vector2d> expected = PixelFromWorld(ortho, point_in_world);
+      ASSERT_TRUE(expected.has_value());
+      EXPECT_LT((*expected - pixel).norm(), kPixelAgreement * std::max(1.0, k.fx * std::abs(x)));
+      for (const GlDepth& depth_convention : kAllDepths) {
+        for (const PixelOrigin origin : {PixelOrigin::kCenter, PixelOrigin::kCorner}) {
+          const Eigen::Matrix4d projection = ClipFromGlEyeOrthographic(
+              ConvertPixelOrigin(k, PixelOrigin::kCenter, origin), camera.size, z_near, z_far,
+              depth_convention, origin);
+          const GlPixel gl = GlPixelFromWorld(projection, view, point_in_world, camera.size,
+                                              depth_convention.clip_depth, origin);
+          EXPECT_LT((gl.pixel - ConvertPixelOrigin(*expected, PixelOrigin::kCenter, origin)).norm(),
+                    kPixelAgreement * std::max(1.0, k.fx * std::abs(x)))
+              << "camera " << i;
+          const double linear = (depth - z_near) / (z_far - z_near);
+          // The world point's coordinates carry rounding of ~1e-16 of their size, which the
+          // depth row divides by far - near (a 1e6-unit-wide view with a 0.01-deep range makes
+          // 1e-8): a few ulps of that, plus the window arithmetic's own.
+          const double world_size =
+              std::max({std::abs(x), std::abs(y), depth, camera.cam_from_world.translation.norm()});
+          EXPECT_NEAR(gl.window_depth, depth_convention.reversed_z ? 1.0 - linear : linear,
+                      1e-15 * world_size / (z_far - z_near) + 1e-14)
+              << "camera " << i;
+        }
+      }
+    }
+    // No orthographic limit of an infinite far plane; distortion is not orthographic.
+    EXPECT_THROW(ClipFromGlEyeOrthographic(k, camera.size, z_near, kInfinity), std::invalid_argument);
+    Intrinsics distorted = k;
+    distorted.k1 = 0.1;
+    EXPECT_THROW(ClipFromGlEyeOrthographic(distorted, camera.size, z_near, z_far),
+                 std::invalid_argument);
   }
 }
 

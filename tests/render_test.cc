@@ -37,6 +37,7 @@
 
 #include "camproj/conventions.h"
 #include "camproj/gl.h"
+#include "camproj/camera.h"
 #include "camproj/intrinsics.h"
 #include "camproj/look_at.h"
 #include "camproj/pose.h"
@@ -502,6 +503,7 @@ struct CameraCase {
   const char* name;
   Intrinsics intrinsics;  // kCenter
   LookAt look_at;
+  Projection projection = Projection::kPerspective;
 };
 
 CameraCase Centered() {
@@ -542,6 +544,32 @@ CameraCase Skewed() {
   return camera;
 }
 
+// Orthographic with skew and an off-centre axis: 36 px per world unit shows a 4.4 x 3.3 window
+// of the scene; the eye sits 4.7 units from the box, in front of everything it sees.
+CameraCase Orthographic() {
+  CameraCase camera{"Orthographic", {}, {}, Projection::kOrthographic};
+  camera.intrinsics.fx = 36.0;
+  camera.intrinsics.fy = 37.5;
+  camera.intrinsics.skew = 3.0;
+  camera.intrinsics.cx = 83.2;
+  camera.intrinsics.cy = 55.7;
+  camera.look_at.eye = Eigen::Vector3d(3.0, 2.0, 2.6);
+  camera.look_at.target = Eigen::Vector3d(0.1, -0.1, 0.05);
+  camera.look_at.up = Eigen::Vector3d(0.15, 1.0, -0.1);
+  return camera;
+}
+
+// The pixel of a point in cam under the case's projection (double precision, from
+// camera.h's definitions, not from the GL matrices).
+Eigen::Vector2d ExpectedPixel(const CameraCase& camera, const Eigen::Vector3d& point_in_cam) {
+  const Intrinsics& k = camera.intrinsics;
+  if (camera.projection == Projection::kOrthographic) {
+    return {k.fx * point_in_cam.x() + k.skew * point_in_cam.y() + k.cx,
+            k.fy * point_in_cam.y() + k.cy};
+  }
+  return PixelFromCam(k, point_in_cam);
+}
+
 struct DepthCase {
   const char* name;
   GlDepth depth;
@@ -556,9 +584,13 @@ using RenderParam = std::tuple<CameraCase, DepthCase>;
 // The window depth the pinhole model predicts at cam-frame depth z (> 0) for glDepthRange(0, 1),
 // from first principles rather than from the projection matrix: both NO and ZO map z = n to 0 and
 // z = f to 1 hyperbolically, i.e. f (z - n) / ((f - n) z); reversed-Z is 1 minus that.
-double ExpectedWindowDepth(double z, bool reversed_z) {
+// Orthographic: linear, (z - n) / (f - n).
+double ExpectedWindowDepth(double z, bool reversed_z, Projection projection) {
   const double n = kZNear;
   const double f = kZFar;
+  if (projection == Projection::kOrthographic) {
+    return reversed_z ? (f - z) / (f - n) : (z - n) / (f - n);
+  }
   return reversed_z ? n * (f - z) / ((f - n) * z) : f * (z - n) / ((f - n) * z);
 }
 
@@ -590,7 +622,9 @@ TEST_P(RenderTest, PointsProjectOntoTheirPixelsWithTheExpectedDepth) {
   const Rigid3 cam_from_world = CamFromWorldFromLookAt(camera.look_at);
   RenderSettings settings;
   settings.clip_from_gl_eye =
-      ClipFromGlEye(camera.intrinsics, kImageSize, kZNear, kZFar, depth_case.depth);
+      camera.projection == Projection::kOrthographic
+          ? ClipFromGlEyeOrthographic(camera.intrinsics, kImageSize, kZNear, kZFar, depth_case.depth)
+          : ClipFromGlEye(camera.intrinsics, kImageSize, kZNear, kZFar, depth_case.depth);
   settings.gl_eye_from_world = GlEyeFromWorld(cam_from_world);
   settings.clip_depth = depth_case.depth.clip_depth;
   settings.reversed_z = depth_case.depth.reversed_z;
@@ -622,7 +656,7 @@ TEST_P(RenderTest, PointsProjectOntoTheirPixelsWithTheExpectedDepth) {
       const Eigen::Vector3d point_in_world(rgba[0], rgba[1], rgba[2]);
       const Eigen::Vector3d point_in_cam = cam_from_world * point_in_world;
       const Eigen::Vector2d pixel(i, height - 1 - j);  // see the file comment
-      const Eigen::Vector2d projection = PixelFromCam(camera.intrinsics, point_in_cam);
+      const Eigen::Vector2d projection = ExpectedPixel(camera, point_in_cam);
       const double pixel_error = (projection - pixel).norm();
       if (!(pixel_error <= max_pixel_error)) {  // also keeps a NaN
         max_pixel_error = pixel_error;
@@ -630,7 +664,7 @@ TEST_P(RenderTest, PointsProjectOntoTheirPixelsWithTheExpectedDepth) {
         worst_projection = projection;
       }
       const double expected_depth =
-          ExpectedWindowDepth(point_in_cam.z(), depth_case.depth.reversed_z);
+          ExpectedWindowDepth(point_in_cam.z(), depth_case.depth.reversed_z, camera.projection);
       max_depth_error = std::max(max_depth_error, std::abs(readback.depth[index] - expected_depth));
 
       int face_index = -1;
@@ -667,7 +701,8 @@ TEST_P(RenderTest, PointsProjectOntoTheirPixelsWithTheExpectedDepth) {
   EXPECT_GE(background_pixels, kMinPixelsPerSurface);
   int front_faces = 0;
   for (int i = 0; i < 6; ++i) {
-    if (!kBoxFaces[i].FacesCamera(camera.look_at.eye)) continue;
+    if (!kBoxFaces[i].FacesCamera(camera.look_at.eye)) continue;  // for the ortho case too:
+                                                                   // its eye sees the same faces
     ++front_faces;
     EXPECT_GE(face_pixels[i], kMinPixelsPerSurface) << "box face " << i;
   }
@@ -680,7 +715,7 @@ std::string ParamName(const testing::TestParamInfo<RenderParam>& info) {
 
 INSTANTIATE_TEST_SUITE_P(
     CamerasAndDepths, RenderTest,
-    testing::Combine(testing::Values(Centered(), Projector(), Skewed()),
+    testing::Combine(testing::Values(Centered(), Projector(), Skewed(), Orthographic()),
                      testing::Values(DepthCase{"NegativeOneToOne",
                                                {ClipDepth::kNegativeOneToOne, false}},
                                      DepthCase{"ZeroToOne", {ClipDepth::kZeroToOne, false}},

@@ -74,8 +74,14 @@ Command AddExportCommand(CLI::App& root) {
             options.pixel_origin = PixelOriginFromString(args->pixel_origin);
             const ExportFormat format = ExportFormatFromString(args->to);
             // Depth-precision advice (docs/exports.md) on stderr, so stdout stays the export.
-            if (format == ExportFormat::kGl || format == ExportFormat::kGlm ||
-                format == ExportFormat::kThree) {
+            const bool gl_like = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
+                                 format == ExportFormat::kThree;
+            if (gl_like && camera.projection == Projection::kOrthographic && !args->quiet) {
+              // Orthographic depth is linear: the same step everywhere.
+              std::cerr << "camproj: note: orthographic depth is linear in distance: the 24-bit "
+                           "step is (far - near) / 2^24 = "
+                        << (camera.z_far - camera.z_near) / 16777216.0 << " world units\n";
+            } else if (gl_like) {
               const DepthAdvice advice = AdviseDepth(camera.z_near, camera.z_far, options.depth);
               for (const std::string& warning : advice.warnings) {
                 std::cerr << "camproj: warning: " << warning << '\n';

@@ -131,6 +131,14 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   camera.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
 
   camera.intrinsics = ReadIntrinsics(document, reader);
+  if (document.contains("projection")) {
+    const json& projection = document.at("projection");
+    if (projection == "orthographic") {
+      camera.projection = Projection::kOrthographic;
+    } else if (projection != "perspective") {
+      reader.Fail("projection", "expected \"perspective\" or \"orthographic\"");
+    }
+  }
 
   try {
     if (document.contains("cam_from_world")) {
@@ -195,6 +203,8 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
   json document;
   document["image_size"] = {camera.image_size.width, camera.image_size.height};
   document["pixel_origin"] = ToString(options.pixel_origin);
+  const bool orthographic = camera.projection == Projection::kOrthographic;
+  document["projection"] = orthographic ? "orthographic" : "perspective";
   document["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy},     {"cx", k.cx}, {"cy", k.cy},
                             {"skew", k.skew}, {"k1", k.k1}, {"k2", k.k2}};
   json rows = json::array();
@@ -205,7 +215,15 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
   document["look_at"] = {{"eye", Vector3Json(views.look_at.eye)},
                          {"target", Vector3Json(views.look_at.target)},
                          {"up", Vector3Json(views.look_at.up)}};
-  if (views.frustum) {
+  if (orthographic) {
+    document["frustum"] = {{"near", camera.z_near}, {"far", camera.z_far},
+                           {"note", "orthographic: no frustum; fx, fy, skew are px per world unit"}};
+    if (views.ortho) {
+      const Ortho& o = *views.ortho;
+      document["ortho"] = {{"left", o.left}, {"right", o.right}, {"bottom", o.bottom},
+                           {"top", o.top},   {"near", o.z_near}, {"far", o.z_far}};
+    }
+  } else if (views.frustum) {
     const Frustum& f = *views.frustum;
     document["frustum"] = {{"left", f.left}, {"right", f.right}, {"bottom", f.bottom},
                            {"top", f.top},   {"near", f.z_near}, {"far", FarJson(f.z_far)}};

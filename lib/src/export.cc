@@ -91,6 +91,7 @@ std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
               ? " (glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE))"
               : " ([-1,1], GL default)")
       << (options.depth.reversed_z ? ", reversed-Z (glDepthFunc(GL_GREATER), clear depth 0)" : "")
+      << (camera.projection == Projection::kOrthographic ? "; orthographic" : "")
       << "; near " << camera.z_near << ", far " << camera.z_far << "; viewport 0 0 "
       << camera.image_size.width << ' ' << camera.image_size.height << '\n';
   if (camera.intrinsics.HasDistortion()) {
@@ -127,6 +128,9 @@ std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
   out << "// camproj glm export: projection = clip_from_gl_eye, view = gl_eye_from_world.\n"
       << "// #include <glm/glm.hpp> and <glm/gtc/type_ptr.hpp>. glm is column-major: the\n"
       << "// 16-number glm::dmat4 constructor takes column 0 first, the order GL uploads.\n"
+      << (camera.projection == Projection::kOrthographic
+              ? "// Orthographic (glOrtho form when skew is 0; fx, fy in px per world unit).\n"
+              : "")
       << "// Depth " << DepthSummary(options.depth) << "; near " << camera.z_near << ", far "
       << camera.z_far << ".\n"
       << "// GL state: glViewport(0, 0, " << camera.image_size.width << ", "
@@ -175,7 +179,13 @@ void RequireNoSkew(const Camera& camera, const char* format, const char* why) {
                     " px (fit with skew fixed at 0, or export to gl, glm, three or json)");
 }
 
+void RequirePerspective(const Camera& camera, const char* format) {
+  internal::Require(camera.projection == Projection::kPerspective, format,
+                    " has no orthographic camera model: export to gl, glm, three or json");
+}
+
 std::string ExportOpenCvYamlText(const Camera& camera) {
+  RequirePerspective(camera, "opencv-yaml");
   camera.Check();
   RequireNoSkew(camera, "opencv-yaml",
                 "OpenCV's camera model has no skew (cv::projectPoints ignores camera_matrix(0,1))");
@@ -205,6 +215,7 @@ std::string ExportOpenCvYamlText(const Camera& camera) {
 double WithoutNegativeZero(double value) { return value + 0.0; }
 
 std::string ExportColmapText(const Camera& camera) {
+  RequirePerspective(camera, "colmap");
   camera.Check();
   RequireNoSkew(camera, "colmap", "no COLMAP camera model (PINHOLE, OPENCV, ...) has skew");
   const Intrinsics k =
@@ -261,7 +272,19 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
   // Why three's updateProjectionMatrix() cannot rebuild projectionMatrix, if it cannot.
   std::string no_rebuild;
   std::string off_axis;
-  if (views.frustum) {
+  if (camera.projection == Projection::kOrthographic) {
+    // THREE.OrthographicCamera(left, right, top, bottom, near, far): the glOrtho box.
+    document["type"] = "OrthographicCamera";
+    if (views.ortho) {
+      document["left"] = views.ortho->left;
+      document["right"] = views.ortho->right;
+      document["top"] = views.ortho->top;
+      document["bottom"] = views.ortho->bottom;
+    } else {
+      no_rebuild += " skew != 0 (no left, right, top, bottom form);";
+    }
+  } else if (views.frustum) {
+    document["type"] = "PerspectiveCamera";
     // Enlarge the frustum to one centred on the gaze and show the image as a window of it, in
     // units of s = W / (r - l) per near-plane unit on both axes, so that fullWidth / fullHeight
     // is the full view's aspect (setViewOffset sets aspect to it). Exactly centred: no window.
@@ -304,7 +327,10 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
       "projectionMatrix is exact: camera.projectionMatrix.fromArray(projectionMatrix); "
       "camera.projectionMatrixInverse.copy(camera.projectionMatrix).invert(). "
       "camera.updateProjectionMatrix() (which resize handlers call, and the renderer too when "
-      "reversedDepthBuffer is on) rebuilds it from fov, aspect, near, far, zoom and view: ";
+      "reversedDepthBuffer is on) rebuilds it from " +
+      std::string(camera.projection == Projection::kOrthographic
+                      ? "left, right, top, bottom, near, far and zoom: "
+                      : "fov, aspect, near, far, zoom and view: ");
   if (depth.clip_depth == ClipDepth::kNegativeOneToOne && depth.reversed_z) {
     no_rebuild += " three has no [-1, 1] reversed-Z depth;";
   }

@@ -1,6 +1,7 @@
 #include "camproj/gl.h"
 
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -107,6 +108,53 @@ Eigen::Matrix4d ClipFromGlEyeOrtho(const Ortho& ortho, ClipDepth clip_depth) {
     m(2, 3) = -ortho.z_near / depth;
   }
   return m;
+}
+
+Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const ImageSize& size,
+                                          double z_near, double z_far, const GlDepth& depth,
+                                          PixelOrigin origin) {
+  intrinsics.Check();
+  size.Check();
+  Require(!intrinsics.HasDistortion(), "an orthographic camera has no distortion, got k1 = ",
+          intrinsics.k1, ", k2 = ", intrinsics.k2);
+  Require(std::isfinite(z_near) && std::isfinite(z_far) && z_far > z_near,
+          "an orthographic projection needs finite near < far, got near ", z_near, ", far ", z_far);
+  // Corner convention, x_eye = x_cam, y_eye = -y_cam, z_eye = -z_cam:
+  //   u = fx x_cam + skew y_cam + cx,  x_ndc = 2 u / W - 1;
+  //   v = fy y_cam + cy,               y_ndc = 1 - 2 v / H.
+  const Intrinsics k = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCorner);
+  const double w = size.width;
+  const double h = size.height;
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m(0, 0) = 2.0 * k.fx / w;
+  m(0, 1) = -2.0 * k.skew / w + 0.0;
+  m(0, 3) = 2.0 * k.cx / w - 1.0;
+  m(1, 1) = 2.0 * k.fy / h;
+  m(1, 3) = 1.0 - 2.0 * k.cy / h;
+  // z_ndc = a z_eye + b through (-z_near, ndc_near) and (-z_far, ndc_far).
+  const bool zo = depth.clip_depth == ClipDepth::kZeroToOne;
+  double ndc_near = zo ? 0.0 : -1.0;
+  double ndc_far = 1.0;
+  if (depth.reversed_z) std::swap(ndc_near, ndc_far);
+  const double a = (ndc_near - ndc_far) / (z_far - z_near);
+  m(2, 2) = a;
+  m(2, 3) = ndc_near + a * z_near;
+  return m;
+}
+
+Ortho OrthoFromOrthographic(const Intrinsics& intrinsics, const ImageSize& size, double z_near,
+                            double z_far, PixelOrigin origin) {
+  Require(intrinsics.skew == 0.0, "skew ", intrinsics.skew, " has no glOrtho form");
+  const Eigen::Matrix4d m = ClipFromGlEyeOrthographic(intrinsics, size, z_near, z_far, {}, origin);
+  // x_ndc = m00 x + m03 = -1 at left, +1 at right; likewise y.
+  Ortho ortho;
+  ortho.left = (-1.0 - m(0, 3)) / m(0, 0);
+  ortho.right = (1.0 - m(0, 3)) / m(0, 0);
+  ortho.bottom = (-1.0 - m(1, 3)) / m(1, 1);
+  ortho.top = (1.0 - m(1, 3)) / m(1, 1);
+  ortho.z_near = z_near;
+  ortho.z_far = z_far;
+  return ortho;
 }
 
 Intrinsics IntrinsicsFromClipFromGlEye(const Eigen::Matrix4d& clip_from_gl_eye,

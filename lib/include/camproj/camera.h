@@ -17,8 +17,15 @@
 
 namespace camproj {
 
+// kPerspective: a pinhole, pixel = K (x/z, y/z) (docs/conventions.md). kOrthographic: parallel
+// projection, pixel = (fx x + skew y + cx, fy y + cy) of the point in cam, fx, fy and skew in
+// px per world unit, no distortion; depth only orders points (the eye may sit anywhere on the
+// axis: a fit places it in front of every point).
+enum class Projection { kPerspective, kOrthographic };
+
 struct Camera {
   ImageSize image_size;
+  Projection projection = Projection::kPerspective;
   Intrinsics intrinsics;  // cx, cy in kCenter
   Rigid3 cam_from_world;
   double z_near = 0.1;    // depth range of the GL export, > 0
@@ -33,6 +40,7 @@ struct CameraViews {
   LookAt look_at;                          // target at target_distance along the gaze
   std::optional<Frustum> frustum;          // absent when skew != 0 (no glFrustum form)
   std::optional<Perspective> perspective;  // only when the frustum is symmetric
+  std::optional<Ortho> ortho;              // orthographic camera without skew: the glOrtho box
   Eigen::Matrix4d clip_from_gl_eye;        // projection matrix (pinhole part, skew included)
   Eigen::Matrix4d gl_eye_from_world;       // view matrix
 };
@@ -43,7 +51,7 @@ CameraViews ViewsOfCamera(const Camera& camera, double target_distance = 1.0,
                           const GlDepth& depth = {});
 
 // The pixel (kCenter) of a world point, distortion included; std::nullopt if the point is not in
-// front of the camera (z_cam <= 0).
+// front of the camera (z_cam <= 0), for either projection.
 std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
                                               const Eigen::Vector3d& point_in_world);
 

@@ -53,6 +53,21 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
 Eigen::Matrix4d ClipFromGlEyeOrtho(const Ortho& ortho,
                                    ClipDepth clip_depth = ClipDepth::kNegativeOneToOne);
 
+// The projection matrix of an orthographic camera (camera.h): fx, fy, skew in px per world unit,
+// cx, cy where the optical axis meets the image (in `origin`). x_ndc, y_ndc are affine in the
+// eye coordinates; z_ndc is linear in depth, -1 (0 for kZeroToOne) at -z_near and +1 at -z_far,
+// swapped by reversed_z. Equals ClipFromGlEyeOrtho of OrthoFromOrthographic's box when skew is
+// 0 and not reversed. Throws on distortion, an infinite far plane (no orthographic limit) or
+// z_far <= z_near.
+Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const ImageSize& size,
+                                          double z_near, double z_far, const GlDepth& depth = {},
+                                          PixelOrigin origin = PixelOrigin::kCenter);
+
+// The glOrtho box of an orthographic camera without skew (the eye-space extents the image
+// covers, pixel edges included). Throws if skew != 0.
+Ortho OrthoFromOrthographic(const Intrinsics& intrinsics, const ImageSize& size, double z_near,
+                            double z_far, PixelOrigin origin = PixelOrigin::kCenter);
+
 // Intrinsics (fx, fy, skew; cx, cy in `origin`) of a perspective projection matrix built as
 // above for the image size. The matrix may carry any positive overall scale (clip.w > 0 in front
 // of the camera). Throws
