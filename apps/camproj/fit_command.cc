@@ -104,7 +104,22 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   request.automatic = args.model == "auto" && args.intrinsics_path.empty();
   FitOptions& options = request.auto_options.fit;
   options.pixel_origin = PixelOriginFromString(args.pixel_origin);
-  if (args.model != "auto") {
+  const std::string orthographic = "orthographic";
+  if (args.model.rfind(orthographic, 0) == 0) {
+    // "orthographic[+aspect][+skew]": the scale (focal) is always free.
+    options.projection = Projection::kOrthographic;
+    for (const std::string& name : kParameterNames) *ModeOf(options, name) = ParameterMode::Default();
+    options.focal = ParameterMode::Free();
+    if (args.model.size() > orthographic.size()) {
+      if (args.model[orthographic.size()] != '+') throw UsageError("--model: unknown model \"" + args.model + "\"");
+      for (const std::string& name : ModelNames(args.model.substr(orthographic.size() + 1))) {
+        if (name != "aspect" && name != "skew") {
+          throw UsageError("--model: an orthographic camera has aspect and skew, not " + name);
+        }
+        *ModeOf(options, name) = ParameterMode::Free();
+      }
+    }
+  } else if (args.model != "auto") {
     // Exactly the listed intrinsics are free; the rest stay at their defaults.
     for (const std::string& name : kParameterNames) *ModeOf(options, name) = ParameterMode::Default();
     for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
@@ -320,7 +335,8 @@ Command AddFitCommand(CLI::App& root) {
   app->add_option("--model", args->model,
                   "auto (default): the simplest model the data support; or the free intrinsics "
                   "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
-                  "pose: none (with --intrinsics or fixed values)");
+                  "pose: none (with --intrinsics or fixed values); orthographic[+aspect][+skew]: "
+                  "a parallel projection (scale in px per world unit)");
   app->add_option("--criterion", args->criterion,
                   "model selection criterion: bic (default) or aic")
       ->check(CLI::IsMember({"aic", "bic"}));

@@ -16,6 +16,7 @@
 
 #include "check.h"
 #include "closed_form.h"
+#include "orthographic_fit.h"
 #include "reprojection_error.h"
 
 namespace camproj {
@@ -675,6 +676,16 @@ internal::StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& po
 }  // namespace
 
 void FitOptions::Check() const {
+  if (projection == Projection::kOrthographic) {
+    Require(!principal_point.IsFree(),
+            "an orthographic camera's principal point is not determined (it trades exactly with "
+            "its position): leave it at the image centre or give it");
+    Require(!k1.IsFree() && !k2.IsFree() && (k1.kind != ParameterMode::Kind::kFixed || k1.value == 0.0) &&
+                (k2.kind != ParameterMode::Kind::kFixed || k2.value == 0.0),
+            "an orthographic camera has no radial distortion (k1, k2)");
+    Require(!ransac, "RANSAC is for perspective cameras: use a robust loss with the orthographic one");
+    Require(!known_intrinsics, "known intrinsics are for perspective cameras");
+  }
   Require(focal.kind != ParameterMode::Kind::kDefault || known_intrinsics.has_value(),
           "focal has no default: make it free or fix it at a value");
   auto check_fixed = [](const ParameterMode& mode, const char* name) {
@@ -731,6 +742,9 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                                         points_in_world[i].transpose(), ", pixel = ",
                                         observed_pixels[i].transpose(), "): remove or fix it"));
     }
+  }
+  if (options.projection == Projection::kOrthographic) {
+    return internal::FitOrthographic(points_in_world, observed_pixels, image_size, options);
   }
   const Model start_model = MakeModel(options, image_size);
   const int num_params = 6 + start_model.NumFree();

@@ -62,7 +62,9 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   const int n = static_cast<int>(fit.residuals_px.size());
   out << "model: " << fit.model << ", " << fit.free_parameters.size()
       << " free parameters (pose";
-  for (size_t i = 6; i < fit.free_parameters.size(); ++i) out << ", " << fit.free_parameters[i];
+  for (const std::string& name : fit.free_parameters) {
+    if (name.rfind("rotation", 0) != 0 && name.rfind("eye", 0) != 0) out << ", " << name;
+  }
   out << "), " << n << " points" << (fit.planar ? " (coplanar)" : "") << ", start "
       << fit.start_method << "\n";
   if (!fit.candidates.empty()) {
@@ -112,7 +114,12 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   };
   out << "look-at: eye " << vec(look.eye) << ", target " << vec(look.target) << ", up "
       << vec(look.up) << "\n";
-  if (fit.views.perspective) {
+  if (fit.views.ortho) {
+    const Ortho& o = *fit.views.ortho;
+    out << "ortho (orthographic, world units): left " << Format("%.6g", o.left) << " right "
+        << Format("%.6g", o.right) << " bottom " << Format("%.6g", o.bottom) << " top "
+        << Format("%.6g", o.top) << "\n";
+  } else if (fit.views.perspective) {
     out << "perspective: fovy " << Format("%.6g", fit.views.perspective->fovy_deg) << " deg, aspect "
         << Format("%.6g", fit.views.perspective->aspect) << "\n";
   } else if (fit.views.frustum) {

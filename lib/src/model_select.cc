@@ -79,6 +79,17 @@ double CornerEffectPx(const ParameterSigma& s, const Intrinsics& k, const ImageS
   return s.sigma;  // cx, cy
 }
 
+// Whether the caller's options allow an orthographic camera: nothing only a perspective camera
+// has is forced or given (principal point free, distortion), no RANSAC, no known intrinsics.
+bool OrthographicIsPossible(const FitOptions& options) {
+  auto zero_or_default = [](const ParameterMode& mode) {
+    return mode.kind == ParameterMode::Kind::kDefault ||
+           (mode.kind == ParameterMode::Kind::kFixed && mode.value == 0.0);
+  };
+  return !options.principal_point.IsFree() && zero_or_default(options.k1) &&
+         zero_or_default(options.k2) && !options.ransac && !options.known_intrinsics;
+}
+
 std::string Fixed(double value, int digits = 3) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
@@ -155,6 +166,19 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
         sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
       }
     }
+    if (sigma == 0.0 && options.allow_orthographic && OrthographicIsPossible(base)) {
+      // No perspective model fits (a nearly parallel projection): the affine camera's noise.
+      FitOptions affine = base;
+      affine.projection = Projection::kOrthographic;
+      affine.compute_uncertainty = false;
+      for (const int g : {kAspect, kSkew}) {
+        if (ModeOf(affine, g).kind == ParameterMode::Kind::kDefault) ModeOf(affine, g) = ParameterMode::Free();
+      }
+      const Evaluation e = Evaluate(points, pixels, image_size, affine);
+      if (e.fit && num_equations > e.num_params) {
+        sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
+      }
+    }
     if (sigma == 0.0) sigma = kMinNoisePx;  // no model leaves a residual: the simplest decides
   }
   const bool aic = options.criterion == ModelCriterion::kAic;
@@ -187,13 +211,75 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
   base.pixel_sigma = sigma;
   base.compute_uncertainty = true;
 
-  // The simplest model: pose + focal with the forced groups. Its refusal is the caller's.
+  // "" when 1 sigma of each named parameter moves the image corner by at most the bound, else
+  // what moves it most and by how much.
+  auto undetermined = [&](const FitResult& fit, const std::vector<std::string>& sigma_names) {
+    double worst_effect = 0.0;
+    std::string worst_name;
+    for (const ParameterSigma& s : fit.sigmas) {
+      if (std::find(sigma_names.begin(), sigma_names.end(), s.name) == sigma_names.end()) continue;
+      const double effect = CornerEffectPx(s, fit.camera.intrinsics, image_size);
+      if (!(effect <= worst_effect)) {
+        worst_effect = effect;
+        worst_name = s.name;
+      }
+    }
+    if (worst_effect <= corner_bound_px) return std::string();
+    return "1 sigma of " + worst_name + " would move the image corner by " + Fixed(worst_effect) +
+           " px (bound " + Fixed(corner_bound_px) + " px)";
+  };
+
+  // The simplest models: pose + focal with the forced groups, and the orthographic camera.
   FitOptions current_options = base;
   Evaluation current = Evaluate(points, pixels, image_size, current_options);
-  if (!current.fit) FitCamera(points, pixels, image_size, current_options);  // rethrows
-  size_t current_index = record(current, "", "simplest model");
+  // Perspective or orthographic is the criterion's call: a focal length with a large sigma is
+  // still the better model when the perspective is significant (its sigma is reported).
+  const std::string perspective_problem = current.fit ? "" : current.refusal;
+  size_t current_index =
+      record(current, "pose+focal",
+             perspective_problem.empty() ? "simplest perspective model"
+                                         : "not determined: " + perspective_problem);
+  bool orthographic = false;
+  if (options.allow_orthographic && OrthographicIsPossible(base)) {
+    FitOptions ortho_options = base;
+    ortho_options.projection = Projection::kOrthographic;
+    Evaluation ortho = Evaluate(points, pixels, image_size, ortho_options);
+    if (!ortho.fit) {
+      record(ortho, "orthographic", "not determined: refused");
+    } else {
+      const double delta = perspective_problem.empty() ? criterion_of(ortho) - criterion_of(current) : 0.0;
+      orthographic = !perspective_problem.empty() || delta < 0.0;
+      const size_t index = record(
+          ortho, "orthographic",
+          !perspective_problem.empty()
+              ? std::string("kept: no perspective camera fits")
+              : "delta " + std::string(criterion_name) + " " + (delta >= 0 ? "+" : "") +
+                    Fixed(delta) + " against pose+focal" + (orthographic ? ": kept" : ""));
+      if (orthographic) {
+        current = std::move(ortho);
+        current_options = ortho_options;
+        current_index = index;
+      }
+    }
+  }
+  if (!orthographic && !perspective_problem.empty()) {
+    FitCamera(points, pixels, image_size, current_options);  // rethrows the refusal
+  }
   std::vector<int> included;
   std::string why_left_out[kNumGroups];
+  if (orthographic) {
+    // An orthographic camera has aspect and skew; the rest are not part of it.
+    std::vector<int> kept;
+    for (const int g : candidates) {
+      if (g == kAspect || g == kSkew) {
+        kept.push_back(g);
+      } else {
+        why_left_out[g] = "left out: not part of an orthographic camera (the perspective is not "
+                          "supported by the data)";
+      }
+    }
+    candidates = kept;
+  }
 
   for (;;) {
     int best_group = -1;
@@ -217,23 +303,10 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
         record(trial, name, "not determined: refused");
         continue;
       }
-      double worst_effect = 0.0;
-      std::string worst_name;
-      for (const ParameterSigma& s : trial.fit->sigmas) {
-        for (const std::string& freed : SigmaNamesOf(g)) {
-          if (s.name != freed) continue;
-          const double effect = CornerEffectPx(s, trial.fit->camera.intrinsics, image_size);
-          if (!(effect <= worst_effect)) {
-            worst_effect = effect;
-            worst_name = s.name;
-          }
-        }
-      }
-      if (!(worst_effect <= corner_bound_px)) {
-        why_left_out[g] = "left out: not determined: 1 sigma of " + worst_name +
-                          " would move the image corner by " + Fixed(worst_effect) +
-                          " px (bound " + Fixed(corner_bound_px) + " px)";
-        record(trial, name, "not determined: sigma " + Fixed(worst_effect) + " px at the corner");
+      const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
+      if (!problem.empty()) {
+        why_left_out[g] = "left out: not determined: " + problem;
+        record(trial, name, "not determined: " + problem);
         continue;
       }
       const double delta = criterion_of(trial) - criterion_of(current);

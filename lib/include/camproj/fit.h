@@ -53,6 +53,13 @@ struct FitOptions {
   ParameterMode k1 = ParameterMode::Default();
   ParameterMode k2 = ParameterMode::Default();
 
+  // kOrthographic fits a parallel projection (camera.h): focal is the scale (px per world unit),
+  // aspect and skew as above; the principal point stays at the image centre or its given value
+  // (it trades exactly with the position); no distortion, RANSAC or known intrinsics. Needs
+  // points off a plane (a plane seen orthographically has two mirror-image poses). The depth
+  // order, which an orthographic image does not show, is the one a right-handed world implies.
+  Projection projection = Projection::kPerspective;
+
   // When set, the intrinsics are known (in `pixel_origin`) and only the pose is fitted; the
   // modes above are ignored.
   std::optional<Intrinsics> known_intrinsics;

@@ -47,6 +47,11 @@ struct AutoFitOptions {
   // A freed parameter is "not determined" when 1 sigma of it moves the image corner by more than
   // this fraction of the image half-diagonal (0.05 of 1101 px = 55 px for 1920 x 1080).
   double max_corner_sigma_fraction = 0.05;
+  // Also consider an orthographic camera (scale, then aspect and skew): chosen when the
+  // criterion prefers it to pose + focal (the perspective is not observable: a telephoto or
+  // satellite-like view whose depth range is tiny against its distance), or when no perspective
+  // camera fits.
+  bool allow_orthographic = true;
 
   void Check() const;  // throws std::invalid_argument naming the field
 };

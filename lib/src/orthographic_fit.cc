@@ -1,0 +1,373 @@
+#include "orthographic_fit.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <Eigen/Dense>
+
+#include "check.h"
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+// Below this ratio of the point cloud's smallest to middle RMS extent the points are taken as
+// coplanar (as in fit.cc): a plane seen orthographically has two mirror-image poses.
+constexpr double kOrthoPlanarRatio = 1e-6;
+constexpr double kOrthoCollinearRatio = 1e-9;
+// Reciprocal condition of the Jacobi-scaled normal equations below which parameters are not
+// determined (as in fit.cc).
+constexpr double kOrthoSingularRcond = 1e-12;
+
+// Intrinsics block: [scale, aspect, skew] in px per normalized world unit; fx = scale,
+// fy = aspect * scale.
+constexpr int kOrthoIntrinsics = 3;
+
+// pixel = K2 (exp(omega) R0 X)_xy + offset, X in the normalized world, R0 X precomputed.
+struct OrthographicReprojection {
+  OrthographicReprojection(const Eigen::Vector3d& rotated_point, const Eigen::Vector2d& observed)
+      : p_(rotated_point), observed_(observed) {}
+
+  template <typename T>
+  bool operator()(const T* omega, const T* offset, const T* k, T* residual) const {
+    const T p[3] = {T(p_.x()), T(p_.y()), T(p_.z())};
+    T q[3];
+    ceres::AngleAxisRotatePoint(omega, p, q);
+    residual[0] = k[0] * q[0] + k[2] * q[1] + offset[0] - T(observed_.x());
+    residual[1] = k[1] * k[0] * q[1] + offset[1] - T(observed_.y());
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d p_;
+  Eigen::Vector2d observed_;
+};
+
+// Upper-triangular K2 = [[fx, s], [0, fy]] and orthonormal rows R2 with A = K2 R2.
+void AffineRq(const Eigen::Matrix<double, 2, 3>& a, Eigen::Matrix2d* k2, Eigen::Matrix3d* r) {
+  const Eigen::Vector3d a2 = a.row(1).transpose();
+  const double fy = a2.norm();
+  const Eigen::Vector3d r2 = a2 / fy;
+  const double skew = a.row(0).dot(r2.transpose());
+  const Eigen::Vector3d rest = a.row(0).transpose() - skew * r2;
+  const double fx = rest.norm();
+  const Eigen::Vector3d r1 = rest / fx;
+  *k2 << fx, skew, 0.0, fy;
+  r->row(0) = r1.transpose();
+  r->row(1) = r2.transpose();
+  r->row(2) = r1.cross(r2).transpose();  // proper: the depth order a right-handed world implies
+}
+
+}  // namespace
+
+FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
+                          const std::vector<Eigen::Vector2d>& observed_pixels,
+                          const ImageSize& image_size, const FitOptions& options) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const int n = static_cast<int>(points_in_world.size());
+  const bool scale_free = options.focal.IsFree() || options.focal.kind == ParameterMode::Kind::kDefault;
+  const bool aspect_free = options.aspect.IsFree();
+  const bool skew_free = options.skew.IsFree();
+  const int num_params = 5 + (scale_free ? 1 : 0) + (aspect_free ? 1 : 0) + (skew_free ? 1 : 0);
+  if (2 * n < num_params || n < 4) {
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     Concat(n, " points give ", 2 * n, " equations; the orthographic model has ",
+                            num_params, " unknowns and its linear start needs 4 points off a "
+                            "plane: add points"));
+  }
+
+  // The normalized world (centred, unit RMS distance) and kCenter pixels, as in FitCamera.
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& x : points_in_world) centroid += x;
+  centroid /= n;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& x : points_in_world) scatter += (x - centroid) * (x - centroid).transpose();
+  const double scale = std::sqrt(scatter.trace() / n);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(scatter);
+  const Eigen::Vector3d extents = shape.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
+  if (!(scale > 0.0) || extents(1) <= kOrthoCollinearRatio * extents(2)) {
+    throw SceneError(SceneError::Reason::kCollinearPoints,
+                     "the 3D points are collinear (or coincide): add points off the line");
+  }
+  if (extents(0) <= kOrthoPlanarRatio * extents(1)) {
+    throw SceneError(SceneError::Reason::kPlanarUnderdetermined,
+                     "the points are coplanar: a plane seen orthographically has two mirror-image "
+                     "poses (the sign of its tilt is not in the image); add points off the plane "
+                     "or fit a perspective camera");
+  }
+  std::vector<Eigen::Vector3d> points(n);
+  std::vector<Eigen::Vector2d> pixels(n);
+  for (int i = 0; i < n; ++i) {
+    points[i] = (points_in_world[i] - centroid) / scale;
+    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
+  }
+
+  // Affine start: [X 1] a_row = u, v by least squares (4 x 4 normal equations).
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector4d h = points[i].homogeneous();
+    normal += h * h.transpose();
+    rhs += h * pixels[i].transpose();
+  }
+  const Eigen::Matrix<double, 4, 2> solution = normal.ldlt().solve(rhs);
+  Eigen::Matrix<double, 2, 3> a = solution.topRows<3>().transpose();
+  Eigen::Matrix2d k2;
+  Eigen::Matrix3d rotation;
+  AffineRq(a, &k2, &rotation);
+  if (!(k2(0, 0) > 0.0 && k2(1, 1) > 0.0) || !rotation.allFinite()) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "no affine camera fits these points (their image is degenerate): check the "
+                     "correspondences");
+  }
+
+  // Start values projected onto the model; given values (px per world unit) converted to the
+  // normalized world.
+  std::array<double, kOrthoIntrinsics> k = {k2(0, 0), k2(1, 1) / k2(0, 0), k2(0, 1)};
+  if (!aspect_free) {
+    const double aspect = options.aspect.kind == ParameterMode::Kind::kFixed ? options.aspect.value : 1.0;
+    k[0] = std::sqrt(k2(0, 0) * k2(1, 1) / aspect);
+    k[1] = aspect;
+  }
+  if (!scale_free) k[0] = options.focal.value * scale;
+  if (!skew_free) k[2] = options.skew.kind == ParameterMode::Kind::kFixed ? options.skew.value * scale : 0.0;
+  std::array<double, 2> offset = {solution(3, 0), solution(3, 1)};
+  std::array<double, 3> omega = {0.0, 0.0, 0.0};
+
+  // Refinement (rotation on the chart exp(omega) R0, so omega's are about the camera axes).
+  FitResult result;
+  if (options.refine) {
+    // One loss object shared by every block (the problem does not own it).
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    std::unique_ptr<ceres::LossFunction> loss;
+    if (options.loss == LossType::kHuber) loss.reset(new ceres::HuberLoss(options.loss_scale_px));
+    if (options.loss == LossType::kCauchy) loss.reset(new ceres::CauchyLoss(options.loss_scale_px));
+    ceres::Problem problem(problem_options);
+    for (int i = 0; i < n; ++i) {
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<OrthographicReprojection, 2, 3, 2, kOrthoIntrinsics>(
+              new OrthographicReprojection(rotation * points[i], pixels[i])),
+          loss.get(), omega.data(), offset.data(), k.data());
+    }
+    std::vector<int> constant;
+    if (!scale_free) constant.push_back(0);
+    if (!aspect_free) constant.push_back(1);
+    if (!skew_free) constant.push_back(2);
+    if (constant.size() == kOrthoIntrinsics) {
+      problem.SetParameterBlockConstant(k.data());
+    } else if (!constant.empty()) {
+      problem.SetManifold(k.data(), new ceres::SubsetManifold(kOrthoIntrinsics, constant));
+    }
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = 1e-15;
+    solver_options.parameter_tolerance = 1e-14;
+    solver_options.gradient_tolerance = 1e-16;
+    solver_options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    if (summary.termination_type == ceres::FAILURE) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "the orthographic refinement failed: " + summary.message);
+    }
+    result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
+                         ": " + summary.message;
+    Eigen::Matrix3d step;
+    ceres::AngleAxisToRotationMatrix(omega.data(), ceres::ColumnMajorAdapter3x3(step.data()));
+    rotation = step * rotation;
+    omega = {0.0, 0.0, 0.0};
+  } else {
+    result.termination = "not refined (closed-form start only)";
+  }
+
+  // Residuals, and the Jacobian at the solution (omega = 0) for the uncertainty.
+  ceres::Problem problem;
+  for (int i = 0; i < n; ++i) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<OrthographicReprojection, 2, 3, 2, kOrthoIntrinsics>(
+            new OrthographicReprojection(rotation * points[i], pixels[i])),
+        nullptr, omega.data(), offset.data(), k.data());
+  }
+  std::vector<double> residuals;
+  ceres::CRSMatrix jacobian_crs;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, &residuals, nullptr, &jacobian_crs);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(2 * n, 8);
+  for (int row = 0; row < jacobian_crs.num_rows; ++row) {
+    for (int j = jacobian_crs.rows[row]; j < jacobian_crs.rows[row + 1]; ++j) {
+      jacobian(row, jacobian_crs.cols[j]) = jacobian_crs.values[j];
+    }
+  }
+  // Free columns: omega (3), offset (2), then the free intrinsics.
+  std::vector<int> columns = {0, 1, 2, 3, 4};
+  std::vector<std::string> names = {"rotation_x_deg", "rotation_y_deg", "rotation_z_deg",
+                                    "eye_along_x", "eye_along_y"};
+  if (scale_free) columns.push_back(5), names.push_back("fx");
+  if (aspect_free) columns.push_back(6), names.push_back("fy");
+  if (skew_free) columns.push_back(7), names.push_back("skew");
+  Eigen::MatrixXd j_free(2 * n, static_cast<int>(columns.size()));
+  for (size_t c = 0; c < columns.size(); ++c) j_free.col(static_cast<int>(c)) = jacobian.col(columns[c]);
+
+  // The camera: principal point fixed; the eye on the axis through the image offset, placed one
+  // normalized unit (the points' RMS distance from their centroid) in front of the nearest
+  // point (any depth gives the same image).
+  const Eigen::Vector2d principal(
+      options.principal_point.kind == ParameterMode::Kind::kFixed
+          ? Eigen::Vector2d(options.principal_point.value + shift, options.principal_point.value2 + shift)
+          : Eigen::Vector2d(0.5 * (image_size.width - 1.0), 0.5 * (image_size.height - 1.0)));
+  Eigen::Matrix2d k2_final;
+  k2_final << k[0], k[2], 0.0, k[1] * k[0];
+  const Eigen::Vector2d lateral = k2_final.inverse() * (principal - Eigen::Vector2d(offset[0], offset[1]));
+  double min_depth = std::numeric_limits<double>::infinity();
+  for (const auto& x : points) min_depth = std::min(min_depth, rotation.row(2).dot(x));
+  const Eigen::Vector3d eye_in_cam_axes(lateral.x(), lateral.y(), min_depth - 1.0);
+  const Eigen::Vector3d eye = rotation.transpose() * eye_in_cam_axes;
+
+  Camera& camera = result.camera;
+  camera.image_size = image_size;
+  camera.projection = Projection::kOrthographic;
+  camera.intrinsics.fx = k[0] / scale;
+  camera.intrinsics.fy = k[1] * k[0] / scale;
+  camera.intrinsics.skew = k[2] / scale + 0.0;
+  camera.intrinsics.cx = principal.x();
+  camera.intrinsics.cy = principal.y();
+  camera.cam_from_world = CamFromWorldFromCenter(rotation, centroid + scale * eye);
+
+  std::vector<double> depths(n);
+  std::vector<double> norms(n);
+  double sum_squares = 0.0;
+  result.residuals_px.resize(n);
+  for (int i = 0; i < n; ++i) {
+    result.residuals_px[i] = Eigen::Vector2d(residuals[2 * i], residuals[2 * i + 1]);
+    norms[i] = result.residuals_px[i].norm();
+    sum_squares += norms[i] * norms[i];
+    depths[i] = (rotation.row(2).dot(points[i]) - eye_in_cam_axes.z()) * scale;
+  }
+  result.rms_px = std::sqrt(sum_squares / n);
+  std::vector<double> sorted = norms;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  result.median_px = sorted[n / 2];
+  if (n % 2 == 0) {
+    result.median_px = 0.5 * (result.median_px + *std::max_element(sorted.begin(), sorted.begin() + n / 2));
+  }
+  result.max_px = *std::max_element(norms.begin(), norms.end());
+  const auto [near_it, far_it] = std::minmax_element(depths.begin(), depths.end());
+  camera.z_near = options.z_near.value_or(*near_it / (1.0 + options.depth_margin));
+  camera.z_far = options.z_far.value_or(*far_it * (1.0 + options.depth_margin));
+  Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
+          camera.z_far, ")");
+  std::vector<double> depths_sorted = depths;
+  std::nth_element(depths_sorted.begin(), depths_sorted.begin() + n / 2, depths_sorted.end());
+  result.views = ViewsOfCamera(camera, depths_sorted[n / 2]);
+  result.start_method = "affine";
+  result.planar = false;
+  result.free_parameters = names;
+  result.model = std::string("orthographic") + (aspect_free ? "+aspect" : "") + (skew_free ? "+skew" : "");
+  if (!scale_free) result.model += " (scale given)";
+  auto fixed = [&](const char* name, const std::string& value, const ParameterMode& mode,
+                   const char* default_why) {
+    result.fixed_parameters.push_back(
+        {name, value, mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
+  };
+  if (!scale_free) fixed("scale", Concat(camera.intrinsics.fx, " px per world unit"), options.focal, "given");
+  if (!aspect_free) fixed("aspect", Concat(k[1]), options.aspect, "default: square pixels");
+  if (!skew_free) fixed("skew", Concat(camera.intrinsics.skew), options.skew, "default: no skew");
+  fixed("principal point", Concat(principal.x(), ", ", principal.y()), options.principal_point,
+        "not determined: it trades exactly with the position in an orthographic view");
+
+  // Uncertainty, as in FitCamera: Jacobi-scaled normal equations, refusal when singular.
+  const int p = static_cast<int>(columns.size());
+  const Eigen::MatrixXd jtj = j_free.transpose() * j_free;
+  const Eigen::VectorXd column_scale = jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::MatrixXd scaled = column_scale.asDiagonal() * jtj * column_scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+  const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(p - 1);
+  if (!(rcond > kOrthoSingularRcond)) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     Concat("the points do not determine the orthographic camera (singular "
+                            "normal equations, reciprocal condition ", rcond, ")"));
+  }
+  result.jacobian_condition = std::sqrt(1.0 / rcond);
+  const int dof = 2 * n - p;
+  if (options.pixel_sigma) {
+    result.pixel_sigma = *options.pixel_sigma;
+    result.pixel_sigma_estimated = false;
+  } else if (dof > 0) {
+    result.pixel_sigma = std::sqrt(sum_squares / dof);
+  }
+  if (options.compute_uncertainty && (options.pixel_sigma || dof > 0)) {
+    const Eigen::MatrixXd inverse = column_scale.asDiagonal() * eigen.eigenvectors() *
+                                    eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                                    eigen.eigenvectors().transpose() * column_scale.asDiagonal();
+    // To user units: omega -> degrees; the eye's lateral position g = K2^-1 (c - offset) (world
+    // units, along the camera's x and y) by its derivatives; scale, fy and skew / scale.
+    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(p, p);
+    for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
+    const Eigen::Matrix2d k2_inverse = k2_final.inverse();
+    l.block<2, 2>(3, 3) = -scale * k2_inverse;
+    // d g / d K2 entries: d(K2^-1) = -K2^-1 dK2 K2^-1.
+    auto dg = [&](const Eigen::Matrix2d& dk2) {
+      return Eigen::Vector2d(-scale * k2_inverse * dk2 * lateral);
+    };
+    int col = 5;
+    if (scale_free) {
+      Eigen::Matrix2d d;
+      d << 1.0, 0.0, 0.0, k[1];
+      l.block<2, 1>(3, col) = dg(d);
+      l(col, col) = 1.0 / scale;
+      ++col;
+    }
+    if (aspect_free) {
+      Eigen::Matrix2d d;
+      d << 0.0, 0.0, 0.0, k[0];
+      l.block<2, 1>(3, col) = dg(d);
+      l(col, col) = k[0] / scale;           // fy = aspect * scale / s
+      if (scale_free) l(col, 5) = k[1] / scale;
+      ++col;
+    }
+    if (skew_free) {
+      Eigen::Matrix2d d;
+      d << 0.0, 1.0, 0.0, 0.0;
+      l.block<2, 1>(3, col) = dg(d);
+      l(col, col) = 1.0 / scale;
+    }
+    result.covariance = result.pixel_sigma * result.pixel_sigma * l * inverse * l.transpose();
+    result.covariance_available = true;
+    const Eigen::Vector2d lateral_world = scale * lateral;
+    const std::vector<double> values = {0.0, 0.0, 0.0, lateral_world.x(), lateral_world.y(),
+                                        camera.intrinsics.fx, camera.intrinsics.fy,
+                                        camera.intrinsics.skew};
+    for (int j = 0; j < p; ++j) {
+      const int value_index = j < 5 ? j : columns[j];
+      const std::string unit = j < 3 ? "deg" : j < 5 ? "world" : "px per world unit";
+      result.sigmas.push_back({names[j], values[value_index], std::sqrt(result.covariance(j, j)), unit});
+    }
+    for (int a_index = 0; a_index < p; ++a_index) {
+      for (int b_index = a_index + 1; b_index < p; ++b_index) {
+        const double rho = result.covariance(a_index, b_index) /
+                           std::sqrt(result.covariance(a_index, a_index) * result.covariance(b_index, b_index));
+        if (std::abs(rho) >= options.strong_correlation) {
+          result.strong_correlations.push_back({names[a_index], names[b_index], rho});
+        }
+      }
+    }
+  }
+  result.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+}  // namespace internal
+}  // namespace camproj
