@@ -102,7 +102,7 @@ reason in the test.
 - **RANSAC: exact outlier set.** Outliers are moved at least 20 px from their pixel; the fitted
   camera predicts an inlier to well under 1 px, and an inlier with 0.5 px noise leaves the 4 px
   threshold with probability exp(-32), so the outlier set must come back exactly; the camera is
-  then judged by NEES as above.
+  then judged by the noisy-fit checks above.
 - **GL export.** For points from the near plane (1e-6) to the far plane (1e9, or up to 1e300 with an
   infinite far plane) on five pixels of an off-axis, skewed projector: everything finite; the
   GL pipeline's pixel (`GlPixelFromWorld`) and the pinhole pixel (`PixelFromWorld`) within float64
@@ -111,8 +111,8 @@ reason in the test.
   depth within its rounding of the exact value from docs/conventions.md section 6; and the depth
   order right wherever two exact depths are further apart than their tolerances.
 - **Look-at.** A refusal must be `std::invalid_argument` naming the problem. A pose built with `up`
-  almost along the gaze must be right to `8 u (1 + (|eye| + |target|) / |gaze|) / sin(up, gaze)`,
-  the rounding of `up x w` relative to its length.
+  almost along the gaze must be right to `8 u (1 + (|eye| + |target|) / |gaze|) / sin(up, gaze)`
+  (u = 2^-53, the unit roundoff), the rounding of `up x w` relative to its length.
 
 ## Columns
 
