@@ -21,6 +21,7 @@ STYLE = {
     "ours-start": ("#9ecae1", "v"),
     "ours-refine": ("#08519c", "o"),
     "ours-default": ("#31a354", "s"),
+    "ours-auto": ("#006d2c", "P"),
     "cv-calib-80deg": ("#d62728", "D"),
     "cv-calib-ourstart": ("#ff7f0e", "^"),
     "cv-sqpnp": ("#7f7f7f", "P"),

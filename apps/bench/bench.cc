@@ -27,6 +27,7 @@
 #include <opencv2/core/version.hpp>
 
 #include "camproj/camera.h"
+#include "camproj/model_select.h"
 #include "camproj/fit.h"
 #include "camproj/synth.h"
 
@@ -125,6 +126,7 @@ enum class MethodId {
   kOursStart,
   kOursRefine,
   kOursDefault,
+  kOursAuto,
   kCvCalib80,
   kCvCalibOurStart,
   kCvSqpnp,
@@ -143,8 +145,11 @@ const std::vector<Method> kMethods = {
      Model::kShared},
     {MethodId::kOursRefine, "ours-refine", "camproj start + Ceres (compute_uncertainty = false)",
      Model::kShared},
-    {MethodId::kOursDefault, "ours-default", "camproj default FitOptions (what `camproj fit` runs)",
-     Model::kDefault},
+    {MethodId::kOursDefault, "ours-default",
+     "camproj default FitOptions (10 parameters, covariance included)", Model::kDefault},
+    {MethodId::kOursAuto, "ours-auto",
+     "camproj automatic model selection (what `camproj fit` runs; CRB of the shared model)",
+     Model::kShared},
     {MethodId::kCvCalib80, "cv-calib-80deg",
      "OpenCV calibrateCamera from an 80 deg guess (mapamok / camSchnappr style)", Model::kShared},
     {MethodId::kCvCalibOurStart, "cv-calib-ourstart",
@@ -296,6 +301,9 @@ Outcome Run(const Method& method, const SceneInput& in, const MethodConfig& conf
       case MethodId::kOursRefine:
       case MethodId::kOursDefault:
         outcome.estimate = FromFit(FitCamera(in.points, in.pixels, kImageSize, options));
+        break;
+      case MethodId::kOursAuto:
+        outcome.estimate = FromFit(FitCameraAuto(in.points, in.pixels, kImageSize));
         break;
       case MethodId::kCvCalib80:
         outcome.estimate =

@@ -25,11 +25,11 @@ enum class Projection { kPerspective, kOrthographic };
 
 struct Camera {
   ImageSize image_size;
-  Projection projection = Projection::kPerspective;
   Intrinsics intrinsics;  // cx, cy in kCenter
   Rigid3 cam_from_world;
   double z_near = 0.1;    // depth range of the GL export, > 0
-  double z_far = 100.0;   // > z_near, or kInfinity
+  double z_far = 100.0;   // > z_near, or kInfinity (perspective only)
+  Projection projection = Projection::kPerspective;
 
   // Throws std::invalid_argument naming the field on any invalid part.
   void Check() const;
