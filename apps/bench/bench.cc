@@ -302,9 +302,13 @@ Outcome Run(const Method& method, const SceneInput& in, const MethodConfig& conf
       case MethodId::kOursDefault:
         outcome.estimate = FromFit(FitCamera(in.points, in.pixels, kImageSize, options));
         break;
-      case MethodId::kOursAuto:
-        outcome.estimate = FromFit(FitCameraAuto(in.points, in.pixels, kImageSize));
+      case MethodId::kOursAuto: {
+        // A plane cannot determine the principal point: given, as to every planar method.
+        AutoFitOptions auto_options;
+        if (in.planar) auto_options.fit.principal_point = ParameterMode::Fixed(in.truth.cx, in.truth.cy);
+        outcome.estimate = FromFit(FitCameraAuto(in.points, in.pixels, kImageSize, auto_options));
         break;
+      }
       case MethodId::kCvCalib80:
         outcome.estimate =
             CvCalibrate(in, config.calib80_focal, in.planar ? in.truth.cx : centre_x,
