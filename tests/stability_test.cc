@@ -44,6 +44,7 @@
 #include "camproj/fit.h"
 #include "camproj/gl.h"
 #include "camproj/look_at.h"
+#include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "test_scenes.h"
 
@@ -724,6 +725,38 @@ Case Refused(std::string id, std::string label, std::function<Scenario()> make, 
   return c;
 }
 
+// Automatic model selection on a view whose perspective is not observable: it must return an
+// orthographic camera (pose + focal is refused as undetermined) whose image agrees with the
+// truth's. With sigma px noise on N points a 6-parameter linear fit leaves an RMS prediction
+// error of sqrt(6 / N) sigma sqrt(2) in expectation; 3 times that bounds it (the perspective's
+// own deviation from parallel, ~1e-3 of the image at 0.1 degrees, is well inside).
+Row RunAutoOrthographic(const Case& c, const Scenario& s, double sigma) {
+  Row row = RowOf(c);
+  Camera truth;
+  truth.image_size = s.truth.size;
+  truth.intrinsics = s.truth.intrinsics;
+  truth.cam_from_world = CamFromWorldFromCenter(s.truth.rotation, s.truth.center);
+  try {
+    const FitResult fit = FitCameraAuto(s.points, s.pixels, s.truth.size);
+    row.outcome = "fitted: " + fit.model;
+    row.condition = Sci(fit.jacobian_condition, 3);
+    row.time_ms = Fixed(fit.time_ms, 2) + " (last model)";
+    double sum = 0.0;
+    for (const Eigen::Vector3d& x : s.points) {
+      sum += (*PixelFromWorld(fit.camera, x) - *PixelFromWorld(truth, x)).squaredNorm();
+    }
+    const double rms = std::sqrt(sum / s.points.size());
+    const double bound = 3.0 * std::sqrt(6.0 / s.points.size()) * sigma * std::sqrt(2.0);
+    row.error = "image RMS vs truth " + Sci(rms, 2) + " px (bound " + Sci(bound, 2) + ")";
+    EXPECT_EQ(fit.camera.projection, Projection::kOrthographic) << c.label << ": " << fit.model;
+    EXPECT_LT(rms, bound) << c.label;
+  } catch (const std::exception& e) {
+    row.outcome = std::string("threw: ") + e.what();
+    ADD_FAILURE() << c.label << ": " << e.what();
+  }
+  return row;
+}
+
 // --- Scenes of the cases ------------------------------------------------------------------------
 
 // The scene with seeded Gaussian pixel noise of `sigma` px per axis.
@@ -1095,6 +1128,16 @@ std::vector<Case> AllCases() {
   cases.push_back(Refused("CompactObjectFov0p1Deg", "FoV 0.1 deg, compact object, focal free",
                           [] { return CompactObject(0.1); },
                           {{Reason::kDegenerate}, {"determine"}}));
+
+  // The same object with automatic model selection and 0.5 px noise: orthographic.
+  {
+    Case c{"CompactObjectFov0p1DegAuto", "FoV 0.1 deg, compact object, --model auto, 0.5 px noise",
+           "orthographic camera, image within 3 sqrt(6/N) sigma sqrt 2 of the truth's", nullptr};
+    c.run = [](const Case& self) {
+      return RunAutoOrthographic(self, WithNoise(CompactObject(0.1), 0.5, 43), 0.5);
+    };
+    cases.push_back(c);
+  }
 
   // Noise on the hardest-conditioned scenes that still fit.
   cases.push_back(Fitted(
