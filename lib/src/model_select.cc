@@ -96,6 +96,9 @@ std::string Fixed(double value, int digits = 3) {
   return buffer;
 }
 
+// A criterion difference with its sign: "+3.3", "-128".
+std::string Signed(double value) { return (value >= 0.0 ? "+" : "") + Fixed(value); }
+
 }  // namespace
 
 void AutoFitOptions::Check() const {
@@ -253,8 +256,8 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
           ortho, "orthographic",
           !perspective_problem.empty()
               ? std::string("kept: no perspective camera fits")
-              : "delta " + std::string(criterion_name) + " " + (delta >= 0 ? "+" : "") +
-                    Fixed(delta) + " against pose+focal" + (orthographic ? ": kept" : ""));
+              : "delta " + std::string(criterion_name) + " " + Signed(delta) +
+                    " against pose+focal" + (orthographic ? ": kept" : ""));
       if (orthographic) {
         current = std::move(ortho);
         current_options = ortho_options;
@@ -311,10 +314,10 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
       }
       const double delta = criterion_of(trial) - criterion_of(current);
       why_left_out[g] = "left out: delta " + std::string(criterion_name) + " " +
-                        (delta >= 0 ? "+" : "") + Fixed(delta) + " against " +
+                        Signed(delta) + " against " +
                         current.fit->model + ": not supported by the data";
       const size_t index =
-          record(trial, name, "delta " + std::string(criterion_name) + " " + Fixed(delta));
+          record(trial, name, "delta " + std::string(criterion_name) + " " + Signed(delta));
       if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
         best_group = g;
         best_index = index;
