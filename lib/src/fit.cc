@@ -453,55 +453,120 @@ std::string TinySolverStatusText(int status) {
   }
 }
 
-// The Gauss-Newton normal equations of all residuals in the user parameterization u = [omega
-// (3, rad, R = exp(omega) R_hat), center (3, normalized world), free intrinsic slots]: at
-// omega = 0, dp/domega = -[p]x and dp/dC = -R_hat. Accumulated point by point (J^T J, J^T r and
-// r^T r) so that no 2N x p matrix is formed. Returns false if a point is not in front.
+// Gauss-Newton normal equations of all residuals (J^T J, J^T r and r^T r), accumulated point by
+// point so that no 2N x p matrix is formed; the parameters are said where they are made.
 struct NormalEquations {
   Eigen::MatrixXd jtj;
   Eigen::VectorXd jtr;
   double cost = 0.0;  // sum of squared residuals
 };
 
+constexpr int kMaxParams = 6 + internal::kFitIntrinsicsSize;
+
+// The free intrinsic slots in order: the parameters after the pose.
+struct FreeSlots {
+  explicit FreeSlots(const Model& model) {
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model.free[slot]) slots[count++] = slot;
+    }
+  }
+  int slots[internal::kFitIntrinsicsSize] = {};
+  int count = 0;
+};
+
+// The normal equations in the camera's local frame at (rotation, center): parameters [theta (3),
+// c (3), free intrinsic slots] with R -> exp(theta) R and C -> C + R^T c, so that a point in the
+// camera frame moves by dp = -[p]x dtheta - dc. This is the cheapest Jacobian to form per point;
+// ToChart maps the sums to the solver's parameters once per pass instead. kNumParams = 6 + the
+// number of free slots, a template parameter so that the accumulation below is unrolled.
+template <int kNumParams>
+bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<Eigen::Vector2d>& pixels,
+                                    const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                                    const Model& model, const FreeSlots& free,
+                                    NormalEquations* out) {
+  // Upper triangle only: J^T J is symmetric.
+  Eigen::Matrix<double, kNumParams, kNumParams> jtj = Eigen::Matrix<double, kNumParams, kNumParams>::Zero();
+  Eigen::Matrix<double, kNumParams, 1> jtr = Eigen::Matrix<double, kNumParams, 1>::Zero();
+  double cost = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p = rotation * (points[i] - center);
+    if (!(p.z() > 0.0)) return false;
+    double r[2];
+    double jk[2 * internal::kFitIntrinsicsSize];  // row-major 2 x 7
+    double jp[6];                                 // row-major 2 x 3: d residual / d p
+    internal::ResidualOfCamPoint(model.value.data(), p, pixels[i], r, jk, jp);
+    double j[2][kNumParams];
+    for (int row = 0; row < 2; ++row) {
+      const double* a = jp + 3 * row;
+      // d residual / d theta = -a^T [p]x = (p x a)^T; d residual / d c = -a^T.
+      j[row][0] = p.y() * a[2] - p.z() * a[1];
+      j[row][1] = p.z() * a[0] - p.x() * a[2];
+      j[row][2] = p.x() * a[1] - p.y() * a[0];
+      j[row][3] = -a[0];
+      j[row][4] = -a[1];
+      j[row][5] = -a[2];
+      for (int f = 0; f < kNumParams - 6; ++f) {
+        j[row][6 + f] = jk[row * internal::kFitIntrinsicsSize + free.slots[f]];
+      }
+    }
+    for (int a = 0; a < kNumParams; ++a) {
+      for (int b = a; b < kNumParams; ++b) jtj(a, b) += j[0][a] * j[0][b] + j[1][a] * j[1][b];
+      jtr(a) += j[0][a] * r[0] + j[1][a] * r[1];
+    }
+    cost += r[0] * r[0] + r[1] * r[1];
+  }
+  out->jtj = jtj.template selfadjointView<Eigen::Upper>();
+  out->jtr = jtr;
+  out->cost = cost;
+  return true;
+}
+
+bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<Eigen::Vector2d>& pixels,
+                          const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                          const Model& model, NormalEquations* out) {
+  const FreeSlots free(model);
+  switch (6 + free.count) {
+    case 6: return AccumulateLocalNormalEquations<6>(points, pixels, rotation, center, model, free, out);
+    case 7: return AccumulateLocalNormalEquations<7>(points, pixels, rotation, center, model, free, out);
+    case 8: return AccumulateLocalNormalEquations<8>(points, pixels, rotation, center, model, free, out);
+    case 9: return AccumulateLocalNormalEquations<9>(points, pixels, rotation, center, model, free, out);
+    case 10: return AccumulateLocalNormalEquations<10>(points, pixels, rotation, center, model, free, out);
+    case 11: return AccumulateLocalNormalEquations<11>(points, pixels, rotation, center, model, free, out);
+    case 12: return AccumulateLocalNormalEquations<12>(points, pixels, rotation, center, model, free, out);
+    default: return AccumulateLocalNormalEquations<kMaxParams>(points, pixels, rotation, center, model, free, out);
+  }
+}
+
+// Maps local normal equations to parameters whose first six are [omega, center] with
+// dtheta = d_theta_d_omega domega and dc = rotation dC: J = J_local T with T = diag(d_theta_d_omega,
+// rotation, I), so J^T J -> T^T J^T J T and J^T r -> T^T J^T r (only the first six rows and
+// columns change).
+void ToChart(const Eigen::Matrix3d& d_theta_d_omega, const Eigen::Matrix3d& rotation,
+             NormalEquations* normal) {
+  const int num_intrinsics = static_cast<int>(normal->jtr.size()) - 6;
+  Eigen::Matrix<double, 6, 6> t = Eigen::Matrix<double, 6, 6>::Zero();
+  t.topLeftCorner<3, 3>() = d_theta_d_omega;
+  t.bottomRightCorner<3, 3>() = rotation;
+  const Eigen::Matrix<double, 6, 6> pose_block = normal->jtj.topLeftCorner<6, 6>();
+  normal->jtj.topLeftCorner<6, 6>() = t.transpose() * pose_block * t;
+  const Eigen::MatrixXd cross_block = t.transpose() * normal->jtj.topRightCorner(6, num_intrinsics);
+  normal->jtj.topRightCorner(6, num_intrinsics) = cross_block;
+  normal->jtj.bottomLeftCorner(num_intrinsics, 6) = cross_block.transpose();
+  const Eigen::Matrix<double, 6, 1> pose_gradient = normal->jtr.head<6>();
+  normal->jtr.head<6>() = t.transpose() * pose_gradient;
+}
+
+// The normal equations in the user parameterization u = [omega (3, rad, R = exp(omega) R_hat),
+// center (3, normalized world), free intrinsic slots] at omega = 0: dp/domega = -[p]x and
+// dp/dC = -R_hat. Returns false if a point is not in front.
 bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector2d>& pixels,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                            const Model& model, int num_params, NormalEquations* out) {
-  constexpr int kMax = 6 + internal::kFitIntrinsicsSize;
-  Eigen::Matrix<double, kMax, kMax> jtj = Eigen::Matrix<double, kMax, kMax>::Zero();
-  Eigen::Matrix<double, kMax, 1> jtr = Eigen::Matrix<double, kMax, 1>::Zero();
-  double cost = 0.0;
-  const Eigen::Quaterniond q(rotation);
-  Eigen::Matrix<double, 2, 7, Eigen::RowMajor> jk;
-  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> jp;
-  Eigen::Matrix<double, 2, kMax> j = Eigen::Matrix<double, 2, kMax>::Zero();
-  int free_slots[internal::kFitIntrinsicsSize];
-  int num_free = 0;
-  for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-    if (model.free[slot]) free_slots[num_free++] = slot;
-  }
-  for (size_t i = 0; i < points.size(); ++i) {
-    Eigen::Vector2d r;
-    if (!internal::ProjectPointWithJacobian(q.coeffs().data(), center.data(), model.value.data(),
-                                            points[i], pixels[i], r.data(), nullptr, nullptr,
-                                            jk.data(), jp.data())) {
-      return false;
-    }
-    const Eigen::Vector3d p = rotation * (points[i] - center);
-    // -jp [p]x, column by column: row k of -[p]x is -(e_k x p)... written out.
-    j.col(0) = jp.col(2) * p.y() - jp.col(1) * p.z();
-    j.col(1) = jp.col(0) * p.z() - jp.col(2) * p.x();
-    j.col(2) = jp.col(1) * p.x() - jp.col(0) * p.y();
-    j.block<2, 3>(0, 3) = -jp * rotation;
-    for (int f = 0; f < num_free; ++f) j.col(6 + f) = jk.col(free_slots[f]);
-    // lazyProduct: a 13 x 2 by 2 x 13 product is far below GEMM's break-even size.
-    jtj.noalias() += j.transpose().lazyProduct(j);
-    jtr.noalias() += j.transpose().lazyProduct(r);
-    cost += r.squaredNorm();
-  }
-  out->jtj = jtj.topLeftCorner(num_params, num_params);
-  out->jtr = jtr.head(num_params);
-  out->cost = cost;
+                            const Model& model, NormalEquations* out) {
+  if (!LocalNormalEquations(points, pixels, rotation, center, model, out)) return false;
+  ToChart(Eigen::Matrix3d::Identity(), rotation, out);
   return true;
 }
 
@@ -510,11 +575,11 @@ bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. Leaves in
 // `normal` the normal equations at the final parameters.
 void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
-                       const std::vector<Eigen::Vector2d>& pixels, int num_params,
+                       const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
                        NormalEquations* normal) {
   constexpr int kMaxSteps = 6;
-  if (!ComputeNormalEquations(points, pixels, *rotation, *center, *model, num_params, normal)) {
+  if (!ComputeNormalEquations(points, pixels, *rotation, *center, *model, normal)) {
     return;
   }
   double previous_step_px = std::numeric_limits<double>::infinity();
@@ -537,8 +602,7 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       if (new_model.free[slot]) new_model.value[slot] += delta(next++);
     }
     NormalEquations new_normal;
-    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_model, num_params,
-                                &new_normal)) {
+    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_model, &new_normal)) {
       return;
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
@@ -602,7 +666,7 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   function.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
   outcome.iterations = summary.iterations;
   outcome.termination = TinySolverStatusText(summary.status);
-  PolishGaussNewton(points, pixels, num_params, &outcome.rotation, &outcome.center,
+  PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
                     &outcome.model, &outcome.normal);
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned
   // half a turn: neither is an answer (the caller refuses).
@@ -1008,8 +1072,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     result.termination = "not refined (closed-form start only)";
   }
   if (!(options.refine && options.loss == LossType::kNone)) {
-    ComputeNormalEquations(points, pixels, rotation_matrix, center, model, num_params,
-                           &normal_equations);
+    ComputeNormalEquations(points, pixels, rotation_matrix, center, model, &normal_equations);
   }
 
   // Residuals and depths.
