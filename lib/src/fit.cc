@@ -672,13 +672,16 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
-// holds the normal equations (ComputeNormalEquations) at the start on entry, at the final
-// parameters on return.
+// holds the normal equations (ComputeNormalEquations) at the start on entry; on return, those
+// at the final parameters, or one settling step (under kSettledStepPx) before them.
 void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
                        NormalEquations* normal) {
   constexpr int kMaxSteps = 6;
+  // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
+  // their pixel-noise sigma per px of noise).
+  constexpr double kSettledStepPx = 1e-9;
   double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
     const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
@@ -698,24 +701,31 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
       if (new_model.free[slot]) new_model.value[slot] += delta(next++);
     }
+    // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
+    const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
+    if (step_px <= kSettledStepPx) {
+      // The last step: take it without another pass over the points. The normal equations stay
+      // those one step back, where J^T J differs by ~1e-12 relative (the step's size against
+      // the parameters' scales) and the cost by far less than its own rounding.
+      *rotation = new_rotation;
+      *center = new_center;
+      *model = new_model;
+      return;
+    }
     NormalEquations new_normal;
     if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_model, &new_normal)) {
       return;
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
-    // ~1e-16), so accept rounding-level increases and stop on the step's size instead: in
-    // Jacobi-scaled units it is the change it makes to the residuals, in px.
+    // ~1e-16), so accept rounding-level increases and stop on the step's size instead.
     if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) return;
     *rotation = new_rotation;
     *center = new_center;
     *model = new_model;
-    // Settled when a step moves the residuals by under 1e-9 px (parameters then move by under
-    // 1e-9 of their pixel-noise sigma per px of noise), or stops shrinking (rounding floor).
-    const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
-    const bool settled = step_px <= 1e-9 || step_px > 0.5 * previous_step_px;
-    previous_step_px = step_px;
     *normal = std::move(new_normal);
-    if (settled) return;
+    // A step that stops shrinking has reached the rounding floor.
+    if (step_px > 0.5 * previous_step_px) return;
+    previous_step_px = step_px;
   }
 }
 
