@@ -317,36 +317,60 @@ struct NormalEquations {
   double cost = 0.0;  // sum of squared residuals
 };
 
-// The free intrinsic slots in order: the parameters after the pose.
-struct FreeSlots {
-  explicit FreeSlots(const Model& model) {
+// The columns of the Jacobian in the camera's local frame (see LocalNormalEquations), split by
+// how they are summed: the principal point's two columns are the same for every point
+// (d residual / d (cx, cy) = I), so their rows of J^T J are sums of the other columns and need
+// no products; every other column ("general": the pose and the other free slots) varies.
+struct JacobianColumns {
+  explicit JacobianColumns(const Model& model) {
+    int parameter = 6;
     for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-      if (model.free[slot]) slots[count++] = slot;
+      if (!model.free[slot]) continue;
+      if (slot == 2) {
+        cx_parameter = parameter;
+      } else if (slot == 3) {
+        cy_parameter = parameter;
+      } else {
+        general_slots[num_general - 6] = slot;
+        general_parameter[num_general] = parameter;
+        ++num_general;
+      }
+      ++parameter;
     }
+    num_params = parameter;
   }
-  int slots[internal::kFitIntrinsicsSize] = {};
-  int count = 0;
+  int num_params = 0;
+  int num_general = 6;  // the pose's 6, then the general free slots
+  int general_slots[internal::kFitIntrinsicsSize] = {};  // slot of general column 6 + i
+  int general_parameter[kMaxParams] = {0, 1, 2, 3, 4, 5};  // parameter index of general column
+  int cx_parameter = -1;  // parameter indices of the principal point, -1 when it is fixed
+  int cy_parameter = -1;
 };
 
 // The normal equations in the camera's local frame at (rotation, center): parameters [theta (3),
 // c (3), free intrinsic slots] with R -> exp(theta) R and C -> C + R^T c, so that a point in the
 // camera frame moves by dp = -[p]x dtheta - dc. This is the cheapest Jacobian to form per point;
-// ToChart maps the sums to the solver's parameters once per pass instead. kNumParams = 6 + the
-// number of free slots, a template parameter so that the accumulation below is unrolled.
-template <int kNumParams>
+// ToChart maps the sums to the solver's parameters once per pass instead. kNumGeneral (the
+// general columns) and kPrincipalPoint (whether it is free) are template parameters so that the
+// accumulation below is unrolled.
+template <int kNumGeneral, bool kPrincipalPoint>
 bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                                    const Model& model, const FreeSlots& free,
+                                    const Model& model, const JacobianColumns& columns,
                                     NormalEquations* out) {
-  // Each parameter's two Jacobian entries (one per residual) side by side in an Array2d, so that
-  // one SIMD product and sum serve both residuals; J^T J's upper triangle is summed per residual
-  // and the two halves added at the end.
-  constexpr int kTriangle = kNumParams * (kNumParams + 1) / 2;
+  // Each column's two entries (one per residual) side by side in an Array2d, so that one SIMD
+  // product and sum serve both residuals; the two halves are added at the end. J^T J: the upper
+  // triangle of the general columns' products, and each general column's sum (its products with
+  // the principal point's columns (1, 0) and (0, 1)).
+  constexpr int kTriangle = kNumGeneral * (kNumGeneral + 1) / 2;
   Eigen::Array2d jtj[kTriangle];
-  Eigen::Array2d jtr[kNumParams];
+  Eigen::Array2d jtr[kNumGeneral];
+  Eigen::Array2d column_sums[kNumGeneral];
   for (auto& e : jtj) e.setZero();
   for (auto& e : jtr) e.setZero();
+  for (auto& e : column_sums) e.setZero();
+  Eigen::Array2d residual_sum = Eigen::Array2d::Zero();
   Eigen::Array2d cost = Eigen::Array2d::Zero();
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d p = rotation * (points[i] - center);
@@ -355,7 +379,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     double jk[2 * internal::kFitIntrinsicsSize];  // row-major 2 x 7
     double jp[6];                                 // row-major 2 x 3: d residual / d p
     internal::ResidualOfCamPoint(model.value.data(), p, pixels[i], r.data(), jk, jp);
-    Eigen::Array2d j[kNumParams];
+    Eigen::Array2d j[kNumGeneral];
     const Eigen::Array2d ax(jp[0], jp[3]);
     const Eigen::Array2d ay(jp[1], jp[4]);
     const Eigen::Array2d az(jp[2], jp[5]);
@@ -366,46 +390,74 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     j[3] = -ax;
     j[4] = -ay;
     j[5] = -az;
-    for (int f = 0; f < kNumParams - 6; ++f) {
-      j[6 + f] = Eigen::Array2d(jk[free.slots[f]], jk[internal::kFitIntrinsicsSize + free.slots[f]]);
+    for (int g = 6; g < kNumGeneral; ++g) {
+      const int slot = columns.general_slots[g - 6];
+      j[g] = Eigen::Array2d(jk[slot], jk[internal::kFitIntrinsicsSize + slot]);
     }
     // GCC does not unroll the triangular loops by itself; unrolled, a point costs ~500
     // instructions instead of ~710 (callgrind, 10 parameters).
     int k = 0;
 #pragma GCC unroll 16
-    for (int a = 0; a < kNumParams; ++a) {
+    for (int a = 0; a < kNumGeneral; ++a) {
 #pragma GCC unroll 16
-      for (int b = a; b < kNumParams; ++b) jtj[k++] += j[a] * j[b];
+      for (int b = a; b < kNumGeneral; ++b) jtj[k++] += j[a] * j[b];
       jtr[a] += j[a] * r;
+      if (kPrincipalPoint) column_sums[a] += j[a];
     }
+    residual_sum += r;
     cost += r * r;
   }
-  out->jtj.resize(kNumParams, kNumParams);
-  out->jtr.resize(kNumParams);
+
+  // In parameter order.
+  out->jtj.setZero(columns.num_params, columns.num_params);
+  out->jtr.resize(columns.num_params);
   int k = 0;
-  for (int a = 0; a < kNumParams; ++a) {
-    for (int b = a; b < kNumParams; ++b, ++k) out->jtj(a, b) = out->jtj(b, a) = jtj[k].sum();
-    out->jtr(a) = jtr[a].sum();
+  for (int a = 0; a < kNumGeneral; ++a) {
+    const int row = columns.general_parameter[a];
+    for (int b = a; b < kNumGeneral; ++b, ++k) {
+      const int column = columns.general_parameter[b];
+      out->jtj(row, column) = out->jtj(column, row) = jtj[k].sum();
+    }
+    out->jtr(row) = jtr[a].sum();
+    if (kPrincipalPoint) {
+      out->jtj(row, columns.cx_parameter) = out->jtj(columns.cx_parameter, row) = column_sums[a](0);
+      out->jtj(row, columns.cy_parameter) = out->jtj(columns.cy_parameter, row) = column_sums[a](1);
+    }
+  }
+  if (kPrincipalPoint) {
+    out->jtj(columns.cx_parameter, columns.cx_parameter) = static_cast<double>(points.size());
+    out->jtj(columns.cy_parameter, columns.cy_parameter) = static_cast<double>(points.size());
+    out->jtr(columns.cx_parameter) = residual_sum(0);
+    out->jtr(columns.cy_parameter) = residual_sum(1);
   }
   out->cost = cost.sum();
   return true;
+}
+
+template <bool kPrincipalPoint>
+bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<Eigen::Vector2d>& pixels,
+                                    const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                                    const Model& model, const JacobianColumns& columns,
+                                    NormalEquations* out) {
+  switch (columns.num_general) {
+    case 6: return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    case 7: return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    case 8: return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    case 9: return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    case 10: return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    default: return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+  }
 }
 
 bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<Eigen::Vector2d>& pixels,
                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
                           const Model& model, NormalEquations* out) {
-  const FreeSlots free(model);
-  switch (6 + free.count) {
-    case 6: return AccumulateLocalNormalEquations<6>(points, pixels, rotation, center, model, free, out);
-    case 7: return AccumulateLocalNormalEquations<7>(points, pixels, rotation, center, model, free, out);
-    case 8: return AccumulateLocalNormalEquations<8>(points, pixels, rotation, center, model, free, out);
-    case 9: return AccumulateLocalNormalEquations<9>(points, pixels, rotation, center, model, free, out);
-    case 10: return AccumulateLocalNormalEquations<10>(points, pixels, rotation, center, model, free, out);
-    case 11: return AccumulateLocalNormalEquations<11>(points, pixels, rotation, center, model, free, out);
-    case 12: return AccumulateLocalNormalEquations<12>(points, pixels, rotation, center, model, free, out);
-    default: return AccumulateLocalNormalEquations<kMaxParams>(points, pixels, rotation, center, model, free, out);
-  }
+  const JacobianColumns columns(model);
+  return columns.cx_parameter >= 0
+             ? AccumulateLocalNormalEquations<true>(points, pixels, rotation, center, model, columns, out)
+             : AccumulateLocalNormalEquations<false>(points, pixels, rotation, center, model, columns, out);
 }
 
 // Maps local normal equations to parameters whose first six are [omega, center] with
