@@ -317,6 +317,9 @@ struct NormalEquations {
   double cost = 0.0;  // sum of squared residuals
 };
 
+// Every intrinsic slot's value, free or fixed (Model::value's layout).
+using IntrinsicValues = std::array<double, internal::kFitIntrinsicsSize>;
+
 // The columns of the Jacobian in the camera's local frame (see LocalNormalEquations), split by
 // how they are summed: the principal point's two columns are the same for every point
 // (d residual / d (cx, cy) = I), so their rows of J^T J are sums of the other columns and need
@@ -357,8 +360,8 @@ template <int kNumGeneral, bool kPrincipalPoint>
 bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                                    const Model& model, const JacobianColumns& columns,
-                                    NormalEquations* out) {
+                                    const IntrinsicValues& intrinsics,
+                                    const JacobianColumns& columns, NormalEquations* out) {
   // Each column's two entries (one per residual) side by side in an Array2d, so that one SIMD
   // product and sum serve both residuals; the two halves are added at the end. J^T J: the upper
   // triangle of the general columns' products, and each general column's sum (its products with
@@ -378,7 +381,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     Eigen::Array2d r;
     double jk[2 * internal::kFitIntrinsicsSize];  // row-major 2 x 7
     double jp[6];                                 // row-major 2 x 3: d residual / d p
-    internal::ResidualOfCamPoint(model.value.data(), p, pixels[i], r.data(), jk, jp);
+    internal::ResidualOfCamPoint(intrinsics.data(), p, pixels[i], r.data(), jk, jp);
     Eigen::Array2d j[kNumGeneral];
     const Eigen::Array2d ax(jp[0], jp[3]);
     const Eigen::Array2d ay(jp[1], jp[4]);
@@ -438,26 +441,28 @@ template <bool kPrincipalPoint>
 bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                                    const Model& model, const JacobianColumns& columns,
-                                    NormalEquations* out) {
+                                    const IntrinsicValues& intrinsics,
+                                    const JacobianColumns& columns, NormalEquations* out) {
   switch (columns.num_general) {
-    case 6: return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
-    case 7: return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
-    case 8: return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
-    case 9: return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
-    case 10: return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
-    default: return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center, model, columns, out);
+    case 6: return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    case 7: return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    case 8: return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    case 9: return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    case 10: return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    default: return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
   }
 }
 
 bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<Eigen::Vector2d>& pixels,
                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                          const Model& model, NormalEquations* out) {
-  const JacobianColumns columns(model);
+                          const IntrinsicValues& intrinsics, const JacobianColumns& columns,
+                          NormalEquations* out) {
   return columns.cx_parameter >= 0
-             ? AccumulateLocalNormalEquations<true>(points, pixels, rotation, center, model, columns, out)
-             : AccumulateLocalNormalEquations<false>(points, pixels, rotation, center, model, columns, out);
+             ? AccumulateLocalNormalEquations<true>(points, pixels, rotation, center, intrinsics,
+                                                    columns, out)
+             : AccumulateLocalNormalEquations<false>(points, pixels, rotation, center, intrinsics,
+                                                     columns, out);
 }
 
 // Maps local normal equations to parameters whose first six are [omega, center] with
@@ -486,10 +491,21 @@ void ToChart(const Eigen::Matrix3d& d_theta_d_omega, const Eigen::Matrix3d& rota
 bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector2d>& pixels,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                            const Model& model, NormalEquations* out) {
-  if (!LocalNormalEquations(points, pixels, rotation, center, model, out)) return false;
+                            const IntrinsicValues& intrinsics, const JacobianColumns& columns,
+                            NormalEquations* out) {
+  if (!LocalNormalEquations(points, pixels, rotation, center, intrinsics, columns, out)) {
+    return false;
+  }
   ToChart(Eigen::Matrix3d::Identity(), rotation, out);
   return true;
+}
+
+bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<Eigen::Vector2d>& pixels,
+                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                            const Model& model, NormalEquations* out) {
+  return ComputeNormalEquations(points, pixels, rotation, center, model.value,
+                                JacobianColumns(model), out);
 }
 
 // The least-squares problem Levenberg-Marquardt solves, on the chart u = [omega (3), center (3),
@@ -500,7 +516,8 @@ class ChartProblem {
   ChartProblem(const std::vector<Eigen::Vector3d>& points,
                const std::vector<Eigen::Vector2d>& pixels, const Eigen::Matrix3d& start_rotation,
                const Model& model)
-      : points_(points), pixels_(pixels), start_rotation_(start_rotation), model_(model) {}
+      : points_(points), pixels_(pixels), start_rotation_(start_rotation), model_(model),
+        columns_(model) {}
 
   int NumPoints() const { return static_cast<int>(points_.size()); }
 
@@ -517,13 +534,8 @@ class ChartProblem {
 
   void Unpack(const ParamVector& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
               Model* model) const {
-    *rotation = Rotation(u) * start_rotation_;
-    *center = u.segment<3>(3);
     *model = model_;
-    int next = 6;
-    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-      if (model->free[slot]) model->value[slot] = u(next++);
-    }
+    Unpack(u, rotation, center, &model->value);
   }
 
   // The normal equations at u on the chart; `local` receives them before the change of variables
@@ -531,15 +543,29 @@ class ChartProblem {
   bool Linearize(const ParamVector& u, NormalEquations* chart, NormalEquations* local) const {
     Eigen::Matrix3d rotation;
     Eigen::Vector3d center;
-    Model model;
-    Unpack(u, &rotation, &center, &model);
-    if (!LocalNormalEquations(points_, pixels_, rotation, center, model, local)) return false;
+    IntrinsicValues intrinsics;
+    Unpack(u, &rotation, &center, &intrinsics);
+    if (!LocalNormalEquations(points_, pixels_, rotation, center, intrinsics, columns_, local)) {
+      return false;
+    }
     *chart = *local;
     ToChart(LeftJacobian(u), rotation, chart);
     return true;
   }
 
  private:
+  // Unpack without copying the model's descriptions (strings): for every pass over the points.
+  void Unpack(const ParamVector& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
+              IntrinsicValues* intrinsics) const {
+    *rotation = Rotation(u) * start_rotation_;
+    *center = u.segment<3>(3);
+    *intrinsics = model_.value;
+    int next = 6;
+    for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) (*intrinsics)[slot] = u(next++);
+    }
+  }
+
   static Eigen::Matrix3d Rotation(const ParamVector& omega) {
     const Eigen::Vector3d w = omega.head<3>();
     const double angle = w.norm();
@@ -574,6 +600,7 @@ class ChartProblem {
   const std::vector<Eigen::Vector2d>& pixels_;
   Eigen::Matrix3d start_rotation_;
   Model model_;
+  JacobianColumns columns_;
 };
 
 // Why Levenberg-Marquardt stopped; the texts are Ceres' (TinySolver's statuses).
@@ -734,6 +761,7 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
   // their pixel-noise sigma per px of noise).
   constexpr double kSettledStepPx = 1e-9;
+  const JacobianColumns columns(*model);
   double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
     const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
@@ -748,10 +776,10 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       new_rotation = Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix() * *rotation;
     }
     const Eigen::Vector3d new_center = *center + delta.segment<3>(3);
-    Model new_model = *model;
+    IntrinsicValues new_intrinsics = model->value;
     int next = 6;
     for (int slot = 0; slot < internal::kFitIntrinsicsSize; ++slot) {
-      if (new_model.free[slot]) new_model.value[slot] += delta(next++);
+      if (model->free[slot]) new_intrinsics[slot] += delta(next++);
     }
     // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
@@ -761,11 +789,12 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       // the parameters' scales) and the cost by far less than its own rounding.
       *rotation = new_rotation;
       *center = new_center;
-      *model = new_model;
+      model->value = new_intrinsics;
       return;
     }
     NormalEquations new_normal;
-    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_model, &new_normal)) {
+    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_intrinsics, columns,
+                                &new_normal)) {
       return;
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
@@ -773,7 +802,7 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) return;
     *rotation = new_rotation;
     *center = new_center;
-    *model = new_model;
+    model->value = new_intrinsics;
     *normal = std::move(new_normal);
     // A step that stops shrinking has reached the rounding floor.
     if (step_px > 0.5 * previous_step_px) return;
@@ -1291,14 +1320,15 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.fixed_parameters = model.fixed;
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
-  const Eigen::MatrixXd& normal = normal_equations.jtj;
-  const Eigen::VectorXd column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-  const Eigen::MatrixXd scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+  // Fixed-capacity types (ParamMatrix): no allocation, and Eigen's small-matrix products.
+  const ParamMatrix& normal = normal_equations.jtj;
+  const ParamVector column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+  const ParamMatrix scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<ParamMatrix> eigen(scaled);
   const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(num_params - 1);
   if (!(rcond > kSingularRcond)) {
     // Name the parameters that move along the unconstrained direction.
-    const Eigen::VectorXd direction = eigen.eigenvectors().col(0);
+    const ParamVector direction = eigen.eigenvectors().col(0);
     std::string involved;
     for (int j = 0; j < num_params; ++j) {
       if (std::abs(direction(j)) > 0.3) involved += (involved.empty() ? "" : ", ") + names[j];
@@ -1318,13 +1348,13 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     result.pixel_sigma = std::sqrt(sum_squares / dof);
   }
   if (options.compute_uncertainty && (options.pixel_sigma || dof > 0)) {
-    const Eigen::MatrixXd scaled_inverse =
+    const ParamMatrix scaled_inverse =
         eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
         eigen.eigenvectors().transpose();
-    const Eigen::MatrixXd covariance_u = result.pixel_sigma * result.pixel_sigma *
-                                         column_scale.asDiagonal() * scaled_inverse *
-                                         column_scale.asDiagonal();
-    Eigen::MatrixXd l = Eigen::MatrixXd::Identity(num_params, num_params);
+    const ParamMatrix covariance_u = result.pixel_sigma * result.pixel_sigma *
+                                     column_scale.asDiagonal() * scaled_inverse *
+                                     column_scale.asDiagonal();
+    ParamMatrix l = ParamMatrix::Identity(num_params, num_params);
     for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
     for (int j = 3; j < 6; ++j) l(j, j) = scale;
     if (model.free[1]) {
