@@ -375,9 +375,12 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
   for (auto& e : column_sums) e.setZero();
   Eigen::Array2d residual_sum = Eigen::Array2d::Zero();
   Eigen::Array2d cost = Eigen::Array2d::Zero();
+  bool all_in_front = true;
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d p = rotation * (points[i] - center);
-    if (!(p.z() > 0.0)) return false;
+    // Checked after the loop: with an exit here GCC stores every sum twice per point (~15 % more
+    // instructions). A point behind makes infinities or NaNs, never a trap, and is refused below.
+    all_in_front &= p.z() > 0.0;
     Eigen::Array2d r;
     double jk[2 * internal::kFitIntrinsicsSize];  // row-major 2 x 7
     double jp[6];                                 // row-major 2 x 3: d residual / d p
@@ -397,8 +400,8 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
       const int slot = columns.general_slots[g - 6];
       j[g] = Eigen::Array2d(jk[slot], jk[internal::kFitIntrinsicsSize + slot]);
     }
-    // GCC does not unroll the triangular loops by itself; unrolled, a point costs ~500
-    // instructions instead of ~710 (callgrind, 10 parameters).
+    // GCC does not unroll the triangular loops by itself; unrolled, they take ~30 % fewer
+    // instructions per point (callgrind, 10 parameters).
     int k = 0;
 #pragma GCC unroll 16
     for (int a = 0; a < kNumGeneral; ++a) {
@@ -410,6 +413,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     residual_sum += r;
     cost += r * r;
   }
+  if (!all_in_front) return false;
 
   // In parameter order.
   out->jtj.setZero(columns.num_params, columns.num_params);
