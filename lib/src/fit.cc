@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -87,6 +88,15 @@ struct Model {
   }
 };
 
+// A value as internal::Concat writes it (printf's %.17g in the "C" locale), without a stream:
+// MakeModel describes every fixed slot on every fit, and a stream costs ~5000 instructions.
+std::string ValueText(double value) {
+  char text[32];
+  const char* end =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::general, 17).ptr;
+  return std::string(static_cast<const char*>(text), end);
+}
+
 Model MakeModel(const FitOptions& options, const ImageSize& size) {
   Model model;
   if (options.known_intrinsics) {
@@ -106,13 +116,12 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
     model.value[slot] = mode.kind == ParameterMode::Kind::kFixed ? fixed_value : default_value;
     if (mode.IsFree() || slot == 3) return;  // cy is described with cx
     std::string name = kSlotNames[slot];
-    std::string value = internal::Concat(model.value[slot]);
+    std::string value = ValueText(model.value[slot]);
     if (slot == 2) {
       name = "principal point";
-      value = internal::Concat(model.value[2], ", ",
-                               mode.kind == ParameterMode::Kind::kFixed
-                                   ? options.principal_point.value2 + shift
-                                   : 0.5 * (size.height - 1.0));
+      value += ", " + ValueText(mode.kind == ParameterMode::Kind::kFixed
+                                    ? options.principal_point.value2 + shift
+                                    : 0.5 * (size.height - 1.0));
     }
     model.fixed.push_back({name, value,
                            mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
