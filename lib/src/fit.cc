@@ -318,7 +318,8 @@ class TraceCallback : public ceres::IterationCallback {
 constexpr int kMaxParams = 6 + internal::kFitIntrinsicsSize;
 // At most kMaxParams entries, sized at run time: on the stack, never allocated.
 using ParamVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxParams, 1>;
-using ParamMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParams, kMaxParams>;
+using ParamMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParams, kMaxParams>;
 
 struct NormalEquations {
   ParamMatrix jtj;
@@ -456,13 +457,26 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
                                     const IntrinsicValues& intrinsics,
                                     const JacobianColumns& columns, NormalEquations* out) {
+  // 6 (pose) + up to 5 general slots: focal, aspect, skew, k1, k2.
   switch (columns.num_general) {
-    case 6: return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
-    case 7: return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
-    case 8: return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
-    case 9: return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
-    case 10: return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
-    default: return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center, intrinsics, columns, out);
+    case 6:
+      return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                intrinsics, columns, out);
+    case 7:
+      return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                intrinsics, columns, out);
+    case 8:
+      return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                intrinsics, columns, out);
+    case 9:
+      return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                intrinsics, columns, out);
+    case 10:
+      return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                 intrinsics, columns, out);
+    default:
+      return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center,
+                                                                 intrinsics, columns, out);
   }
 }
 
@@ -479,9 +493,9 @@ bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
 }
 
 // Maps local normal equations to parameters whose first six are [omega, center] with
-// dtheta = d_theta_d_omega domega and dc = rotation dC: J = J_local T with T = diag(d_theta_d_omega,
-// rotation, I), so J^T J -> T^T J^T J T and J^T r -> T^T J^T r (only the first six rows and
-// columns change).
+// dtheta = d_theta_d_omega domega and dc = rotation dC: J = J_local T with
+// T = diag(d_theta_d_omega, rotation, I), so J^T J -> T^T J^T J T and J^T r -> T^T J^T r (only
+// the first six rows and columns change).
 void ToChart(const Eigen::Matrix3d& d_theta_d_omega, const Eigen::Matrix3d& rotation,
              NormalEquations* normal) {
   const int num_intrinsics = static_cast<int>(normal->jtr.size()) - 6;
