@@ -58,21 +58,15 @@ struct ReprojectionError {
   Eigen::Vector2d observed_;
 };
 
-// The same residual with analytic derivatives, for one point; the blocks are as above. Any
-// Jacobian pointer may be null. Returns false where the point is not in front (z <= 0).
-//   p = q * (X - C), Eigen's rotation of v by q: t = 2 u x v, p = v + w t + u x t (u = q.vec());
-//   dp/dw = t, dp/du = -2w [v]x - [t]x - 2 [u]x [v]x, dp/dC = -R.
-// jacobian_p, if given, receives d pixel / d p (2 x 3, row-major) for the caller's own chain rule.
-inline bool ProjectPointWithJacobian(const double* q, const double* c, const double* k,
-                                     const Eigen::Vector3d& point, const Eigen::Vector2d& observed,
-                                     double* residual, double* jacobian_q, double* jacobian_c,
-                                     double* jacobian_k, double* jacobian_p = nullptr) {
-  const Eigen::Vector3d u(q[0], q[1], q[2]);
-  const double w = q[3];
-  const Eigen::Vector3d v = point - Eigen::Vector3d(c[0], c[1], c[2]);
-  const Eigen::Vector3d t = 2.0 * u.cross(v);
-  const Eigen::Vector3d p = v + w * t + u.cross(t);
-  if (!(p.z() > 0.0)) return false;
+// The residual (predicted - observed pixel) of a point already in the camera frame, which the
+// caller has checked is in front (z > 0), with analytic derivatives: d residual / d intrinsics
+// (2 x 7, row-major, layout above) and d residual / d point_in_cam (2 x 3, row-major), each
+// only if its pointer is given. The part of the model after the rotation, shared by
+// ProjectPointWithJacobian and the fitter's normal equations (which rotate with a matrix).
+inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_cam,
+                               const Eigen::Vector2d& observed, double* residual,
+                               double* jacobian_k, double* jacobian_p) {
+  const Eigen::Vector3d& p = point_in_cam;
   const double inv_z = 1.0 / p.z();
   const double x = p.x() * inv_z;
   const double y = p.y() * inv_z;
@@ -89,7 +83,7 @@ inline bool ProjectPointWithJacobian(const double* q, const double* c, const dou
     jk << xd, 0.0, 1.0, 0.0, yd, pu * r2, pu * r2 * r2,  //
         a * yd, f * yd, 0.0, 1.0, 0.0, a * f * y * r2, a * f * y * r2 * r2;
   }
-  if (jacobian_q == nullptr && jacobian_c == nullptr && jacobian_p == nullptr) return true;
+  if (jacobian_p == nullptr) return;
   // d pixel / d (x, y), then / d p.
   const double dd = 2.0 * (k1 + 2.0 * k2 * r2);  // d d / d x = dd x, d d / d y = dd y
   const double dxd_dx = d + x * dd * x, dxd_dy = x * dd * y;
@@ -99,12 +93,34 @@ inline bool ProjectPointWithJacobian(const double* q, const double* c, const dou
       a * f * dyd_dx, a * f * dyd_dy;
   Eigen::Matrix<double, 2, 3> d_xy_d_p;
   d_xy_d_p << inv_z, 0.0, -x * inv_z, 0.0, inv_z, -y * inv_z;
-  const Eigen::Matrix<double, 2, 3> d_pixel_d_p = d_pixel_d_xy * d_xy_d_p;
+  Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jacobian_p);
+  jp = d_pixel_d_xy * d_xy_d_p;
+}
+
+// The same residual with analytic derivatives, for one point; the blocks are as above. Any
+// Jacobian pointer may be null. Returns false where the point is not in front (z <= 0).
+//   p = q * (X - C), Eigen's rotation of v by q: t = 2 u x v, p = v + w t + u x t (u = q.vec());
+//   dp/dw = t, dp/du = -2w [v]x - [t]x - 2 [u]x [v]x, dp/dC = -R.
+// jacobian_p, if given, receives d pixel / d p (2 x 3, row-major) for the caller's own chain rule.
+inline bool ProjectPointWithJacobian(const double* q, const double* c, const double* k,
+                                     const Eigen::Vector3d& point, const Eigen::Vector2d& observed,
+                                     double* residual, double* jacobian_q, double* jacobian_c,
+                                     double* jacobian_k, double* jacobian_p = nullptr) {
+  const Eigen::Vector3d u(q[0], q[1], q[2]);
+  const double w = q[3];
+  const Eigen::Vector3d v = point - Eigen::Vector3d(c[0], c[1], c[2]);
+  const Eigen::Vector3d t = 2.0 * u.cross(v);
+  const Eigen::Vector3d p = v + w * t + u.cross(t);
+  if (!(p.z() > 0.0)) return false;
+  const bool pose_jacobian = jacobian_q != nullptr || jacobian_c != nullptr;
+  Eigen::Matrix<double, 2, 3, Eigen::RowMajor> d_pixel_d_p;
+  ResidualOfCamPoint(k, p, observed, residual, jacobian_k,
+                     pose_jacobian || jacobian_p != nullptr ? d_pixel_d_p.data() : nullptr);
   if (jacobian_p != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jacobian_p);
     jp = d_pixel_d_p;
   }
-  if (jacobian_q == nullptr && jacobian_c == nullptr) return true;
+  if (!pose_jacobian) return true;
   auto skew = [](const Eigen::Vector3d& e) {
     Eigen::Matrix3d m;
     m << 0.0, -e.z(), e.y(), e.z(), 0.0, -e.x(), -e.y(), e.x(), 0.0;
