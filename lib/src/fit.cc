@@ -780,8 +780,11 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
 // holds the normal equations (ComputeNormalEquations) at the start on entry; on return, those
-// at the final parameters, or one settling step (under kSettledStepPx) before them.
-void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
+// at the final parameters, or one settling step (under kSettledStepPx) before them. Returns
+// whether it settled: a step under kSettledStepPx, or steps that stopped shrinking at the
+// rounding floor (under kRoundingFloorPx). It does not settle where LM stopped short of the
+// minimum on a curved valley: there Gauss-Newton steps overshoot and raise the cost.
+bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
                        NormalEquations* normal) {
@@ -789,6 +792,20 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
   // their pixel-noise sigma per px of noise).
   constexpr double kSettledStepPx = 1e-9;
+  // Converged when the last Gauss-Newton step, taken or not, changes the residual vector by at
+  // most kConvergedFraction of the residuals' own sigma (|J delta| in px against
+  // sqrt(cost / (2N - p))), or by rounding alone (kRoundingStepPx): the parameters are then
+  // within 1e-3 of their standard deviation of the minimum in the joint (Mahalanobis) sense.
+  // Where LM stops short on a curved valley, most of the residual is still removable and the
+  // step is about sqrt(2N - p) sigmas.
+  constexpr double kConvergedFraction = 1e-3;
+  constexpr double kRoundingStepPx = 1e-8;
+  double last_step_px = std::numeric_limits<double>::infinity();
+  const double dof = std::max(1.0, 2.0 * points.size() - normal->jtj.rows());
+  auto converged = [&] {
+    const double noise_px = std::sqrt(normal->cost / dof);
+    return last_step_px <= std::max(kConvergedFraction * noise_px, kRoundingStepPx);
+  };
   const JacobianColumns columns(*model);
   double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
@@ -797,7 +814,7 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
         -(scale.asDiagonal() * (scale.asDiagonal() * normal->jtj * scale.asDiagonal())
                                    .ldlt()
                                    .solve(scale.asDiagonal() * normal->jtr));
-    if (!delta.allFinite()) return;
+    if (!delta.allFinite()) return false;
     Eigen::Matrix3d new_rotation = *rotation;
     const double angle = delta.head<3>().norm();
     if (angle > 0.0) {
@@ -811,6 +828,8 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     }
     // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
+    // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
+    last_step_px = std::sqrt(std::max(0.0, delta.dot(normal->jtj * delta)));
     if (step_px <= kSettledStepPx) {
       // The last step: take it without another pass over the points. The normal equations stay
       // those one step back, where J^T J differs by ~1e-12 relative (the step's size against
@@ -818,24 +837,27 @@ void PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       *rotation = new_rotation;
       *center = new_center;
       model->value = new_intrinsics;
-      return;
+      return true;
     }
     NormalEquations new_normal;
     if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_intrinsics, columns,
                                 &new_normal)) {
-      return;
+      return false;  // a point behind the camera
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
     // ~1e-16), so accept rounding-level increases and stop on the step's size instead.
-    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) return;
+    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) {
+      return converged();
+    }
     *rotation = new_rotation;
     *center = new_center;
     model->value = new_intrinsics;
     *normal = std::move(new_normal);
     // A step that stops shrinking has reached the rounding floor.
-    if (step_px > 0.5 * previous_step_px) return;
+    if (step_px > 0.5 * previous_step_px) return converged();
     previous_step_px = step_px;
   }
+  return converged();
 }
 
 double Median(std::vector<double> values) {
@@ -852,6 +874,7 @@ double Median(std::vector<double> values) {
 // One least-squares refinement: Levenberg-Marquardt, then the Gauss-Newton polish, with its trace.
 struct LeastSquaresOutcome {
   bool ok = false;
+  bool converged = false;  // the polish settled (see PolishGaussNewton)
   Eigen::Matrix3d rotation;
   Eigen::Vector3d center;
   Model model;
@@ -867,27 +890,38 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time) {
   LeastSquaresOutcome outcome;
-  const ChartProblem problem(points, pixels, start_rotation, model);
-  ParamVector u = problem.Pack(start_center);
-  const LmSummary summary =
-      MinimizeLevenbergMarquardt(problem, options, start_time, &u, &outcome.trace);
-  problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
-  outcome.iterations = summary.iterations;
-  outcome.termination = LmStatusText(summary.status);
-  // LM's last normal equations, when they are at its answer, are the polish's first (the local
-  // ones at the same camera: only the change of variables differs).
-  bool have_normal = summary.local_at_solution;
-  if (have_normal) {
-    outcome.normal = summary.local;
-    ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
-  } else {
-    have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
-                                         outcome.model, &outcome.normal);
+  outcome.rotation = start_rotation;
+  outcome.center = start_center;
+  outcome.model = model;
+  // LM's stopping rules can fire while it crawls along a curved, nearly flat valley (a nearly
+  // planar scene with the full model: 100 iterations left it 6 sigma from the optimum; at
+  // thickness 1e-4 it needs 700). The polish then does not converge, and LM resumes from where it
+  // stopped; after kMaxRounds the caller refuses rather than return a camera short of the minimum.
+  constexpr int kMaxRounds = 20;
+  bool have_normal = false;
+  for (int round = 0; round < kMaxRounds && !outcome.converged; ++round) {
+    const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
+    ParamVector u = problem.Pack(outcome.center);
+    const LmSummary summary =
+        MinimizeLevenbergMarquardt(problem, options, start_time, &u, &outcome.trace);
+    problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
+    outcome.iterations += summary.iterations;
+    outcome.termination = LmStatusText(summary.status);
+    // LM's last normal equations, when they are at its answer, are the polish's first (the local
+    // ones at the same camera: only the change of variables differs).
+    have_normal = summary.local_at_solution;
+    if (have_normal) {
+      outcome.normal = summary.local;
+      ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
+    } else {
+      have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
+                                           outcome.model, &outcome.normal);
+    }
+    if (!have_normal) break;
+    outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
+                                          &outcome.model, &outcome.normal);
   }
-  if (have_normal) {
-    PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center, &outcome.model,
-                      &outcome.normal);
-  }
+  if (!have_normal) outcome.normal = NormalEquations();
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned
   // half a turn: neither is an answer (the caller refuses).
   outcome.ok = outcome.normal.jtj.size() > 0 && std::isfinite(outcome.normal.cost) &&
@@ -1243,6 +1277,15 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                        "the correspondences are inconsistent (mismatched or mis-clicked points); "
                        "check them or use --ransac");
     }
+    if (!best.converged) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       internal::Concat("the refinement did not reach the minimum in ",
+                                        best.iterations, " iterations: the points barely "
+                                        "determine the model (a nearly flat, curved valley of "
+                                        "cameras that fit about equally well; ",
+                                        best.termination, "). Fix intrinsics (e.g. "
+                                        "--model focal), or add points spread further in depth"));
+    }
     rotation_matrix = best.rotation;
     center = best.center;
     model = best.model;
@@ -1373,17 +1416,27 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   const Eigen::SelfAdjointEigenSolver<ParamMatrix> eigen(scaled);
   const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(num_params - 1);
   if (!(rcond > kSingularRcond)) {
-    // Name the parameters that move along the unconstrained direction.
+    // Name the parameters that move along the unconstrained direction, and the free intrinsic
+    // that moves most along it: the pose cannot be fixed, an intrinsic can.
     const ParamVector direction = eigen.eigenvectors().col(0);
     std::string involved;
+    int intrinsic = -1;
     for (int j = 0; j < num_params; ++j) {
       if (std::abs(direction(j)) > 0.3) involved += (involved.empty() ? "" : ", ") + names[j];
+      if (j >= 6 && (intrinsic < 0 || std::abs(direction(j)) > std::abs(direction(intrinsic)))) {
+        intrinsic = j;
+      }
     }
+    const std::string fix =
+        intrinsic >= 0 ? "fix " + names[intrinsic] + " (the free intrinsic that moves most along "
+                                                      "it, e.g. with --model or a value)"
+                       : "fix intrinsics";
     throw SceneError(SceneError::Reason::kDegenerate,
                      internal::Concat("the points do not determine ", involved,
-                                      " (singular normal equations, reciprocal condition ", rcond,
-                                      "): fix them, or add points that spread further in depth "
-                                      "and across the image"));
+                                      " (singular normal equations, reciprocal condition ",
+                                      std::max(rcond, 0.0), "): ", fix,
+                                      ", or add points that spread further in depth and across "
+                                      "the image"));
   }
   result.jacobian_condition = std::sqrt(1.0 / rcond);
   const int dof = 2 * n - num_params;

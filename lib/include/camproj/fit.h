@@ -86,14 +86,18 @@ struct FitOptions {
   std::optional<double> pixel_sigma;
 
   // false: return the closed-form start (DLT / homography / PnP, projected onto the model)
-  // without Ceres refinement; the residuals, views and uncertainty are those of the start.
+  // without refinement; the residuals, views and uncertainty are those of the start. (A
+  // six-point DLT that reads the world as mirrored still refines both readings to decide.)
   bool refine = true;
   // false: skip the covariance (sigmas, correlations); saves its cost in batch use.
   bool compute_uncertainty = true;
 
-  // Ceres' Levenberg-Marquardt stopping rules. LM only needs to get close: a few undamped
-  // Gauss-Newton steps with the exact Jacobian follow it (without a robust loss) and stop when a
-  // step changes the residuals by less than 1e-12 px.
+  // Levenberg-Marquardt's stopping rules (ceres::TinySolver's; Ceres' own solver with a robust
+  // loss). LM only needs to get close: undamped Gauss-Newton steps with the exact Jacobian follow
+  // it (without a robust loss) and settle when a step moves the residuals by under 1e-9 px. The
+  // answer must be at the minimum -- the last Gauss-Newton step changes the residual vector by at
+  // most 1e-3 of the residuals' sigma -- else LM resumes from there, up to 20 rounds of
+  // max_iterations, and then the fit is refused (kDegenerate) rather than returned short of it.
   int max_iterations = 100;
   double function_tolerance = 1e-10;   // relative cost change
   double gradient_tolerance = 1e-16;
