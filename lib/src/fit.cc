@@ -1337,6 +1337,14 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                        "the refinement failed: " + summary.message +
                            ": check the correspondences");
     }
+    if (summary.termination_type == ceres::NO_CONVERGENCE) {
+      // As for least squares: never a camera short of the minimum.
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       internal::Concat("the robust refinement did not converge in ",
+                                        options.max_iterations, " iterations (", summary.message,
+                                        "): the points barely determine the model; fix "
+                                        "intrinsics, add points, or raise --max-iterations"));
+    }
     model.value = intrinsics;
     rotation.normalize();
     rotation_matrix = rotation.toRotationMatrix();
