@@ -232,106 +232,118 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
            " px (bound " + Fixed(corner_bound_px) + " px)";
   };
 
-  // The simplest models: pose + focal with the forced groups, and the orthographic camera.
-  FitOptions current_options = base;
-  Evaluation current = Evaluate(points, pixels, image_size, current_options);
-  // Perspective or orthographic is the criterion's call: a focal length with a large sigma is
-  // still the better model when the perspective is significant (its sigma is reported).
-  const std::string perspective_problem = current.fit ? "" : current.refusal;
-  size_t current_index =
-      record(current, "pose+focal",
-             perspective_problem.empty() ? "simplest perspective model"
-                                         : "not determined: " + perspective_problem);
-  bool orthographic = false;
+  // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
+  // improves and the scene determines it. A refused base is a model of infinite criterion that any
+  // fitted trial improves on (so a perspective camera whose principal point is far from the
+  // centre is still found). Records every model tried and why each group was left out.
+  struct Ladder {
+    Evaluation final;
+    FitOptions final_options;
+    size_t final_index = 0;
+    std::vector<int> included;
+    std::string why_left_out[kNumGroups];
+  };
+  auto criterion_or_inf = [&](const Evaluation& e) {
+    return e.fit ? criterion_of(e) : std::numeric_limits<double>::infinity();
+  };
+  auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
+                        const std::vector<int>& groups) {
+    Ladder ladder;
+    ladder.final_options = base_options;
+    ladder.final = Evaluate(points, pixels, image_size, base_options);
+    ladder.final_index = record(ladder.final, base_name,
+                                ladder.final.fit ? "simplest model"
+                                                 : "not determined: " + ladder.final.refusal);
+    for (;;) {
+      const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
+      int best_group = -1;
+      size_t best_index = 0;
+      Evaluation best;
+      FitOptions best_options;
+      for (const int g : groups) {
+        if (std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end()) {
+          continue;
+        }
+        if (g == kK2 &&
+            std::find(ladder.included.begin(), ladder.included.end(), kK1) == ladder.included.end() &&
+            std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
+          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
+          continue;
+        }
+        FitOptions trial_options = ladder.final_options;
+        ModeOf(trial_options, g) = ParameterMode::Free();
+        Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
+        const std::string name = current_name + "+" + kGroupNames[g];
+        if (!trial.fit) {
+          ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
+                                   trial.refusal + ")";
+          record(trial, name, "not determined: refused");
+          continue;
+        }
+        const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
+        if (!problem.empty()) {
+          ladder.why_left_out[g] = "left out: not determined: " + problem;
+          record(trial, name, "not determined: " + problem);
+          continue;
+        }
+        const double delta = criterion_of(trial) - criterion_or_inf(ladder.final);
+        ladder.why_left_out[g] = "left out: delta " + std::string(criterion_name) + " " +
+                                 Signed(delta) + " against " + current_name +
+                                 ": not supported by the data";
+        const size_t index =
+            record(trial, name, "delta " + std::string(criterion_name) + " " + Signed(delta));
+        if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
+          best_group = g;
+          best_index = index;
+          best = std::move(trial);
+          best_options = trial_options;
+        }
+      }
+      if (best_group < 0) break;
+      ladder.included.push_back(best_group);
+      ladder.final = std::move(best);
+      ladder.final_options = best_options;
+      ladder.final_index = best_index;
+      tried[best_index].verdict += ": kept";
+    }
+    return ladder;
+  };
+
+  // The perspective ladder from pose + focal, and the orthographic one (scale, then aspect and
+  // skew); the family whose final model has the lower criterion wins.
+  Ladder chosen = run_ladder(base, "pose+focal", candidates);
   if (options.allow_orthographic && OrthographicIsPossible(base)) {
     FitOptions ortho_options = base;
     ortho_options.projection = Projection::kOrthographic;
-    Evaluation ortho = Evaluate(points, pixels, image_size, ortho_options);
-    if (!ortho.fit) {
-      record(ortho, "orthographic", "not determined: refused");
-    } else {
-      const double delta = perspective_problem.empty() ? criterion_of(ortho) - criterion_of(current) : 0.0;
-      orthographic = !perspective_problem.empty() || delta < 0.0;
-      const size_t index = record(
-          ortho, "orthographic",
-          !perspective_problem.empty()
-              ? std::string("kept: no perspective camera fits")
-              : "delta " + std::string(criterion_name) + " " + Signed(delta) +
-                    " against pose+focal" + (orthographic ? ": kept" : ""));
-      if (orthographic) {
-        current = std::move(ortho);
-        current_options = ortho_options;
-        current_index = index;
-      }
-    }
-  }
-  if (!orthographic && !perspective_problem.empty()) {
-    FitCamera(points, pixels, image_size, current_options);  // rethrows the refusal
-  }
-  std::vector<int> included;
-  std::string why_left_out[kNumGroups];
-  if (orthographic) {
-    // An orthographic camera has aspect and skew; the rest are not part of it.
-    std::vector<int> kept;
+    std::vector<int> ortho_groups;
     for (const int g : candidates) {
-      if (g == kAspect || g == kSkew) {
-        kept.push_back(g);
-      } else {
-        why_left_out[g] = "left out: not part of an orthographic camera (the perspective is not "
-                          "supported by the data)";
-      }
+      if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
     }
-    candidates = kept;
-  }
-
-  for (;;) {
-    int best_group = -1;
-    size_t best_index = 0;
-    Evaluation best;
-    FitOptions best_options;
-    for (const int g : candidates) {
-      if (std::find(included.begin(), included.end(), g) != included.end()) continue;
-      if (g == kK2 && std::find(included.begin(), included.end(), kK1) == included.end() &&
-          std::find(candidates.begin(), candidates.end(), kK1) != candidates.end()) {
-        why_left_out[g] = "left out: not tried, k1 is not in the model";
-        continue;
+    Ladder ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
+    if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
+      const std::string against =
+          chosen.final.fit ? "delta " + std::string(criterion_name) + " " +
+                                 Signed(criterion_of(ortho.final) - criterion_of(chosen.final)) +
+                                 " against the best perspective model, " + chosen.final.fit->model
+                           : std::string("no perspective model fits");
+      for (const int g : candidates) {
+        // (The orthographic fit says itself why it has no principal point.)
+        if (g != kAspect && g != kSkew && g != kPrincipalPoint) {
+          ortho.why_left_out[g] = "left out: not part of an orthographic camera (" + against + ")";
+        }
       }
-      FitOptions trial_options = current_options;
-      ModeOf(trial_options, g) = ParameterMode::Free();
-      Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
-      const std::string name = current.fit->model + "+" + kGroupNames[g];
-      if (!trial.fit) {
-        why_left_out[g] = "left out: not determined (the fit with it is refused: " +
-                          trial.refusal + ")";
-        record(trial, name, "not determined: refused");
-        continue;
-      }
-      const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
-      if (!problem.empty()) {
-        why_left_out[g] = "left out: not determined: " + problem;
-        record(trial, name, "not determined: " + problem);
-        continue;
-      }
-      const double delta = criterion_of(trial) - criterion_of(current);
-      why_left_out[g] = "left out: delta " + std::string(criterion_name) + " " +
-                        Signed(delta) + " against " +
-                        current.fit->model + ": not supported by the data";
-      const size_t index =
-          record(trial, name, "delta " + std::string(criterion_name) + " " + Signed(delta));
-      if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
-        best_group = g;
-        best_index = index;
-        best = std::move(trial);
-        best_options = trial_options;
-      }
+      chosen = std::move(ortho);
     }
-    if (best_group < 0) break;
-    included.push_back(best_group);
-    current = std::move(best);
-    current_options = best_options;
-    current_index = best_index;
-    tried[current_index].verdict += ": kept";
   }
+  if (!chosen.final.fit) {
+    FitCamera(points, pixels, image_size, base);  // rethrows the simplest model's refusal
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "no model of the ladder fits these points: check the correspondences");
+  }
+  FitOptions current_options = chosen.final_options;
+  const size_t current_index = chosen.final_index;
+  const std::vector<int>& included = chosen.included;
+  const std::string* why_left_out = chosen.why_left_out;
 
   // The chosen model again with the caller's noise setting, so that its sigmas are reported as
   // FitCamera reports them.
