@@ -319,7 +319,30 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
     for (const int g : candidates) {
       if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
     }
-    Ladder ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
+    // No orthographic model fits better than the affine camera (all of them free), so when even
+    // its sum of squares with the fewest orthographic parameters' penalty cannot beat the best
+    // perspective model, the orthographic ladder cannot win: skip it (one fit, not up to four).
+    FitOptions affine_options = ortho_options;
+    for (const int g : ortho_groups) ModeOf(affine_options, g) = ParameterMode::Free();
+    affine_options.compute_uncertainty = false;
+    const Evaluation affine = Evaluate(points, pixels, image_size, affine_options);
+    const double ortho_lower_bound =
+        affine.fit ? affine.sum_squares / (sigma * sigma) + (aic ? 2.0 : std::log(num_equations)) * 6
+                   : std::numeric_limits<double>::infinity();
+    Ladder ortho;
+    if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
+      ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
+    } else {
+      ModelCandidate c;
+      c.name = "orthographic";  // with the forced groups, as its ladder would name it
+      if (ortho_options.aspect.IsFree()) c.name += "+aspect";
+      if (ortho_options.skew.IsFree()) c.name += "+skew";
+      c.verdict = affine.fit ? "not supported: even the affine camera's residual (rms " +
+                                   Fixed(affine.fit->rms_px) + " px) puts every orthographic "
+                                   "model above the best perspective one"
+                             : "not determined: " + affine.refusal;
+      tried.push_back(c);
+    }
     if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
       const std::string against =
           chosen.final.fit ? "delta " + std::string(criterion_name) + " " +
