@@ -16,6 +16,7 @@
 
 #include "check.h"
 #include "closed_form.h"
+#include "correlations.h"
 #include "orthographic_fit.h"
 #include "reprojection_error.h"
 
@@ -1503,15 +1504,8 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                              fov_sigma(k.fx, image_size.width, var_fx), "deg"});
     result.sigmas.push_back({"fovy_deg", 2.0 * std::atan(0.5 * image_size.height / k.fy) * kDegPerRad,
                              fov_sigma(k.fy, image_size.height, var_fy), "deg"});
-    for (int a = 0; a < num_params; ++a) {
-      for (int b = a + 1; b < num_params; ++b) {
-        const double rho = result.covariance(a, b) /
-                           std::sqrt(result.covariance(a, a) * result.covariance(b, b));
-        if (std::abs(rho) >= options.strong_correlation) {
-          result.strong_correlations.push_back({names[a], names[b], rho});
-        }
-      }
-    }
+    result.strong_correlations =
+        internal::StrongCorrelations(result.covariance, names, options.strong_correlation);
   }
   result.time_ms = MicrosecondsSince(start_time) / 1000.0;
   return result;

@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "check.h"
+#include "correlations.h"
 
 namespace camproj {
 namespace internal {
@@ -354,15 +355,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
       const std::string unit = j < 3 ? "deg" : j < 5 ? "world" : "px per world unit";
       result.sigmas.push_back({names[j], values[value_index], std::sqrt(result.covariance(j, j)), unit});
     }
-    for (int a_index = 0; a_index < p; ++a_index) {
-      for (int b_index = a_index + 1; b_index < p; ++b_index) {
-        const double rho = result.covariance(a_index, b_index) /
-                           std::sqrt(result.covariance(a_index, a_index) * result.covariance(b_index, b_index));
-        if (std::abs(rho) >= options.strong_correlation) {
-          result.strong_correlations.push_back({names[a_index], names[b_index], rho});
-        }
-      }
-    }
+    result.strong_correlations = StrongCorrelations(result.covariance, names, options.strong_correlation);
   }
   result.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_time).count();
