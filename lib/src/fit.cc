@@ -16,7 +16,7 @@
 
 #include "check.h"
 #include "closed_form.h"
-#include "correlations.h"
+#include "fit_common.h"
 #include "orthographic_fit.h"
 #include "reprojection_error.h"
 
@@ -1135,12 +1135,8 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
       inlier_pixels.push_back(observed_pixels[i]);
     }
     FitResult result = FitCamera(inlier_points, inlier_pixels, image_size, inner);
-    result.residuals_px.assign(n, Eigen::Vector2d::Constant(kInfinity));
-    std::vector<double> inlier_norms;
-    for (int i = 0; i < n; ++i) {
-      const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(result.camera, points_in_world[i]);
-      if (predicted) result.residuals_px[i] = *predicted - pixels[i];
-    }
+    result.residuals_px = internal::ResidualsAgainst(result.camera, points_in_world,
+                                                     observed_pixels, options.pixel_origin);
     for (int i = 0; i < n; ++i) {
       if (!(result.residuals_px[i].norm() <= options.ransac_threshold_px)) {
         result.outliers.push_back(i);
@@ -1419,15 +1415,12 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
 
   // Uncertainty: Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
   // Fixed-capacity types (ParamMatrix): no allocation, and Eigen's small-matrix products.
-  const ParamMatrix& normal = normal_equations.jtj;
-  const ParamVector column_scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-  const ParamMatrix scaled = column_scale.asDiagonal() * normal * column_scale.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<ParamMatrix> eigen(scaled);
-  const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(num_params - 1);
+  const internal::JacobiScaledNormal<ParamMatrix> scaled_normal(normal_equations.jtj);
+  const double rcond = scaled_normal.rcond;
   if (!(rcond > kSingularRcond)) {
     // Name the parameters that move along the unconstrained direction, and the free intrinsic
     // that moves most along it: the pose cannot be fixed, an intrinsic can.
-    const ParamVector direction = eigen.eigenvectors().col(0);
+    const ParamVector direction = scaled_normal.eigen.eigenvectors().col(0);
     std::string involved;
     int intrinsic = -1;
     for (int j = 0; j < num_params; ++j) {
@@ -1447,21 +1440,11 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                                       ", or add points that spread further in depth and across "
                                       "the image"));
   }
-  result.jacobian_condition = std::sqrt(1.0 / rcond);
-  const int dof = 2 * n - num_params;
-  if (options.pixel_sigma) {
-    result.pixel_sigma = *options.pixel_sigma;
-    result.pixel_sigma_estimated = false;
-  } else if (dof > 0) {
-    result.pixel_sigma = std::sqrt(sum_squares / dof);
-  }
-  if (options.compute_uncertainty && (options.pixel_sigma || dof > 0)) {
-    const ParamMatrix scaled_inverse =
-        eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
-        eigen.eigenvectors().transpose();
-    const ParamMatrix covariance_u = result.pixel_sigma * result.pixel_sigma *
-                                     column_scale.asDiagonal() * scaled_inverse *
-                                     column_scale.asDiagonal();
+  result.jacobian_condition = scaled_normal.JacobianCondition();
+  const bool have_sigma = internal::SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
+  if (options.compute_uncertainty && have_sigma) {
+    const ParamMatrix covariance_u =
+        result.pixel_sigma * result.pixel_sigma * scaled_normal.Inverse();
     ParamMatrix l = ParamMatrix::Identity(num_params, num_params);
     for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
     for (int j = 3; j < 6; ++j) l(j, j) = scale;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "check.h"
+#include "fit_common.h"
 
 namespace camproj {
 
@@ -155,6 +156,26 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
     base.ransac = false;
   }
   const double num_equations = 2.0 * static_cast<double>(points.size());
+  const bool aic = options.criterion == ModelCriterion::kAic;
+  const double penalty = aic ? 2.0 : std::log(num_equations);  // per parameter
+
+  // The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
+  // orthographic family's best fit, evaluated at most once.
+  std::optional<Evaluation> affine;
+  auto affine_evaluation = [&]() -> const Evaluation& {
+    if (!affine) {
+      FitOptions affine_options = base;
+      affine_options.projection = Projection::kOrthographic;
+      affine_options.compute_uncertainty = false;
+      for (const int g : {kAspect, kSkew}) {
+        if (ModeOf(affine_options, g).kind == ParameterMode::Kind::kDefault) {
+          ModeOf(affine_options, g) = ParameterMode::Free();
+        }
+      }
+      affine = Evaluate(points, pixels, image_size, affine_options);
+    }
+    return *affine;
+  };
 
   // The pixel noise: given, or from the richest model the scene supports (dropping groups from
   // the top of the ladder until one is fitted with residual degrees of freedom to spare).
@@ -171,23 +192,15 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
     }
     if (sigma == 0.0 && options.allow_orthographic && OrthographicIsPossible(base)) {
       // No perspective model fits (a nearly parallel projection): the affine camera's noise.
-      FitOptions affine = base;
-      affine.projection = Projection::kOrthographic;
-      affine.compute_uncertainty = false;
-      for (const int g : {kAspect, kSkew}) {
-        if (ModeOf(affine, g).kind == ParameterMode::Kind::kDefault) ModeOf(affine, g) = ParameterMode::Free();
-      }
-      const Evaluation e = Evaluate(points, pixels, image_size, affine);
+      const Evaluation& e = affine_evaluation();
       if (e.fit && num_equations > e.num_params) {
         sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
       }
     }
     if (sigma == 0.0) sigma = kMinNoisePx;  // no model leaves a residual: the simplest decides
   }
-  const bool aic = options.criterion == ModelCriterion::kAic;
   const char* criterion_name = aic ? "AIC" : "BIC";
   auto criterion_of = [&](const Evaluation& e) {
-    const double penalty = aic ? 2.0 : std::log(num_equations);
     return e.sum_squares / (sigma * sigma) + penalty * e.num_params;
   };
   const double corner_bound_px = options.max_corner_sigma_fraction *
@@ -322,13 +335,10 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
     // No orthographic model fits better than the affine camera (all of them free), so when even
     // its sum of squares with the fewest orthographic parameters' penalty cannot beat the best
     // perspective model, the orthographic ladder cannot win: skip it (one fit, not up to four).
-    FitOptions affine_options = ortho_options;
-    for (const int g : ortho_groups) ModeOf(affine_options, g) = ParameterMode::Free();
-    affine_options.compute_uncertainty = false;
-    const Evaluation affine = Evaluate(points, pixels, image_size, affine_options);
+    const Evaluation& affine_fit = affine_evaluation();
     const double ortho_lower_bound =
-        affine.fit ? affine.sum_squares / (sigma * sigma) + (aic ? 2.0 : std::log(num_equations)) * 6
-                   : std::numeric_limits<double>::infinity();
+        affine_fit.fit ? affine_fit.sum_squares / (sigma * sigma) + penalty * 6
+                       : std::numeric_limits<double>::infinity();
     Ladder ortho;
     if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
       ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
@@ -337,10 +347,10 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
       c.name = "orthographic";  // with the forced groups, as its ladder would name it
       if (ortho_options.aspect.IsFree()) c.name += "+aspect";
       if (ortho_options.skew.IsFree()) c.name += "+skew";
-      c.verdict = affine.fit ? "not supported: even the affine camera's residual (rms " +
-                                   Fixed(affine.fit->rms_px) + " px) puts every orthographic "
-                                   "model above the best perspective one"
-                             : "not determined: " + affine.refusal;
+      c.verdict = affine_fit.fit ? "not supported: even the affine camera's residual (rms " +
+                                       Fixed(affine_fit.fit->rms_px) + " px) puts every "
+                                       "orthographic model above the best perspective one"
+                                 : "not determined: " + affine_fit.refusal;
       tried.push_back(c);
     }
     if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
@@ -385,15 +395,8 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
   result.selection_sigma_px = sigma;
   if (options.fit.ransac) {
     // Report every input point against the chosen camera, as FitCamera's RANSAC does.
-    const int n = static_cast<int>(points_in_world.size());
-    const double shift = PixelOriginShift(options.fit.pixel_origin, PixelOrigin::kCenter);
-    result.residuals_px.assign(n, Eigen::Vector2d::Constant(kInfinity));
-    for (int i = 0; i < n; ++i) {
-      const std::optional<Eigen::Vector2d> predicted =
-          PixelFromWorld(result.camera, points_in_world[i]);
-      if (predicted) result.residuals_px[i] = *predicted - observed_pixels[i] -
-                                              Eigen::Vector2d(shift, shift);
-    }
+    result.residuals_px = internal::ResidualsAgainst(result.camera, points_in_world,
+                                                     observed_pixels, options.fit.pixel_origin);
     result.outliers = outliers;
   }
   return result;

@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 
 #include "check.h"
-#include "correlations.h"
+#include "fit_common.h"
 
 namespace camproj {
 namespace internal {
@@ -290,28 +290,17 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
 
   // Uncertainty, as in FitCamera: Jacobi-scaled normal equations, refusal when singular.
   const int p = static_cast<int>(columns.size());
-  const Eigen::MatrixXd jtj = j_free.transpose() * j_free;
-  const Eigen::VectorXd column_scale = jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-  const Eigen::MatrixXd scaled = column_scale.asDiagonal() * jtj * column_scale.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
-  const double rcond = eigen.eigenvalues()(0) / eigen.eigenvalues()(p - 1);
+  const JacobiScaledNormal<Eigen::MatrixXd> scaled_normal(j_free.transpose() * j_free);
+  const double rcond = scaled_normal.rcond;
   if (!(rcond > kOrthoSingularRcond)) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("the points do not determine the orthographic camera (singular "
                             "normal equations, reciprocal condition ", rcond, ")"));
   }
-  result.jacobian_condition = std::sqrt(1.0 / rcond);
-  const int dof = 2 * n - p;
-  if (options.pixel_sigma) {
-    result.pixel_sigma = *options.pixel_sigma;
-    result.pixel_sigma_estimated = false;
-  } else if (dof > 0) {
-    result.pixel_sigma = std::sqrt(sum_squares / dof);
-  }
-  if (options.compute_uncertainty && (options.pixel_sigma || dof > 0)) {
-    const Eigen::MatrixXd inverse = column_scale.asDiagonal() * eigen.eigenvectors() *
-                                    eigen.eigenvalues().cwiseInverse().asDiagonal() *
-                                    eigen.eigenvectors().transpose() * column_scale.asDiagonal();
+  result.jacobian_condition = scaled_normal.JacobianCondition();
+  const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - p, &result);
+  if (options.compute_uncertainty && have_sigma) {
+    const Eigen::MatrixXd inverse = scaled_normal.Inverse();
     // To user units: omega -> degrees; the eye's lateral position g = K2^-1 (c - offset) (world
     // units, along the camera's x and y) by its derivatives; scale, fy and skew / scale.
     Eigen::MatrixXd l = Eigen::MatrixXd::Zero(p, p);

@@ -1,0 +1,96 @@
+// Pieces both fitters (fit.cc, orthographic_fit.cc) and the model selection share (private).
+#ifndef CAMPROJ_SRC_FIT_COMMON_H_
+#define CAMPROJ_SRC_FIT_COMMON_H_
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "camproj/camera.h"
+#include "camproj/fit.h"
+
+namespace camproj {
+namespace internal {
+
+// J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest
+// eigenvalue is the reciprocal condition the fitters refuse on (kDegenerate), and its inverse
+// gives the covariance. `Matrix` is Eigen::MatrixXd or a fixed-capacity type.
+template <typename Matrix>
+struct JacobiScaledNormal {
+  using Vector = Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1, 0, Matrix::MaxRowsAtCompileTime, 1>;
+
+  explicit JacobiScaledNormal(const Matrix& jtj)
+      : column_scale(jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse()),
+        eigen(Matrix(column_scale.asDiagonal() * jtj * column_scale.asDiagonal())),
+        rcond(eigen.eigenvalues()(0) / eigen.eigenvalues()(jtj.rows() - 1)) {}
+
+  // sqrt(largest / smallest eigenvalue): the scaled Jacobian's condition number.
+  double JacobianCondition() const { return std::sqrt(1.0 / rcond); }
+
+  // (J^T J)^-1, undoing the scaling.
+  Matrix Inverse() const {
+    return column_scale.asDiagonal() *
+           Matrix(eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                  eigen.eigenvectors().transpose()) *
+           column_scale.asDiagonal();
+  }
+
+  Vector column_scale;
+  Eigen::SelfAdjointEigenSolver<Matrix> eigen;
+  double rcond;
+};
+
+// The pixel noise the covariance is scaled by: given, or sqrt(sum_squares / dof) (none when
+// dof <= 0). Sets result->pixel_sigma and pixel_sigma_estimated; returns whether there is one.
+inline bool SetPixelSigma(const FitOptions& options, double sum_squares, int dof,
+                          FitResult* result) {
+  if (options.pixel_sigma) {
+    result->pixel_sigma = *options.pixel_sigma;
+    result->pixel_sigma_estimated = false;
+    return true;
+  }
+  if (dof <= 0) return false;
+  result->pixel_sigma = std::sqrt(sum_squares / dof);
+  return true;
+}
+
+// Every pair (a < b) whose |correlation| is at least `threshold`, named by `names` (the
+// covariance's order).
+inline std::vector<Correlation> StrongCorrelations(const Eigen::MatrixXd& covariance,
+                                                   const std::vector<std::string>& names,
+                                                   double threshold) {
+  std::vector<Correlation> strong;
+  for (int a = 0; a < covariance.rows(); ++a) {
+    for (int b = a + 1; b < covariance.rows(); ++b) {
+      const double rho = covariance(a, b) / std::sqrt(covariance(a, a) * covariance(b, b));
+      if (std::abs(rho) >= threshold) strong.push_back({names[a], names[b], rho});
+    }
+  }
+  return strong;
+}
+
+// Predicted - observed pixel (observed in `origin`, the result in kCenter px) of every point
+// against `camera`; infinite for a point behind it. For reporting RANSAC's outliers too.
+inline std::vector<Eigen::Vector2d> ResidualsAgainst(const Camera& camera,
+                                                     const std::vector<Eigen::Vector3d>& points,
+                                                     const std::vector<Eigen::Vector2d>& observed,
+                                                     PixelOrigin origin) {
+  const double shift = PixelOriginShift(origin, PixelOrigin::kCenter);
+  std::vector<Eigen::Vector2d> residuals(points.size(), Eigen::Vector2d::Constant(
+                                                            std::numeric_limits<double>::infinity()));
+  for (size_t i = 0; i < points.size(); ++i) {
+    const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, points[i]);
+    if (predicted) residuals[i] = *predicted - (observed[i] + Eigen::Vector2d(shift, shift));
+  }
+  return residuals;
+}
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_COMMON_H_
