@@ -127,6 +127,11 @@ class SceneError : public std::runtime_error {
     kPointsBehindCamera,
     kMirroredWorld,          // left-handed world frame
     kDegenerate,             // no unique solution (e.g. a plane seen head-on with free focal)
+    // FitCameraAuto (model_select.h) only:
+    kContaminated,  // some points disagree with the rest and the rest cannot say which
+    kInconsistent,  // the best camera's residuals are larger than the pixel noise allows
+    kAmbiguous,     // two different cameras explain the points about equally well
+    kNumerical,     // a numerical failure on these values (a bug: please report it)
   };
   SceneError(Reason reason, const std::string& message)
       : std::runtime_error(message), reason_(reason) {}
@@ -178,6 +183,31 @@ struct ModelCandidate {
   std::string verdict;       // "chosen", "kept", "not supported ...", "not determined ...", ...
 };
 
+// A point FitCameraAuto's outlier stage left out of the fit, measured against the returned
+// camera.
+struct LeftOutPoint {
+  int index = 0;               // into the caller's points, 0-based
+  double residual_px = 0.0;    // |predicted - observed| against the returned camera
+  double rms_with_px = 0.0;    // RMS of the same model fitted with this point put back
+};
+
+// FitCameraAuto's final consistency gate (docs/model-selection.md): the returned camera's
+// residuals are consistent with the pixel noise. A result is only returned when `passed`.
+struct ConsistencyCheck {
+  bool checked = false;        // false: FitCamera alone, no gate ran
+  bool passed = false;
+  double noise_px = 0.0;       // the noise the residuals are tested against (per axis)
+  std::string noise_source;    // "given", "default prior", ...
+  double rms_px = 0.0;         // of the points kept
+  double noise_estimate_px = 0.0;  // sqrt(J / (2N - p)) over the points kept
+  double noise_bound_px = 0.0;     // the largest noise estimate the chi-square test accepts
+  double robust_noise_px = 0.0;    // from the median residual (Rayleigh), over the points kept
+  double max_residual_px = 0.0;    // largest residual among the points kept
+  double max_residual_bound_px = 0.0;  // outlier bound: sqrt(2 ln(N / alpha)) * noise
+  double significance = 0.0;   // alpha of both tests
+  std::string summary;         // one line in words
+};
+
 struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
@@ -185,7 +215,12 @@ struct FitResult {
   // Per point: predicted - observed, px, in input order (infinite for a point behind the camera,
   // possible only among RANSAC's outliers).
   std::vector<Eigen::Vector2d> residuals_px;
-  std::vector<int> outliers;  // with FitOptions::ransac: indices of the points it left out
+  // Indices of the points left out of the fit: RANSAC's (FitOptions::ransac), or FitCameraAuto's
+  // outlier stage (then also in left_out, with their residuals).
+  std::vector<int> outliers;
+  std::vector<LeftOutPoint> left_out;
+  std::string outlier_method;  // "", "ransac", "leave-one-out", "leave-two-out", "lo-ransac"
+  ConsistencyCheck consistency;
   double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;

@@ -53,6 +53,41 @@ struct AutoFitOptions {
   // camera fits.
   bool allow_orthographic = true;
 
+  // The outlier stage (docs/model-selection.md): when the least-squares fit of every point fails
+  // the consistency gate, find the points that disagree -- by an exhaustive leave-one-out /
+  // leave-two-out search up to exhaustive_max_points, by LO-RANSAC above -- and select the
+  // model again on the rest. false (camproj fit --keep-all): every point is kept, and a
+  // contaminated scene is refused by the gate. FitOptions::ransac forces RANSAC at its threshold.
+  bool find_outliers = true;
+  int exhaustive_max_points = 12;
+
+  // The pixel noise assumed when FitOptions::pixel_sigma is unset (clicked points: about 1 px).
+  // The model selection's noise is this prior combined with the residuals of the richest model
+  // the scene supports, the prior counting as prior_weight residual degrees of freedom (a
+  // scaled-inverse-chi-square prior): at 6-12 points the prior decides, at hundreds the data.
+  double prior_sigma_px = 1.0;
+  double prior_weight = 10.0;
+
+  // The consistency gate, at significance `significance` (per test): (1) the noise estimate
+  // sqrt(J / (2N - p)) is at most noise_tolerance times the noise (given, else the prior):
+  // J <= (noise_tolerance * noise)^2 * chi2_{2N-p}(1 - significance); (2) no kept point's
+  // residual exceeds sqrt(2 ln(N / significance)) times the robust noise estimate (median
+  // residual, corrected for the fit's leverage). Failing either is SceneError kInconsistent.
+  double significance = 1e-3;
+  double noise_tolerance = 2.0;
+
+  // A model is only freed beyond pose + focal when it leaves at least this many redundant
+  // equations (2N - p): with fewer, its residuals cannot show that it is wrong.
+  int min_redundancy = 3;
+
+  // Below this many points, refine the chosen model from several starts (the other models'
+  // cameras, focal lengths 0.5x and 2x); if another minimum fits about as well (criterion within
+  // ambiguity_criterion_gap) but moves a point of the scene's bounding box by more than
+  // ambiguity_px, refuse (SceneError kAmbiguous).
+  int multi_start_below_points = 20;
+  double ambiguity_criterion_gap = 4.0;
+  double ambiguity_px = 5.0;
+
   void Check() const;  // throws std::invalid_argument naming the field
 };
 
@@ -61,6 +96,14 @@ struct AutoFitOptions {
 // every candidate left out with the reason ("left out: not determined: sigma would be 180 px
 // at the corner, bound 55 px"; "left out: delta AIC +3.1 against the chosen model: not
 // supported by the data"). Throws like FitCamera when even the simplest model is refused.
+//
+// This is what `camproj fit` runs, as a pipeline: validated scene -> model selection on every
+// point -> consistency gate; if it fails, the outlier stage and the selection again on the
+// inliers -> several starts at small N (ambiguity) -> the gate on the returned camera. A result
+// is returned only if FitResult::consistency.passed; every refusal of well-formed input is a
+// SceneError whose message says what to fix (std::invalid_argument only for bad options or
+// mismatched sizes). FitResult::rms_px etc. are recomputed from the returned camera in world
+// coordinates, as a reader of the camera file would recompute them.
 FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& observed_pixels,
                         const ImageSize& image_size, const AutoFitOptions& options = {});
