@@ -129,13 +129,16 @@ TEST(ModelSelectTest, ForcedAndGivenParametersAreRespected) {
   EXPECT_EQ(fit.candidates.back().verdict.empty(), false);
 }
 
-// Noise-free data of an off-axis camera: the selection noise floors at kMinNoisePx, the
-// principal point is kept and the camera recovered exactly (1e-9 relative, as FitCamera).
+// Noise-free data of an off-axis camera: the selection noise is the prior alone over the
+// richest model's residual degrees of freedom (its residuals are zero): 1 px * sqrt(10 / (10 +
+// 2 * 20 - 13)) with the prior weight 10 and 13 parameters (pose, focal, aspect, principal point,
+// skew, k1, k2); the principal point is kept and the camera recovered exactly (1e-9 relative,
+// as FitCamera).
 TEST(ModelSelectTest, ExactDataGiveTheExactCamera) {
   const SynthScene scene = Projector(5, 20, 0.0, 0.5);
   const FitResult fit = Auto(scene);
   EXPECT_EQ(fit.model, "pose+focal+principal-point");
-  EXPECT_EQ(fit.selection_sigma_px, kMinNoisePx);
+  EXPECT_NEAR(fit.selection_sigma_px, std::sqrt(10.0 / 37.0), 1e-12);
   EXPECT_NEAR(fit.camera.intrinsics.fx, scene.truth.intrinsics.fx, 1e-9 * scene.truth.intrinsics.fx);
   EXPECT_NEAR(fit.camera.intrinsics.cy, scene.truth.intrinsics.cy, 1e-9 * scene.truth.intrinsics.fx);
 }

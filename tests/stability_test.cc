@@ -197,6 +197,14 @@ const char* ReasonName(Reason reason) {
       return "kMirroredWorld";
     case Reason::kDegenerate:
       return "kDegenerate";
+    case Reason::kContaminated:
+      return "kContaminated";
+    case Reason::kInconsistent:
+      return "kInconsistent";
+    case Reason::kAmbiguous:
+      return "kAmbiguous";
+    case Reason::kNumerical:
+      return "kNumerical";
   }
   return "?";
 }

@@ -977,7 +977,7 @@ internal::StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& po
         "the best right-handed camera's RMS is ", std::sqrt(proper_cost / points.size()),
         " px, the mirrored one's ", std::sqrt(mirrored_cost / points.size()), " px");
     if (proper_cost <= kMirroredAmbiguousRatio * mirrored_cost) {
-      throw SceneError(SceneError::Reason::kMirroredWorld,
+      throw SceneError(SceneError::Reason::kAmbiguous,
                        "the points fit a camera seen through a mirror (a left-handed world frame) "
                        "somewhat better than a proper one (" + fits + "): too few points or too "
                        "much noise to tell. Add points spread in depth, or check the world "

@@ -1,12 +1,20 @@
+// FitCameraAuto: the default path as a pipeline of stages (lib/src/fit/): model selection on
+// every point -> consistency gate -> (outlier stage -> model selection on the inliers) ->
+// assessment of the returned camera. Each stage's contract is in its header.
 #include "camproj/model_select.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <limits>
+#include <cstdio>
 #include <optional>
 #include <string>
 
 #include "check.h"
+#include "fit/gate.h"
+#include "fit/outliers.h"
+#include "fit/selection.h"
+#include "fit/statistics.h"
 #include "fit_common.h"
 
 namespace camproj {
@@ -15,90 +23,215 @@ using internal::Require;
 
 namespace {
 
-// A group of intrinsics the ladder frees together, in ladder order.
-enum Group { kPrincipalPoint, kAspect, kSkew, kK1, kK2, kNumGroups };
+using Clock = std::chrono::steady_clock;
 
-const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew", "k1", "k2"};
-// FitResult::fixed_parameters' name of each group.
-const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
-
-ParameterMode& ModeOf(FitOptions& options, int group) {
-  switch (group) {
-    case kPrincipalPoint: return options.principal_point;
-    case kAspect: return options.aspect;
-    case kSkew: return options.skew;
-    case kK1: return options.k1;
-    default: return options.k2;
-  }
-}
-
-// The free parameters' names in FitResult::sigmas that belong to a group.
-std::vector<std::string> SigmaNamesOf(int group) {
-  switch (group) {
-    case kPrincipalPoint: return {"cx", "cy"};
-    case kAspect: return {"fy"};
-    case kSkew: return {"skew"};
-    case kK1: return {"k1"};
-    default: return {"k2"};
-  }
-}
-
-struct Evaluation {
-  std::optional<FitResult> fit;  // empty: refused
-  std::string refusal;           // SceneError's message
-  double sum_squares = 0.0;
-  int num_params = 0;
-};
-
-Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
-                    const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
-                    const FitOptions& options) {
-  Evaluation e;
-  try {
-    e.fit = FitCamera(points, pixels, size, options);
-    e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
-    e.num_params = static_cast<int>(e.fit->free_parameters.size());
-  } catch (const SceneError& error) {
-    e.refusal = error.what();
-  }
-  return e;
-}
-
-// Pixels that 1 sigma of the parameter moves the image corner by: the principal point shifts
-// every pixel; focal, fy and skew scale offsets from the centre (fx: the half-diagonal, fy and
-// skew: the half-height); k1, k2 the radial displacement k r^2 (r^4) * r at the corner.
-double CornerEffectPx(const ParameterSigma& s, const Intrinsics& k, const ImageSize& size) {
-  const double half_width = 0.5 * size.width;
-  const double half_height = 0.5 * size.height;
-  const double corner_px = std::hypot(half_width, half_height);
-  const double corner_normalized = corner_px / std::sqrt(k.fx * k.fy);
-  const double r2 = corner_normalized * corner_normalized;
-  if (s.name == "fx") return s.sigma * corner_px / k.fx;
-  if (s.name == "fy" || s.name == "skew") return s.sigma * half_height / k.fy;
-  if (s.name == "k1") return s.sigma * r2 * corner_px;
-  if (s.name == "k2") return s.sigma * r2 * r2 * corner_px;
-  return s.sigma;  // cx, cy
-}
-
-// Whether the caller's options allow an orthographic camera: nothing only a perspective camera
-// has is forced or given (principal point free, distortion), no RANSAC, no known intrinsics.
-bool OrthographicIsPossible(const FitOptions& options) {
-  auto zero_or_default = [](const ParameterMode& mode) {
-    return mode.kind == ParameterMode::Kind::kDefault ||
-           (mode.kind == ParameterMode::Kind::kFixed && mode.value == 0.0);
-  };
-  return !options.principal_point.IsFree() && zero_or_default(options.k1) &&
-         zero_or_default(options.k2) && !options.ransac && !options.known_intrinsics;
-}
-
-std::string Fixed(double value, int digits = 3) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+std::string Px(double value) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.3g px", value);
   return buffer;
 }
 
-// A criterion difference with its sign: "+3.3", "-128".
-std::string Signed(double value) { return (value >= 0.0 ? "+" : "") + Fixed(value); }
+std::vector<std::string> NamesOf(const AutoFitOptions& options, size_t n) {
+  if (!options.point_names.empty()) return options.point_names;
+  std::vector<std::string> names(n);
+  for (size_t i = 0; i < n; ++i) names[i] = "point " + std::to_string(i + 1);
+  return names;
+}
+
+// The points not in `left_out` (sorted).
+template <typename T>
+std::vector<T> Kept(const std::vector<T>& values, const std::vector<int>& left_out) {
+  std::vector<T> kept;
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::binary_search(left_out.begin(), left_out.end(), static_cast<int>(i))) {
+      kept.push_back(values[i]);
+    }
+  }
+  return kept;
+}
+
+// "c4 (118 px), c2 (3.1 px), c7 (2.9 px)": the largest residuals among the kept points.
+std::string WorstPoints(const std::vector<Eigen::Vector2d>& residuals,
+                        const std::vector<int>& left_out, const std::vector<std::string>& names,
+                        int count = 3) {
+  std::vector<int> order;
+  for (size_t i = 0; i < residuals.size(); ++i) {
+    if (!std::binary_search(left_out.begin(), left_out.end(), static_cast<int>(i))) {
+      order.push_back(static_cast<int>(i));
+    }
+  }
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return residuals[a].norm() > residuals[b].norm(); });
+  std::string text;
+  for (int i = 0; i < std::min<int>(count, static_cast<int>(order.size())); ++i) {
+    text += (i == 0 ? "" : ", ") + names[order[i]] + " (" + Px(residuals[order[i]].norm()) + ")";
+  }
+  return text;
+}
+
+// Refusals that no choice of points can change: the outlier stage is not tried.
+bool Final(SceneError::Reason reason) {
+  return reason == SceneError::Reason::kNonFiniteInput ||
+         reason == SceneError::Reason::kTooFewPoints ||
+         reason == SceneError::Reason::kCollinearPoints ||
+         reason == SceneError::Reason::kPlanarUnderdetermined;
+}
+
+// The model selection on the points not in `left_out`.
+internal::Selection SelectOn(const std::vector<Eigen::Vector3d>& points,
+                             const std::vector<Eigen::Vector2d>& pixels,
+                             const std::vector<int>& left_out, const ImageSize& size,
+                             const AutoFitOptions& options) {
+  return internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options);
+}
+
+// The assessment: every point's residual against the chosen camera, recomputed in world
+// coordinates from the camera as returned (and as the camera file stores it), the statistics
+// over the kept points, the left-out points' report, and the gate. Throws kInconsistent when the
+// gate fails.
+FitResult Assess(internal::Selection selection, const std::vector<int>& left_out,
+                 const std::string& method, const std::vector<Eigen::Vector3d>& points,
+                 const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                 const AutoFitOptions& options, const std::vector<std::string>& names) {
+  FitResult result = std::move(selection.fit);
+  result.residuals_px =
+      internal::ResidualsAgainst(result.camera, points, pixels, options.fit.pixel_origin);
+  result.outliers = left_out;
+  result.outlier_method = left_out.empty() ? "" : method;
+  const std::vector<double> kept = internal::KeptResidualLengths(result, left_out);
+  double sum_squares = 0.0;
+  for (const double r : kept) sum_squares += r * r;
+  result.rms_px = std::sqrt(sum_squares / kept.size());
+  result.median_px = internal::Median(kept);
+  result.max_px = *std::max_element(kept.begin(), kept.end());
+  const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
+  result.consistency = internal::CheckConsistency(
+      kept, static_cast<int>(result.free_parameters.size()), noise, options);
+  if (!result.consistency.passed) {
+    throw SceneError(SceneError::Reason::kInconsistent,
+                     "no camera explains these points: " + result.consistency.summary +
+                         ". Largest residuals: " + WorstPoints(result.residuals_px, left_out, names) +
+                         ". Check those points" +
+                         (noise.given ? std::string()
+                                      : "; if your points are this noisy, give --sigma PX") );
+  }
+  constexpr size_t kMaxRefits = 10;  // beyond, rms_with_px is not computed (0)
+  FitOptions refit = selection.options;
+  refit.compute_uncertainty = false;
+  for (const int i : left_out) {
+    LeftOutPoint p;
+    p.index = i;
+    p.residual_px = result.residuals_px[i].norm();
+    if (left_out.size() <= kMaxRefits) {
+      std::vector<int> others;
+      for (const int j : left_out) {
+        if (j != i) others.push_back(j);
+      }
+      try {
+        p.rms_with_px = FitCamera(Kept(points, others), Kept(pixels, others), size, refit).rms_px;
+      } catch (const std::exception&) {
+        p.rms_with_px = std::numeric_limits<double>::infinity();  // no camera with it
+      }
+    }
+    result.left_out.push_back(p);
+  }
+  return result;
+}
+
+FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
+                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                      const AutoFitOptions& options, Clock::time_point start) {
+  const std::vector<std::string> names = NamesOf(options, points.size());
+  const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
+  std::vector<int> left_out;
+  std::string method;
+  std::optional<internal::Selection> selection;
+  if (options.fit.ransac) {
+    // RANSAC at the caller's threshold, with the principal point and aspect free where they are
+    // candidates (the simplest model if the scene cannot determine them), then the selection on
+    // its consensus.
+    FitOptions consensus = options.fit;
+    if (consensus.focal.kind == ParameterMode::Kind::kDefault) consensus.focal = ParameterMode::Free();
+    FitOptions simplest = consensus;
+    for (ParameterMode* mode : {&consensus.principal_point, &consensus.aspect}) {
+      if (mode->kind == ParameterMode::Kind::kDefault) *mode = ParameterMode::Free();
+    }
+    consensus.compute_uncertainty = simplest.compute_uncertainty = false;
+    try {
+      left_out = FitCamera(points, pixels, size, consensus).outliers;
+    } catch (const SceneError&) {
+      left_out = FitCamera(points, pixels, size, simplest).outliers;
+    }
+    method = "ransac";
+    selection = SelectOn(points, pixels, left_out, size, options);
+  } else {
+    std::optional<SceneError> refusal;
+    std::string problem;  // what the fit of every point showed
+    try {
+      selection = SelectOn(points, pixels, {}, size, options);
+      const internal::Selection& s = *selection;
+      std::vector<double> lengths;
+      for (const auto& r : s.fit.residuals_px) lengths.push_back(r.norm());
+      const ConsistencyCheck check = internal::CheckConsistency(
+          lengths, static_cast<int>(s.fit.free_parameters.size()), noise, options);
+      if (!check.passed) {
+        problem = "the best camera for all " + std::to_string(points.size()) + " points (" +
+                  s.fit.model + ", rms " + Px(s.fit.rms_px) + ") does not explain them: " +
+                  check.summary + "; largest residuals " +
+                  WorstPoints(s.fit.residuals_px, {}, names);
+        selection.reset();
+      }
+    } catch (const SceneError& e) {
+      if (Final(e.reason())) throw;
+      refusal = e;
+    }
+    if (!selection) {
+      if (!options.find_outliers) {
+        if (refusal) throw *refusal;
+        throw SceneError(SceneError::Reason::kInconsistent,
+                         problem + ". Check those points, or drop --keep-all to let the fit find "
+                                   "and leave out the points that disagree");
+      }
+      const internal::OutlierSearch search =
+          internal::FindOutliers(points, pixels, size, options, noise, names);
+      if (!search.found) {
+        if (refusal) throw *refusal;
+        throw SceneError(SceneError::Reason::kContaminated,
+                         problem + "; and " + search.why_not +
+                             ". Check the correspondences (ids, order, mis-clicks) and refit");
+      }
+      left_out = search.outliers;
+      method = search.method;
+      try {
+        selection = SelectOn(points, pixels, left_out, size, options);
+      } catch (const SceneError&) {
+        if (refusal) throw *refusal;
+        throw;
+      }
+      if (method == "lo-ransac") {
+        // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at
+        // the noise the inliers show, and select once more if it changed.
+        FitResult all = selection->fit;
+        all.residuals_px =
+            internal::ResidualsAgainst(all.camera, points, pixels, options.fit.pixel_origin);
+        const std::vector<int> reread = internal::OutliersAgainst(all, left_out, noise, options);
+        if (reread != left_out && 2 * (points.size() - reread.size()) > points.size() / 2) {
+          try {
+            internal::Selection again = SelectOn(points, pixels, reread, size, options);
+            selection = std::move(again);
+            left_out = reread;
+          } catch (const SceneError&) {
+            // Keep RANSAC's consensus.
+          }
+        }
+      }
+    }
+  }
+  FitResult result =
+      Assess(std::move(*selection), left_out, method, points, pixels, size, options, names);
+  result.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  return result;
+}
 
 }  // namespace
 
@@ -109,297 +242,49 @@ void AutoFitOptions::Check() const {
           "give the model explicitly to use a robust loss");
   Require(std::isfinite(max_corner_sigma_fraction) && max_corner_sigma_fraction > 0.0,
           "max_corner_sigma_fraction must be positive, got ", max_corner_sigma_fraction);
+  Require(exhaustive_max_points >= 0 && exhaustive_max_points <= 40,
+          "exhaustive_max_points must be in [0, 40], got ", exhaustive_max_points);
+  Require(std::isfinite(prior_sigma_px) && prior_sigma_px > 0.0,
+          "prior_sigma_px must be positive, got ", prior_sigma_px);
+  Require(std::isfinite(prior_weight) && prior_weight >= 0.0,
+          "prior_weight must be >= 0, got ", prior_weight);
+  Require(significance > 0.0 && significance < 0.5, "significance must be in (0, 0.5), got ",
+          significance);
+  Require(std::isfinite(noise_tolerance) && noise_tolerance >= 1.0,
+          "noise_tolerance must be >= 1, got ", noise_tolerance);
+  Require(min_redundancy >= 0, "min_redundancy must be >= 0, got ", min_redundancy);
+  Require(multi_start_below_points >= 0, "multi_start_below_points must be >= 0, got ",
+          multi_start_below_points);
+  Require(std::isfinite(ambiguity_criterion_gap) && ambiguity_criterion_gap >= 0.0,
+          "ambiguity_criterion_gap must be >= 0, got ", ambiguity_criterion_gap);
+  Require(std::isfinite(ambiguity_px) && ambiguity_px > 0.0, "ambiguity_px must be positive, got ",
+          ambiguity_px);
 }
 
 FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& observed_pixels,
                         const ImageSize& image_size, const AutoFitOptions& options) {
+  const Clock::time_point start = Clock::now();
   options.Check();
-  if (options.fit.known_intrinsics) {
-    FitResult fit = FitCamera(points_in_world, observed_pixels, image_size, options.fit);
-    fit.candidates.push_back({fit.model, static_cast<int>(fit.free_parameters.size()), true,
-                              fit.rms_px * fit.rms_px * points_in_world.size(), fit.rms_px, 0.0,
-                              "chosen (intrinsics given)"});
-    return fit;
+  image_size.Check();
+  Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
+          " 3D points but ", observed_pixels.size(), " pixels");
+  Require(options.point_names.empty() || options.point_names.size() == points_in_world.size(),
+          "got ", options.point_names.size(), " point names for ", points_in_world.size(),
+          " points");
+  try {
+    return RunPipeline(points_in_world, observed_pixels, image_size, options, start);
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // Well-formed input never reaches here by design; if it does, it is still a refusal of
+    // these values (exit 3), named as what it is.
+    throw SceneError(SceneError::Reason::kNumerical,
+                     std::string("a numerical failure on these values (") + e.what() +
+                         "): please report it with the points file; meanwhile, extreme "
+                         "coordinates (subtract an offset, change units) or fixing intrinsics "
+                         "may avoid it");
   }
-
-  // RANSAC once, with the richest candidate model, then select on its consensus.
-  std::vector<Eigen::Vector3d> points = points_in_world;
-  std::vector<Eigen::Vector2d> pixels = observed_pixels;
-  FitOptions base = options.fit;
-  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
-  std::vector<int> candidates;  // groups the ladder may free
-  for (int g = 0; g < kNumGroups; ++g) {
-    if (ModeOf(base, g).kind == ParameterMode::Kind::kDefault) candidates.push_back(g);
-  }
-  std::vector<int> outliers;
-  if (base.ransac) {
-    FitOptions consensus = base;
-    for (const int g : candidates) {
-      if (g == kPrincipalPoint || g == kAspect) ModeOf(consensus, g) = ParameterMode::Free();
-    }
-    FitResult ransac_fit;
-    try {
-      ransac_fit = FitCamera(points, pixels, image_size, consensus);
-    } catch (const SceneError&) {
-      // Too much freedom for the scene (a plane, few points): RANSAC on the simplest model.
-      ransac_fit = FitCamera(points, pixels, image_size, base);
-    }
-    outliers = ransac_fit.outliers;
-    points.clear();
-    pixels.clear();
-    for (size_t i = 0; i < points_in_world.size(); ++i) {
-      if (std::binary_search(outliers.begin(), outliers.end(), static_cast<int>(i))) continue;
-      points.push_back(points_in_world[i]);
-      pixels.push_back(observed_pixels[i]);
-    }
-    base.ransac = false;
-  }
-  const double num_equations = 2.0 * static_cast<double>(points.size());
-  const bool aic = options.criterion == ModelCriterion::kAic;
-  const double penalty = aic ? 2.0 : std::log(num_equations);  // per parameter
-
-  // The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
-  // orthographic family's best fit, evaluated at most once.
-  std::optional<Evaluation> affine;
-  auto affine_evaluation = [&]() -> const Evaluation& {
-    if (!affine) {
-      FitOptions affine_options = base;
-      affine_options.projection = Projection::kOrthographic;
-      affine_options.compute_uncertainty = false;
-      for (const int g : {kAspect, kSkew}) {
-        if (ModeOf(affine_options, g).kind == ParameterMode::Kind::kDefault) {
-          ModeOf(affine_options, g) = ParameterMode::Free();
-        }
-      }
-      affine = Evaluate(points, pixels, image_size, affine_options);
-    }
-    return *affine;
-  };
-
-  // The pixel noise: given, or from the richest model the scene supports (dropping groups from
-  // the top of the ladder until one is fitted with residual degrees of freedom to spare).
-  double sigma = base.pixel_sigma.value_or(0.0);
-  if (!base.pixel_sigma) {
-    for (int top = static_cast<int>(candidates.size()); top >= 0 && sigma == 0.0; --top) {
-      FitOptions richest = base;
-      richest.compute_uncertainty = false;
-      for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
-      const Evaluation e = Evaluate(points, pixels, image_size, richest);
-      if (e.fit && num_equations > e.num_params) {
-        sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
-      }
-    }
-    if (sigma == 0.0 && options.allow_orthographic && OrthographicIsPossible(base)) {
-      // No perspective model fits (a nearly parallel projection): the affine camera's noise.
-      const Evaluation& e = affine_evaluation();
-      if (e.fit && num_equations > e.num_params) {
-        sigma = std::max(kMinNoisePx, std::sqrt(e.sum_squares / (num_equations - e.num_params)));
-      }
-    }
-    if (sigma == 0.0) sigma = kMinNoisePx;  // no model leaves a residual: the simplest decides
-  }
-  const char* criterion_name = aic ? "AIC" : "BIC";
-  auto criterion_of = [&](const Evaluation& e) {
-    return e.sum_squares / (sigma * sigma) + penalty * e.num_params;
-  };
-  const double corner_bound_px = options.max_corner_sigma_fraction *
-                                 std::hypot(0.5 * image_size.width, 0.5 * image_size.height);
-
-  std::vector<ModelCandidate> tried;
-  auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
-    ModelCandidate c;
-    c.name = name;
-    c.fitted = e.fit.has_value();
-    if (e.fit) {
-      c.name = e.fit->model;
-      c.num_params = e.num_params;
-      c.sum_squares_px2 = e.sum_squares;
-      c.rms_px = e.fit->rms_px;
-      c.criterion = criterion_of(e);
-    }
-    c.verdict = verdict;
-    tried.push_back(c);
-    return tried.size() - 1;
-  };
-
-  // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
-  base.pixel_sigma = sigma;
-  base.compute_uncertainty = true;
-
-  // "" when 1 sigma of each named parameter moves the image corner by at most the bound, else
-  // what moves it most and by how much.
-  auto undetermined = [&](const FitResult& fit, const std::vector<std::string>& sigma_names) {
-    double worst_effect = 0.0;
-    std::string worst_name;
-    for (const ParameterSigma& s : fit.sigmas) {
-      if (std::find(sigma_names.begin(), sigma_names.end(), s.name) == sigma_names.end()) continue;
-      const double effect = CornerEffectPx(s, fit.camera.intrinsics, image_size);
-      if (!(effect <= worst_effect)) {
-        worst_effect = effect;
-        worst_name = s.name;
-      }
-    }
-    if (worst_effect <= corner_bound_px) return std::string();
-    return "1 sigma of " + worst_name + " would move the image corner by " + Fixed(worst_effect) +
-           " px (bound " + Fixed(corner_bound_px) + " px)";
-  };
-
-  // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
-  // improves and the scene determines it. A refused base is a model of infinite criterion that any
-  // fitted trial improves on (so a perspective camera whose principal point is far from the
-  // centre is still found). Records every model tried and why each group was left out.
-  struct Ladder {
-    Evaluation final;
-    FitOptions final_options;
-    size_t final_index = 0;
-    std::vector<int> included;
-    std::string why_left_out[kNumGroups];
-  };
-  auto criterion_or_inf = [&](const Evaluation& e) {
-    return e.fit ? criterion_of(e) : std::numeric_limits<double>::infinity();
-  };
-  auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
-                        const std::vector<int>& groups) {
-    Ladder ladder;
-    ladder.final_options = base_options;
-    ladder.final = Evaluate(points, pixels, image_size, base_options);
-    ladder.final_index = record(ladder.final, base_name,
-                                ladder.final.fit ? "simplest model"
-                                                 : "not determined: " + ladder.final.refusal);
-    for (;;) {
-      const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
-      int best_group = -1;
-      size_t best_index = 0;
-      Evaluation best;
-      FitOptions best_options;
-      for (const int g : groups) {
-        if (std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end()) {
-          continue;
-        }
-        if (g == kK2 &&
-            std::find(ladder.included.begin(), ladder.included.end(), kK1) == ladder.included.end() &&
-            std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
-          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
-          continue;
-        }
-        FitOptions trial_options = ladder.final_options;
-        ModeOf(trial_options, g) = ParameterMode::Free();
-        Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
-        const std::string name = current_name + "+" + kGroupNames[g];
-        if (!trial.fit) {
-          ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
-                                   trial.refusal + ")";
-          record(trial, name, "not determined: refused");
-          continue;
-        }
-        const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
-        if (!problem.empty()) {
-          ladder.why_left_out[g] = "left out: not determined: " + problem;
-          record(trial, name, "not determined: " + problem);
-          continue;
-        }
-        const double delta = criterion_of(trial) - criterion_or_inf(ladder.final);
-        ladder.why_left_out[g] = "left out: delta " + std::string(criterion_name) + " " +
-                                 Signed(delta) + " against " + current_name +
-                                 ": not supported by the data";
-        const size_t index =
-            record(trial, name, "delta " + std::string(criterion_name) + " " + Signed(delta));
-        if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
-          best_group = g;
-          best_index = index;
-          best = std::move(trial);
-          best_options = trial_options;
-        }
-      }
-      if (best_group < 0) break;
-      ladder.included.push_back(best_group);
-      ladder.final = std::move(best);
-      ladder.final_options = best_options;
-      ladder.final_index = best_index;
-      tried[best_index].verdict += ": kept";
-    }
-    return ladder;
-  };
-
-  // The perspective ladder from pose + focal, and the orthographic one (scale, then aspect and
-  // skew); the family whose final model has the lower criterion wins.
-  Ladder chosen = run_ladder(base, "pose+focal", candidates);
-  if (options.allow_orthographic && OrthographicIsPossible(base)) {
-    FitOptions ortho_options = base;
-    ortho_options.projection = Projection::kOrthographic;
-    std::vector<int> ortho_groups;
-    for (const int g : candidates) {
-      if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
-    }
-    // No orthographic model fits better than the affine camera (all of them free), so when even
-    // its sum of squares with the fewest orthographic parameters' penalty cannot beat the best
-    // perspective model, the orthographic ladder cannot win: skip it (one fit, not up to four).
-    const Evaluation& affine_fit = affine_evaluation();
-    const double ortho_lower_bound =
-        affine_fit.fit ? affine_fit.sum_squares / (sigma * sigma) + penalty * 6
-                       : std::numeric_limits<double>::infinity();
-    Ladder ortho;
-    if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
-      ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
-    } else {
-      ModelCandidate c;
-      c.name = "orthographic";  // with the forced groups, as its ladder would name it
-      if (ortho_options.aspect.IsFree()) c.name += "+aspect";
-      if (ortho_options.skew.IsFree()) c.name += "+skew";
-      c.verdict = affine_fit.fit ? "not supported: even the affine camera's residual (rms " +
-                                       Fixed(affine_fit.fit->rms_px) + " px) puts every "
-                                       "orthographic model above the best perspective one"
-                                 : "not determined: " + affine_fit.refusal;
-      tried.push_back(c);
-    }
-    if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
-      const std::string against =
-          chosen.final.fit ? "delta " + std::string(criterion_name) + " " +
-                                 Signed(criterion_of(ortho.final) - criterion_of(chosen.final)) +
-                                 " against the best perspective model, " + chosen.final.fit->model
-                           : std::string("no perspective model fits");
-      for (const int g : candidates) {
-        // (The orthographic fit says itself why it has no principal point.)
-        if (g != kAspect && g != kSkew && g != kPrincipalPoint) {
-          ortho.why_left_out[g] = "left out: not part of an orthographic camera (" + against + ")";
-        }
-      }
-      chosen = std::move(ortho);
-    }
-  }
-  if (!chosen.final.fit) {
-    FitCamera(points, pixels, image_size, base);  // rethrows the simplest model's refusal
-    throw SceneError(SceneError::Reason::kDegenerate,
-                     "no model of the ladder fits these points: check the correspondences");
-  }
-  FitOptions current_options = chosen.final_options;
-  const size_t current_index = chosen.final_index;
-  const std::vector<int>& included = chosen.included;
-  const std::string* why_left_out = chosen.why_left_out;
-
-  // The chosen model again with the caller's noise setting, so that its sigmas are reported as
-  // FitCamera reports them.
-  current_options.pixel_sigma = options.fit.pixel_sigma;
-  current_options.compute_uncertainty = options.fit.compute_uncertainty;
-  FitResult result = FitCamera(points, pixels, image_size, current_options);
-  tried[current_index].verdict = "chosen";
-  for (const int g : candidates) {
-    if (std::find(included.begin(), included.end(), g) != included.end()) continue;
-    for (FixedParameter& p : result.fixed_parameters) {
-      if (p.name == kFixedNames[g] && !why_left_out[g].empty()) p.why = why_left_out[g];
-    }
-  }
-  result.candidates = std::move(tried);
-  result.criterion = criterion_name;
-  result.selection_sigma_px = sigma;
-  if (options.fit.ransac) {
-    // Report every input point against the chosen camera, as FitCamera's RANSAC does.
-    result.residuals_px = internal::ResidualsAgainst(result.camera, points_in_world,
-                                                     observed_pixels, options.fit.pixel_origin);
-    result.outliers = outliers;
-  }
-  return result;
 }
 
 }  // namespace camproj

@@ -14,6 +14,7 @@
 #ifndef CAMPROJ_MODEL_SELECT_H_
 #define CAMPROJ_MODEL_SELECT_H_
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -84,6 +85,10 @@ struct AutoFitOptions {
   // cameras, focal lengths 0.5x and 2x); if another minimum fits about as well (criterion within
   // ambiguity_criterion_gap) but moves a point of the scene's bounding box by more than
   // ambiguity_px, refuse (SceneError kAmbiguous).
+  // Names of the points in messages and FitResult's text (the CSV's ids); empty: "point 1",
+  // "point 2", ... Its size must match the points' when given.
+  std::vector<std::string> point_names;
+
   int multi_start_below_points = 20;
   double ambiguity_criterion_gap = 4.0;
   double ambiguity_px = 5.0;

@@ -1,0 +1,42 @@
+// The consistency gate (private): are a fit's residuals consistent with the pixel noise?
+// FitCameraAuto runs it on the least-squares fit of every point (a failure sends the scene to
+// the outlier stage), on every subset the outlier stage tries, and on the returned camera (a
+// failure there is a refusal). The tests and their significance: model_select.h,
+// AutoFitOptions::significance; docs/model-selection.md.
+#ifndef CAMPROJ_SRC_FIT_GATE_H_
+#define CAMPROJ_SRC_FIT_GATE_H_
+
+#include <string>
+#include <vector>
+
+#include "camproj/fit.h"
+#include "camproj/model_select.h"
+
+namespace camproj {
+namespace internal {
+
+// The noise the residuals are tested against: FitOptions::pixel_sigma when given, else
+// AutoFitOptions::prior_sigma_px.
+struct NoiseReference {
+  double sigma_px = 1.0;
+  bool given = false;
+  std::string Source() const;  // "given" / "default prior for clicked points"
+};
+
+NoiseReference NoiseReferenceOf(const AutoFitOptions& options);
+
+// Tests the residual lengths (px) of the points a fit kept, for a model of num_params
+// parameters: (1) chi-square: sum r^2 <= (tolerance * noise)^2 * chi2_{2N-p}(1 - alpha);
+// (2) largest residual <= sqrt(2 ln(N / alpha)) * max(robust noise, noise), the robust noise
+// being median |r| / sqrt(2 ln 2), scaled by sqrt(2N / (2N - p)) for the fit's leverage. With no
+// redundant equation (2N <= p) nothing can be tested and the check passes, saying so.
+ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px, int num_params,
+                                  const NoiseReference& noise, const AutoFitOptions& options);
+
+// Lengths of the residuals of the points not listed in `left_out` (sorted indices).
+std::vector<double> KeptResidualLengths(const FitResult& fit, const std::vector<int>& left_out);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_GATE_H_

@@ -1,0 +1,197 @@
+#include "fit/outliers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "fit/selection.h"
+#include "fit/statistics.h"
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+std::string Px(double value) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.3g px", value);
+  return buffer;
+}
+
+// The models the exhaustive search fits each subset with, richest first: pose + focal +
+// principal point (a projector's lens shift), then pose + focal; the caller's forced or given
+// intrinsics as they are. The first one the subset determines with min_redundancy equations to
+// spare is used.
+std::vector<FitOptions> DetectionModels(const AutoFitOptions& options) {
+  FitOptions base = options.fit;
+  base.ransac = false;
+  base.compute_uncertainty = false;
+  if (base.known_intrinsics) return {base};
+  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
+  std::vector<FitOptions> models;
+  if (base.projection == Projection::kPerspective &&
+      base.principal_point.kind == ParameterMode::Kind::kDefault) {
+    FitOptions off_axis = base;
+    off_axis.principal_point = ParameterMode::Free();
+    models.push_back(off_axis);
+  }
+  models.push_back(base);
+  return models;
+}
+
+struct SubsetFit {
+  bool fitted = false;
+  bool consistent = false;
+  double rms_px = 0.0;
+};
+
+SubsetFit FitSubset(const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& left_out,
+                    const ImageSize& size, const std::vector<FitOptions>& models,
+                    const AutoFitOptions& options, const NoiseReference& noise) {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Vector2d> u;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (std::find(left_out.begin(), left_out.end(), static_cast<int>(i)) != left_out.end()) {
+      continue;
+    }
+    x.push_back(points[i]);
+    u.push_back(pixels[i]);
+  }
+  SubsetFit subset;
+  for (const FitOptions& model : models) {
+    const int p = NumParameters(model);
+    if (2 * static_cast<int>(x.size()) - p < options.min_redundancy) continue;
+    try {
+      const FitResult fit = FitCamera(x, u, size, model);
+      std::vector<double> lengths;
+      for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
+      subset.fitted = true;
+      subset.rms_px = fit.rms_px;
+      subset.consistent = CheckConsistency(lengths, p, noise, options).passed;
+      return subset;
+    } catch (const std::exception&) {
+      // Not determined by this subset (or a numerical failure): try the next model.
+    }
+  }
+  return subset;
+}
+
+std::string NameList(const std::vector<int>& indices, const std::vector<std::string>& names) {
+  std::string text;
+  for (size_t i = 0; i < indices.size(); ++i) {
+    text += (i == 0 ? "" : i + 1 == indices.size() ? " or " : ", ") + names[indices[i]];
+  }
+  return text;
+}
+
+OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
+                         const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                         const AutoFitOptions& options, const NoiseReference& noise,
+                         const std::vector<std::string>& names) {
+  const int n = static_cast<int>(points.size());
+  const std::vector<FitOptions> models = DetectionModels(options);
+  OutlierSearch search;
+  for (int k = 1; k <= 2; ++k) {
+    // Whether any subset of n - k points can be checked at all.
+    const int smallest = NumParameters(models.back());
+    if (2 * (n - k) - smallest < options.min_redundancy) {
+      search.why_not = "with " + std::to_string(n - k) + " points left the rest could not be "
+                       "checked (" + std::to_string(2 * (n - k)) + " equations for " +
+                       std::to_string(smallest) + " unknowns)";
+      return search;
+    }
+    std::vector<std::vector<int>> explaining;
+    std::vector<int> left_out(k);
+    for (int a = 0; a < n; ++a) {
+      for (int b = k == 2 ? a + 1 : n; b <= (k == 2 ? n - 1 : n); ++b) {
+        left_out[0] = a;
+        if (k == 2) left_out[1] = b;
+        const SubsetFit fit = FitSubset(points, pixels, left_out, size, models, options, noise);
+        if (fit.consistent) explaining.push_back(left_out);
+      }
+    }
+    if (explaining.size() == 1) {
+      search.found = true;
+      search.outliers = explaining.front();
+      search.method = k == 1 ? "leave-one-out" : "leave-two-out";
+      return search;
+    }
+    if (explaining.size() > 1) {
+      std::vector<int> candidates;
+      for (const auto& s : explaining) {
+        for (const int i : s) {
+          if (std::find(candidates.begin(), candidates.end(), i) == candidates.end()) {
+            candidates.push_back(i);
+          }
+        }
+      }
+      std::sort(candidates.begin(), candidates.end());
+      search.why_not = std::to_string(explaining.size()) + " different choices of " +
+                       (k == 1 ? "one point" : "two points") + " to leave out make the rest " +
+                       "consistent (among " + NameList(candidates, names) +
+                       "): the points cannot tell which " + (k == 1 ? "is" : "are") + " wrong";
+      return search;
+    }
+  }
+  search.why_not = "no camera fits all but one or two of the points";
+  return search;
+}
+
+OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
+                       const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                       const AutoFitOptions& options, const NoiseReference& noise) {
+  const int n = static_cast<int>(points.size());
+  OutlierSearch search;
+  search.method = "lo-ransac";
+  // Inliers within the gate's outlier bound at the largest noise it accepts.
+  const double threshold = MaxResidualBound(n, options.significance) * options.noise_tolerance *
+                           noise.sigma_px;
+  std::string last_refusal;
+  for (FitOptions model : DetectionModels(options)) {
+    if (model.projection != Projection::kPerspective) break;
+    model.ransac = true;
+    model.ransac_threshold_px = threshold;
+    try {
+      const FitResult fit = FitCamera(points, pixels, size, model);
+      search.found = true;
+      search.outliers = fit.outliers;
+      return search;
+    } catch (const std::exception& e) {
+      last_refusal = e.what();
+    }
+  }
+  search.why_not = "RANSAC at " + Px(threshold) + " found no camera that most points agree on (" +
+                   last_refusal + ")";
+  return search;
+}
+
+}  // namespace
+
+OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points,
+                           const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                           const AutoFitOptions& options, const NoiseReference& noise,
+                           const std::vector<std::string>& names) {
+  if (static_cast<int>(points.size()) <= options.exhaustive_max_points) {
+    return Exhaustive(points, pixels, size, options, noise, names);
+  }
+  return LoRansac(points, pixels, size, options, noise);
+}
+
+std::vector<int> OutliersAgainst(const FitResult& fit, const std::vector<int>& left_out,
+                                 const NoiseReference& noise, const AutoFitOptions& options) {
+  const std::vector<double> kept = KeptResidualLengths(fit, left_out);
+  const int p = static_cast<int>(fit.free_parameters.size());
+  const ConsistencyCheck check = CheckConsistency(kept, p, noise, options);
+  const double bound = MaxResidualBound(static_cast<int>(fit.residuals_px.size()),
+                                        options.significance) *
+                       std::max(check.robust_noise_px, noise.sigma_px);
+  std::vector<int> outliers;
+  for (size_t i = 0; i < fit.residuals_px.size(); ++i) {
+    if (!(fit.residuals_px[i].norm() <= bound)) outliers.push_back(static_cast<int>(i));
+  }
+  return outliers;
+}
+
+}  // namespace internal
+}  // namespace camproj

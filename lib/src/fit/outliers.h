@@ -1,0 +1,44 @@
+// The outlier stage (private): which points to leave out so that the rest is consistent with
+// the pixel noise (gate.h). FitCameraAuto runs it when the least-squares fit of every point
+// fails the gate. Up to AutoFitOptions::exhaustive_max_points points (a handful of clicks) every
+// leave-one-out and then leave-two-out subset is fitted: exact, and cheap at that size; above, LO-RANSAC
+// (FitOptions::ransac) at a threshold derived from the noise. The inliers it returns still go
+// through the model selection and the final gate.
+#ifndef CAMPROJ_SRC_FIT_OUTLIERS_H_
+#define CAMPROJ_SRC_FIT_OUTLIERS_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/fit.h"
+#include "camproj/model_select.h"
+#include "fit/gate.h"
+
+namespace camproj {
+namespace internal {
+
+struct OutlierSearch {
+  bool found = false;
+  std::vector<int> outliers;  // sorted indices into the caller's points
+  std::string method;         // "leave-one-out", "leave-two-out", "lo-ransac"
+  std::string why_not;        // when !found: what the search saw, in words (names points)
+};
+
+// `names` name the points in messages. Never throws a SceneError: a search that finds no unique
+// subset says why in why_not.
+OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points_in_world,
+                           const std::vector<Eigen::Vector2d>& observed_pixels,
+                           const ImageSize& image_size, const AutoFitOptions& options,
+                           const NoiseReference& noise, const std::vector<std::string>& names);
+
+// The points whose residual against `fit` (all points) exceeds the gate's outlier bound for the
+// kept points' robust noise: LO-RANSAC's consensus re-read at the noise the data show.
+std::vector<int> OutliersAgainst(const FitResult& fit, const std::vector<int>& left_out,
+                                 const NoiseReference& noise, const AutoFitOptions& options);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_OUTLIERS_H_

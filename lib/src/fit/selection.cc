@@ -1,0 +1,444 @@
+#include "fit/selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+// A group of intrinsics the ladder frees together, in ladder order.
+enum Group { kPrincipalPoint, kAspect, kSkew, kK1, kK2, kNumGroups };
+
+const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew", "k1", "k2"};
+// FitResult::fixed_parameters' name of each group.
+const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
+const int kGroupSize[kNumGroups] = {2, 1, 1, 1, 1};
+
+ParameterMode& ModeOf(FitOptions& options, int group) {
+  switch (group) {
+    case kPrincipalPoint: return options.principal_point;
+    case kAspect: return options.aspect;
+    case kSkew: return options.skew;
+    case kK1: return options.k1;
+    default: return options.k2;
+  }
+}
+
+// The free parameters' names in FitResult::sigmas that belong to a group.
+std::vector<std::string> SigmaNamesOf(int group) {
+  switch (group) {
+    case kPrincipalPoint: return {"cx", "cy"};
+    case kAspect: return {"fy"};
+    case kSkew: return {"skew"};
+    case kK1: return {"k1"};
+    default: return {"k2"};
+  }
+}
+
+// One model fitted, or refused. Any failure is caught: one candidate never aborts the selection.
+struct Evaluation {
+  std::optional<FitResult> fit;
+  std::string refusal;  // the refusal's message
+  SceneError::Reason reason = SceneError::Reason::kDegenerate;
+  double sum_squares = 0.0;
+  int num_params = 0;
+};
+
+Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                    const FitOptions& options) {
+  Evaluation e;
+  e.num_params = NumParameters(options);
+  try {
+    e.fit = FitCamera(points, pixels, size, options);
+    e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
+    e.num_params = static_cast<int>(e.fit->free_parameters.size());
+  } catch (const SceneError& error) {
+    e.refusal = error.what();
+    e.reason = error.reason();
+  } catch (const std::exception& error) {
+    e.refusal = std::string("numerical failure (") + error.what() + ")";
+    e.reason = SceneError::Reason::kNumerical;
+  }
+  return e;
+}
+
+// Pixels that 1 sigma of the parameter moves the image corner by: the principal point shifts
+// every pixel; focal, fy and skew scale offsets from the centre (fx: the half-diagonal, fy and
+// skew: the half-height); k1, k2 the radial displacement k r^2 (r^4) * r at the corner.
+double CornerEffectPx(const ParameterSigma& s, const Intrinsics& k, const ImageSize& size) {
+  const double half_width = 0.5 * size.width;
+  const double half_height = 0.5 * size.height;
+  const double corner_px = std::hypot(half_width, half_height);
+  const double corner_normalized = corner_px / std::sqrt(k.fx * k.fy);
+  const double r2 = corner_normalized * corner_normalized;
+  if (s.name == "fx") return s.sigma * corner_px / k.fx;
+  if (s.name == "fy" || s.name == "skew") return s.sigma * half_height / k.fy;
+  if (s.name == "k1") return s.sigma * r2 * corner_px;
+  if (s.name == "k2") return s.sigma * r2 * r2 * corner_px;
+  return s.sigma;  // cx, cy
+}
+
+// Whether the caller's options allow an orthographic camera: nothing only a perspective camera
+// has is forced or given (principal point free, distortion), no RANSAC, no known intrinsics.
+bool OrthographicIsPossible(const FitOptions& options) {
+  auto zero_or_default = [](const ParameterMode& mode) {
+    return mode.kind == ParameterMode::Kind::kDefault ||
+           (mode.kind == ParameterMode::Kind::kFixed && mode.value == 0.0);
+  };
+  return options.projection == Projection::kPerspective && !options.principal_point.IsFree() &&
+         zero_or_default(options.k1) && zero_or_default(options.k2) && !options.ransac &&
+         !options.known_intrinsics;
+}
+
+std::string Fixed(double value, int digits = 3) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+  return buffer;
+}
+
+// A criterion difference in words: "BIC +3.3 against pose+focal (higher: worse)".
+std::string Versus(const char* criterion, double delta, const std::string& against) {
+  return std::string(criterion) + " " + (delta >= 0.0 ? "+" : "") + Fixed(delta) + " against " +
+         against + (delta < 0.0 ? " (lower: the data support it)"
+                                : " (not lower: the data do not need it)");
+}
+
+// Why a model was not tried: "2N - p = 2 redundant equations, fewer than 3 (its residuals could
+// not show it is wrong)".
+std::string TooFewRedundant(int redundancy, int minimum) {
+  return "2N - p = " + std::to_string(redundancy) + " redundant equations, fewer than " +
+         std::to_string(minimum) + " (its residuals could not show it is wrong)";
+}
+
+}  // namespace
+
+int NumParameters(const FitOptions& options) {
+  if (options.known_intrinsics) return 6;
+  int n = options.projection == Projection::kOrthographic ? 5 : 6;
+  n += options.focal.IsFree() + options.aspect.IsFree() + 2 * options.principal_point.IsFree() +
+       options.skew.IsFree() + options.k1.IsFree() + options.k2.IsFree();
+  return n;
+}
+
+double CombinedNoise(const AutoFitOptions& options, double sum_squares, double dof) {
+  const double prior_variance = options.prior_sigma_px * options.prior_sigma_px;
+  return std::max(kMinNoisePx, std::sqrt((options.prior_weight * prior_variance + sum_squares) /
+                                         (options.prior_weight + std::max(0.0, dof))));
+}
+
+Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
+                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
+                      const AutoFitOptions& options) {
+  FitOptions base = options.fit;
+  base.ransac = false;
+  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
+  std::vector<int> candidates;  // groups the ladder may free
+  if (base.projection == Projection::kPerspective && !base.known_intrinsics) {
+    for (int g = 0; g < kNumGroups; ++g) {
+      if (ModeOf(base, g).kind == ParameterMode::Kind::kDefault) candidates.push_back(g);
+    }
+  }
+  const int n = static_cast<int>(points.size());
+  const double num_equations = 2.0 * n;
+  const bool aic = options.criterion == ModelCriterion::kAic;
+  const double penalty = aic ? 2.0 : std::log(num_equations);  // per parameter
+  const char* criterion_name = aic ? "AIC" : "BIC";
+
+  // The perspective base (pose + focal and whatever the caller forced) decides whether an
+  // orthographic camera may answer: only where the perspective is fitted, not determined or
+  // ambiguous (the depth spread too small against the distance to show it, or to tell a
+  // mirrored world from a proper one), never where it was refused as mirrored, behind the
+  // points, or short of points.
+  base.compute_uncertainty = false;
+  const Evaluation base_fit = Evaluate(points, pixels, image_size, base);
+  const bool orthographic_allowed =
+      options.allow_orthographic && OrthographicIsPossible(base) &&
+      (base_fit.fit || base_fit.reason == SceneError::Reason::kDegenerate ||
+       base_fit.reason == SceneError::Reason::kAmbiguous);
+
+  // The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
+  // orthographic family's best fit, evaluated at most once.
+  std::optional<Evaluation> affine;
+  auto affine_evaluation = [&]() -> const Evaluation& {
+    if (!affine) {
+      FitOptions affine_options = base;
+      affine_options.projection = Projection::kOrthographic;
+      for (const int g : {kAspect, kSkew}) {
+        if (ModeOf(affine_options, g).kind == ParameterMode::Kind::kDefault) {
+          ModeOf(affine_options, g) = ParameterMode::Free();
+        }
+      }
+      affine = Evaluate(points, pixels, image_size, affine_options);
+    }
+    return *affine;
+  };
+
+  // The criterion's noise: given, or the prior combined with the residuals of the richest model
+  // the scene supports (groups dropped from the top of the ladder until one is fitted with
+  // residual degrees of freedom to spare).
+  double sigma = base.pixel_sigma.value_or(0.0);
+  if (!base.pixel_sigma) {
+    bool found = false;
+    for (int top = static_cast<int>(candidates.size()); top >= 0 && !found; --top) {
+      FitOptions richest = base;
+      for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
+      if (num_equations - NumParameters(richest) < 1) continue;
+      const Evaluation e = top == 0 ? base_fit : Evaluate(points, pixels, image_size, richest);
+      if (e.fit && num_equations > e.num_params) {
+        sigma = CombinedNoise(options, e.sum_squares, num_equations - e.num_params);
+        found = true;
+      }
+    }
+    if (!found && orthographic_allowed) {
+      const Evaluation& e = affine_evaluation();
+      if (e.fit && num_equations > e.num_params) {
+        sigma = CombinedNoise(options, e.sum_squares, num_equations - e.num_params);
+        found = true;
+      }
+    }
+    if (!found) sigma = CombinedNoise(options, 0.0, 0.0);  // the prior alone
+  }
+  auto criterion_of = [&](const Evaluation& e) {
+    return e.sum_squares / (sigma * sigma) + penalty * e.num_params;
+  };
+  auto criterion_or_inf = [&](const Evaluation& e) {
+    return e.fit ? criterion_of(e) : std::numeric_limits<double>::infinity();
+  };
+  const double corner_bound_px = options.max_corner_sigma_fraction *
+                                 std::hypot(0.5 * image_size.width, 0.5 * image_size.height);
+
+  std::vector<ModelCandidate> tried;
+  std::vector<Camera> cameras;  // of every fitted trial, for Selection::others
+  auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
+    ModelCandidate c;
+    c.name = name;
+    c.fitted = e.fit.has_value();
+    c.num_params = e.num_params;
+    if (e.fit) {
+      c.name = e.fit->model;
+      c.sum_squares_px2 = e.sum_squares;
+      c.rms_px = e.fit->rms_px;
+      c.criterion = criterion_of(e);
+      cameras.push_back(e.fit->camera);
+    }
+    c.verdict = verdict;
+    tried.push_back(c);
+    return tried.size() - 1;
+  };
+
+  // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
+  base.pixel_sigma = sigma;
+  base.compute_uncertainty = true;
+
+  // "" when 1 sigma of each named parameter moves the image corner by at most the bound, else
+  // what moves it most and by how much.
+  auto undetermined = [&](const FitResult& fit, const std::vector<std::string>& sigma_names) {
+    double worst_effect = 0.0;
+    std::string worst_name;
+    for (const ParameterSigma& s : fit.sigmas) {
+      if (std::find(sigma_names.begin(), sigma_names.end(), s.name) == sigma_names.end()) continue;
+      const double effect = CornerEffectPx(s, fit.camera.intrinsics, image_size);
+      if (!(effect <= worst_effect)) {
+        worst_effect = effect;
+        worst_name = s.name;
+      }
+    }
+    if (worst_effect <= corner_bound_px) return std::string();
+    return "1 sigma of " + worst_name + " would move the image corner by " + Fixed(worst_effect) +
+           " px (bound " + Fixed(corner_bound_px) + " px)";
+  };
+
+  // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
+  // improves, the scene determines the group and the model keeps min_redundancy equations to
+  // spare. A refused base is a model of infinite criterion that any fitted trial improves on (so
+  // a perspective camera whose principal point is far from the centre is still found). Records
+  // every model tried and why each group was left out.
+  struct Ladder {
+    Evaluation final;
+    FitOptions final_options;
+    size_t final_index = 0;
+    std::vector<int> included;
+    std::string why_left_out[kNumGroups];
+  };
+  auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
+                        const std::vector<int>& groups) {
+    Ladder ladder;
+    ladder.final_options = base_options;
+    ladder.final = Evaluate(points, pixels, image_size, base_options);
+    ladder.final_index = record(ladder.final, base_name,
+                                ladder.final.fit ? "simplest model"
+                                                 : "not determined: " + ladder.final.refusal);
+    for (;;) {
+      const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
+      int best_group = -1;
+      size_t best_index = 0;
+      Evaluation best;
+      FitOptions best_options;
+      for (const int g : groups) {
+        if (std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end()) {
+          continue;
+        }
+        if (g == kK2 &&
+            std::find(ladder.included.begin(), ladder.included.end(), kK1) == ladder.included.end() &&
+            std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
+          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
+          continue;
+        }
+        FitOptions trial_options = ladder.final_options;
+        ModeOf(trial_options, g) = ParameterMode::Free();
+        const std::string name = current_name + "+" + kGroupNames[g];
+        const int redundancy = 2 * n - NumParameters(trial_options);
+        if (redundancy < options.min_redundancy) {
+          const std::string why = TooFewRedundant(redundancy, options.min_redundancy);
+          ladder.why_left_out[g] = "left out: not tried: " + why;
+          ModelCandidate c;
+          c.name = name;
+          c.num_params = NumParameters(trial_options);
+          c.verdict = "not tried: " + why;
+          tried.push_back(c);
+          continue;
+        }
+        Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
+        if (!trial.fit) {
+          ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
+                                   trial.refusal + ")";
+          record(trial, name, "not determined: refused");
+          continue;
+        }
+        const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
+        if (!problem.empty()) {
+          ladder.why_left_out[g] = "left out: not determined: " + problem;
+          record(trial, name, "not determined: " + problem);
+          continue;
+        }
+        const double delta = criterion_of(trial) - criterion_or_inf(ladder.final);
+        ladder.why_left_out[g] = "left out: " + Versus(criterion_name, delta, current_name);
+        const size_t index = record(trial, name, Versus(criterion_name, delta, current_name));
+        if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
+          best_group = g;
+          best_index = index;
+          best = std::move(trial);
+          best_options = trial_options;
+        }
+      }
+      if (best_group < 0) break;
+      ladder.included.push_back(best_group);
+      ladder.final = std::move(best);
+      ladder.final_options = best_options;
+      ladder.final_index = best_index;
+      tried[best_index].verdict += ": kept";
+    }
+    return ladder;
+  };
+
+  // The perspective ladder from pose + focal, and the orthographic one (scale, then aspect and
+  // skew); the family whose final model has the lower criterion wins.
+  const std::string base_name =
+      base.projection == Projection::kOrthographic ? "orthographic" : "pose+focal";
+  Ladder chosen = run_ladder(base, base_name, candidates);
+  bool orthographic_chosen = base.projection == Projection::kOrthographic;
+  if (orthographic_allowed) {
+    FitOptions ortho_options = base;
+    ortho_options.projection = Projection::kOrthographic;
+    std::vector<int> ortho_groups;
+    for (const int g : candidates) {
+      if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
+    }
+    // No orthographic model fits better than the affine camera (all of them free), so when even
+    // its sum of squares with the fewest orthographic parameters' penalty cannot beat the best
+    // perspective model, the orthographic ladder cannot win: skip it (one fit, not up to four).
+    const Evaluation& affine_fit = affine_evaluation();
+    const double ortho_lower_bound =
+        affine_fit.fit ? affine_fit.sum_squares / (sigma * sigma) + penalty * 6
+                       : std::numeric_limits<double>::infinity();
+    Ladder ortho;
+    if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
+      ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
+    } else {
+      ModelCandidate c;
+      c.name = "orthographic";  // with the forced groups, as its ladder would name it
+      if (ortho_options.aspect.IsFree()) c.name += "+aspect";
+      if (ortho_options.skew.IsFree()) c.name += "+skew";
+      c.verdict = affine_fit.fit ? "not supported: even the affine camera's residual (rms " +
+                                       Fixed(affine_fit.fit->rms_px) + " px) puts every "
+                                       "orthographic model above the best perspective one"
+                                 : "not determined: " + affine_fit.refusal;
+      tried.push_back(c);
+    }
+    if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
+      const std::string against =
+          chosen.final.fit ? Versus(criterion_name,
+                                    criterion_of(ortho.final) - criterion_of(chosen.final),
+                                    "the best perspective model, " + chosen.final.fit->model)
+                           : std::string("no perspective model is determined");
+      for (const int g : candidates) {
+        // (The orthographic fit says itself why it has no principal point.)
+        if (g != kAspect && g != kSkew && g != kPrincipalPoint) {
+          ortho.why_left_out[g] = "left out: not part of an orthographic camera (" + against + ")";
+        }
+      }
+      chosen = std::move(ortho);
+      orthographic_chosen = true;
+    }
+  }
+  if (!chosen.final.fit) {
+    // The simplest model's refusal says what to fix.
+    throw SceneError(base_fit.fit ? chosen.final.reason : base_fit.reason,
+                     base_fit.fit ? chosen.final.refusal : base_fit.refusal);
+  }
+  if (orthographic_chosen && base.projection == Projection::kPerspective) {
+    // An orthographic image cannot show a mirrored world (its depth order is a choice), but a
+    // perspective camera can: if the mirrored world fits a perspective camera better than any
+    // orthographic one, the world frame is left-handed.
+    std::vector<Eigen::Vector3d> flipped(points);
+    for (auto& x : flipped) x.z() = -x.z();
+    FitOptions mirrored = base;
+    mirrored.compute_uncertainty = false;
+    const Evaluation e = Evaluate(flipped, pixels, image_size, mirrored);
+    if (e.fit && criterion_of(e) < criterion_of(chosen.final)) {
+      throw SceneError(SceneError::Reason::kMirroredWorld,
+                       "the points fit a perspective camera only with one world axis flipped "
+                       "(rms " + Fixed(e.fit->rms_px) + " px; the best camera of this world is "
+                       "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): the "
+                       "world frame is left-handed. Flip one world axis (e.g. negate Z of every "
+                       "point, and again in anything you render) and refit");
+    }
+  }
+
+  Selection selection;
+  selection.sigma_px = sigma;
+  selection.options = chosen.final_options;
+  // The reported sigmas: the noise given, else the prior combined with the chosen model's own
+  // residuals (at 6-12 points its 2N - p alone says little).
+  selection.options.pixel_sigma =
+      options.fit.pixel_sigma
+          ? *options.fit.pixel_sigma
+          : CombinedNoise(options, chosen.final.sum_squares, num_equations - chosen.final.num_params);
+  selection.options.compute_uncertainty = options.fit.compute_uncertainty;
+  selection.fit = FitCamera(points, pixels, image_size, selection.options);
+  if (!options.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
+  tried[chosen.final_index].verdict = "chosen";
+  for (const int g : candidates) {
+    if (std::find(chosen.included.begin(), chosen.included.end(), g) != chosen.included.end()) {
+      continue;
+    }
+    for (FixedParameter& p : selection.fit.fixed_parameters) {
+      if (p.name == kFixedNames[g] && !chosen.why_left_out[g].empty()) p.why = chosen.why_left_out[g];
+    }
+  }
+  selection.others = std::move(cameras);
+  selection.fit.candidates = std::move(tried);
+  selection.fit.criterion = criterion_name;
+  selection.fit.selection_sigma_px = sigma;
+  return selection;
+}
+
+}  // namespace internal
+}  // namespace camproj

@@ -1,0 +1,43 @@
+// The model selection stage (private): the ladders of model_select.h on a fixed set of points.
+// FitCameraAuto runs it on every point, and again on the inliers the outlier stage finds.
+#ifndef CAMPROJ_SRC_FIT_SELECTION_H_
+#define CAMPROJ_SRC_FIT_SELECTION_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/fit.h"
+#include "camproj/model_select.h"
+
+namespace camproj {
+namespace internal {
+
+struct Selection {
+  // The chosen model's fit (FitCamera's result, with ::model, ::candidates, ::criterion,
+  // ::selection_sigma_px and every left-out group's reason in ::fixed_parameters).
+  FitResult fit;
+  FitOptions options;             // the chosen model (pixel_sigma: the noise its sigmas use)
+  std::vector<Camera> others;     // the other fitted candidates' cameras (starts to try)
+  double sigma_px = 0.0;          // the noise the criterion used
+};
+
+// The noise the criterion uses without a given sigma: the prior combined with the residuals
+// (sum_squares over dof degrees of freedom) of the richest model the scene supports:
+// sqrt((prior_weight * prior^2 + sum_squares) / (prior_weight + dof)), floored at kMinNoisePx.
+double CombinedNoise(const AutoFitOptions& options, double sum_squares, double dof);
+
+// The number of parameters of `options`' model: pose (6; orthographic 5) + free intrinsics.
+int NumParameters(const FitOptions& options);
+
+// Selects and fits the model for these points (the caller's, in options.fit.pixel_origin;
+// options.fit.ransac must be off). Throws SceneError when no model fits (the simplest model's
+// refusal), or kMirroredWorld when only a mirrored perspective camera beats an orthographic one.
+Selection SelectModel(const std::vector<Eigen::Vector3d>& points_in_world,
+                      const std::vector<Eigen::Vector2d>& observed_pixels,
+                      const ImageSize& image_size, const AutoFitOptions& options);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_SELECTION_H_
