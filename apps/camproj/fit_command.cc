@@ -46,6 +46,7 @@ struct FitArgs {
   std::string intrinsics_path;
   std::string pixel_origin = "center";
   std::string loss = "none";
+  bool keep_all = false;
   double ransac_px = 0.0;
   double sigma = 0.0;
   double z_near = 0.0;
@@ -75,16 +76,18 @@ struct FitRequest {
 };
 
 FitResult RunFit(const Correspondences& data, const ImageSize& size, const FitRequest& request) {
-  return request.automatic
-             ? FitCameraAuto(data.points_in_world, data.pixels, size, request.auto_options)
-             : FitCamera(data.points_in_world, data.pixels, size, request.options());
+  if (!request.automatic) return FitCamera(data.points_in_world, data.pixels, size, request.options());
+  AutoFitOptions options = request.auto_options;
+  if (data.ids.size() == data.pixels.size()) options.point_names = data.ids;
+  return FitCameraAuto(data.points_in_world, data.pixels, size, options);
 }
 
-// Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none).
+// Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none),
+// optionally after "pose+" as the summary prints models ("pose+focal+principal-point").
 std::vector<std::string> ModelNames(const std::string& model) {
   std::vector<std::string> names;
   if (model == "pose") return names;
-  size_t begin = 0;
+  size_t begin = model.rfind("pose+", 0) == 0 ? 5 : 0;
   for (;;) {
     const size_t end = model.find('+', begin);
     const std::string name = model.substr(begin, end == std::string::npos ? end : end - begin);
@@ -99,16 +102,35 @@ std::vector<std::string> ModelNames(const std::string& model) {
   }
 }
 
+// The value "fixed at its default" means for an intrinsic of `options`' model: in the automatic
+// path a default-mode intrinsic is a candidate, so a model or --fix given on the command line
+// holds it at its default value (in the input's pixel origin).
+ParameterMode DefaultValueOf(const std::string& name, const ImageSize& size, PixelOrigin origin) {
+  const double shift = PixelOriginShift(PixelOrigin::kCenter, origin);
+  if (name == "aspect") return ParameterMode::Fixed(1.0);
+  if (name == "principal-point") {
+    return ParameterMode::Fixed(0.5 * (size.width - 1) + shift, 0.5 * (size.height - 1) + shift);
+  }
+  return ParameterMode::Fixed(0.0);
+}
+
 FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   FitRequest request;
-  request.automatic = args.model == "auto" && args.intrinsics_path.empty();
+  // Every fit runs the default path (outlier stage, consistency gate), a forced model as a
+  // ladder of one; only a robust loss, which the selection cannot compare, runs FitCamera alone.
+  request.automatic = args.loss == "none";
+  const bool forced = args.model != "auto";
   FitOptions& options = request.auto_options.fit;
   options.pixel_origin = PixelOriginFromString(args.pixel_origin);
   const std::string orthographic = "orthographic";
   if (args.model.rfind(orthographic, 0) == 0) {
     // "orthographic[+aspect][+skew]": the scale (focal) is always free.
     options.projection = Projection::kOrthographic;
-    for (const std::string& name : kParameterNames) *ModeOf(options, name) = ParameterMode::Default();
+    for (const std::string& name : kParameterNames) {
+      *ModeOf(options, name) = name == "focal" || name == "principal-point"
+                                   ? ParameterMode::Default()
+                                   : DefaultValueOf(name, size, PixelOrigin::kCenter);
+    }
     options.focal = ParameterMode::Free();
     if (args.model.size() > orthographic.size()) {
       if (args.model[orthographic.size()] != '+') throw UsageError("--model: unknown model \"" + args.model + "\"");
@@ -120,8 +142,12 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
       }
     }
   } else if (args.model != "auto") {
-    // Exactly the listed intrinsics are free; the rest stay at their defaults.
-    for (const std::string& name : kParameterNames) *ModeOf(options, name) = ParameterMode::Default();
+    // Exactly the listed intrinsics are free; the rest stay at their defaults (fixed there, so
+    // that the automatic path does not free them).
+    for (const std::string& name : kParameterNames) {
+      *ModeOf(options, name) =
+          name == "focal" ? ParameterMode::Default() : DefaultValueOf(name, size, options.pixel_origin);
+    }
     for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
   }
   if (args.criterion != "aic" && args.criterion != "bic") {
@@ -131,17 +157,8 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {
     if (name == "focal") throw UsageError("--fix focal needs a value: use --focal PX or --fovy DEG");
-    // With --model auto a default-mode intrinsic is a candidate, so "fix" means given at its
-    // default value (in the input's pixel origin).
-    const double shift = PixelOriginShift(PixelOrigin::kCenter, options.pixel_origin);
-    ParameterMode mode = ParameterMode::Default();
-    if (request.automatic) {
-      mode = name == "aspect" ? ParameterMode::Fixed(1.0)
-             : name == "principal-point"
-                 ? ParameterMode::Fixed(0.5 * (size.width - 1) + shift, 0.5 * (size.height - 1) + shift)
-                 : ParameterMode::Fixed(0.0);
-    }
-    *ModeOf(options, name) = mode;
+    *ModeOf(options, name) = request.automatic ? DefaultValueOf(name, size, options.pixel_origin)
+                                               : ParameterMode::Default();
   }
   if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
   if (args.focal > 0.0 && args.fovy_deg > 0.0) throw UsageError("give --focal or --fovy, not both");
@@ -185,13 +202,21 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
   options.max_iterations = args.max_iterations;
-  if (request.automatic && options.loss != LossType::kNone) {
+  if (!forced && options.loss != LossType::kNone) {
     throw UsageError("--loss needs an explicit --model (automatic selection compares "
-                     "least-squares fits): e.g. --model focal+aspect+principal-point; for "
-                     "mis-clicked points use --ransac PX");
+                     "least-squares fits): e.g. --model focal+aspect+principal-point; "
+                     "mis-clicked points are found and left out by default");
   }
+  if (!request.automatic && options.focal.kind == ParameterMode::Kind::kDefault) {
+    options.focal = ParameterMode::Free();
+  }
+  request.auto_options.find_outliers = !args.keep_all;
   try {
-    request.auto_options.Check();
+    if (request.automatic) {
+      request.auto_options.Check();
+    } else {
+      options.Check();
+    }
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -316,6 +341,10 @@ Command AddFitCommand(CLI::App& root) {
       "scene determines them, and lists what it left out and why. --model focal+principal-point\n"
       "(any '+' list) forces a model; --free forces a parameter in, --fix (or a value: --focal,\n"
       "--aspect, ...) keeps it out.\n"
+      "Points that disagree with the rest (mis-clicks) are found and left out, each named with\n"
+      "its distance from the camera's prediction (--keep-all keeps every point). A camera is\n"
+      "written only if its residuals are consistent with the pixel noise (--sigma; default: a\n"
+      "1 px prior for clicked points); otherwise exit 3 names the worst points and what to do.\n"
       "Prints a summary (parameters +- 1 sigma, residuals, worst points, time); -o writes the\n"
       "camera file (docs/camera-file.md) atomically.\n\n"
       "Examples:\n"
@@ -360,10 +389,16 @@ Command AddFitCommand(CLI::App& root) {
                   "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
   app->add_option("--loss", args->loss, "none, huber:SCALE or cauchy:SCALE (px)");
   app->add_option("--ransac", args->ransac_px,
-                  "find mis-clicked points by RANSAC: inlier threshold in px (e.g. 4); they are "
-                  "left out and listed")->check(CLI::PositiveNumber);
-  app->add_option("--sigma", args->sigma, "pixel noise sigma (px) for the uncertainties; default: "
-                                          "estimated from the residuals")->check(CLI::PositiveNumber);
+                  "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
+                  "instead of the automatic outlier stage; they are left out and listed")
+      ->check(CLI::PositiveNumber);
+  app->add_flag("--keep-all", args->keep_all,
+                "keep every point: no automatic outlier stage (a scene with mis-clicks is then "
+                "refused by the consistency check, naming the worst points)");
+  app->add_option("--sigma", args->sigma,
+                  "pixel noise per axis (px): the model selection, the consistency check and the "
+                  "uncertainties use it; default: a 1 px prior for clicked points, combined with "
+                  "the residuals")->check(CLI::PositiveNumber);
   app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")
       ->check(CLI::PositiveNumber);
   app->add_option("--far", args->z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);

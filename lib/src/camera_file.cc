@@ -249,7 +249,19 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["median_px"] = fit->median_px;
     record["max_px"] = fit->max_px;
     record["num_points"] = fit->num_points;
-    if (!fit->outliers.empty()) record["outliers"] = fit->outliers;
+    if (!fit->outliers.empty()) {
+      record["outliers"] = fit->outliers;
+      record["outlier_method"] = fit->outlier_method;
+      json points = json::array();
+      for (const FitRecord::OutlierPoint& p : fit->outlier_points) {
+        points.push_back({{"index", p.index}, {"residual_px", p.residual_px}});
+        if (p.rms_with_px > 0.0 && std::isfinite(p.rms_with_px)) {
+          points.back()["rms_with_px"] = p.rms_with_px;
+        }
+      }
+      if (!points.empty()) record["outlier_points"] = points;
+    }
+    if (!fit->consistency.empty()) record["consistency"] = fit->consistency;
     record["start"] = fit->start;
     record["model"] = fit->model;
     if (!fit->candidates.empty()) {

@@ -49,6 +49,11 @@ FitRecord FitRecordOf(const FitResult& fit) {
   }
   for (const ParameterSigma& s : fit.sigmas) record.sigma.emplace_back(s.name, s.sigma);
   record.outliers = fit.outliers;
+  record.outlier_method = fit.outlier_method;
+  for (const LeftOutPoint& p : fit.left_out) {
+    record.outlier_points.push_back({p.index, p.residual_px, p.rms_with_px});
+  }
+  if (fit.consistency.checked) record.consistency = fit.consistency.summary;
   record.pixel_sigma = fit.pixel_sigma;
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
@@ -83,8 +88,13 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
     out << "  fixed " << p.name << " = " << p.value << " (" << p.why << ")\n";
   }
   if (fit.covariance_available) {
+    std::string source = fit.pixel_sigma_estimated ? "estimated from the residuals" : "given";
+    if (fit.consistency.checked && fit.pixel_sigma_estimated) {
+      source = "from the residuals and the " + Format("%.3g", fit.consistency.noise_px) +
+               " px prior";
+    }
     out << "parameters (+- 1 sigma, pixel noise " << Format("%.3g", fit.pixel_sigma) << " px "
-        << (fit.pixel_sigma_estimated ? "estimated from the residuals" : "given") << "):\n";
+        << source << "):\n";
     for (const ParameterSigma& s : fit.sigmas) {
       if (s.name.rfind("rotation", 0) == 0) continue;
       out << "  " << s.name << " = " << WithSigma(s.value, s.sigma) << (s.unit.empty() ? "" : " ")
@@ -139,13 +149,34 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   std::sort(order.begin(), order.end(), [&](int a, int b) {
     return fit.residuals_px[a].norm() > fit.residuals_px[b].norm();
   });
-  if (!fit.outliers.empty()) {
-    out << "outliers (RANSAC, left out of the fit): " << fit.outliers.size() << ":";
-    for (const int i : fit.outliers) {
-      out << " " << (i < static_cast<int>(ids.size()) ? ids[i] : std::to_string(i + 1));
+  auto name = [&](int i) {
+    return i < static_cast<int>(ids.size()) ? ids[i] : std::to_string(i + 1);
+  };
+  if (!fit.left_out.empty()) {
+    out << "left out of the fit (found by " << fit.outlier_method << "): " << fit.left_out.size()
+        << " of " << n << " points\n";
+    constexpr size_t kListed = 20;
+    for (size_t j = 0; j < std::min(kListed, fit.left_out.size()); ++j) {
+      const LeftOutPoint& p = fit.left_out[j];
+      out << "  " << name(p.index) << " is " << Format("%.3g", p.residual_px)
+          << " px from where the camera puts it";
+      if (p.rms_with_px > 0.0) {
+        out << "; with it the rms would be "
+            << (std::isfinite(p.rms_with_px) ? Format("%.3g", p.rms_with_px) + " px"
+                                             : std::string("infinite (no camera fits it)"))
+            << ", without it " << Format("%.3g", fit.rms_px) << " px";
+      }
+      out << "\n";
     }
+    if (fit.left_out.size() > kListed) {
+      out << "  ... and " << fit.left_out.size() - kListed << " more (all in the camera file)\n";
+    }
+  } else if (!fit.outliers.empty()) {
+    out << "outliers (RANSAC, left out of the fit): " << fit.outliers.size() << ":";
+    for (const int i : fit.outliers) out << " " << name(i);
     out << "\n";
   }
+  if (fit.consistency.checked) out << "check: " << fit.consistency.summary << "\n";
   out << "worst points:";
   for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {
     const int index = order[i];

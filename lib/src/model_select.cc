@@ -77,6 +77,60 @@ bool Final(SceneError::Reason reason) {
          reason == SceneError::Reason::kPlanarUnderdetermined;
 }
 
+// A scene that no camera explains may be a mirrored world whose reading the fit could not
+// tell: if the screen's model fits every point consistently once the world's z is negated,
+// throws kMirroredWorld with the advice to flip an axis.
+void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                     const AutoFitOptions& options, const internal::NoiseReference& noise) {
+  if (options.fit.projection != Projection::kPerspective) return;
+  std::vector<Eigen::Vector3d> flipped(points);
+  for (auto& x : flipped) x.z() = -x.z();
+  std::string summary;
+  if (internal::ScreenIsConsistent(flipped, pixels, size, options, noise, &summary)) {
+    throw SceneError(SceneError::Reason::kMirroredWorld,
+                     "no camera explains these points, but with one world axis flipped they fit "
+                     "one (" + summary + "): the points are seen as through a mirror, i.e. the "
+                     "world frame is left-handed. Flip one world axis (e.g. negate Z of every "
+                     "point, and again in anything you render) and refit");
+  }
+}
+
+// A right-handed world fits its proper camera better than the same model fits the world with z
+// negated; where the perspective is weak (a Necker-cube reading) the two fit about equally well
+// and either may win by noise. Refuses as mirrored when the mirrored reading fits significantly
+// better: by more than the chi-square 99.9 % quantile of one degree of freedom (10.83) in units
+// of the noise.
+void RefuseIfMirrorFitsBetter(const FitResult& fit, const FitOptions& model,
+                              const std::vector<int>& left_out,
+                              const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                              const internal::NoiseReference& noise) {
+  constexpr double kSignificantChi2 = 10.83;
+  if (model.projection != Projection::kPerspective) return;
+  std::vector<Eigen::Vector3d> flipped = Kept(points, left_out);
+  for (auto& x : flipped) x.z() = -x.z();
+  FitOptions quick = model;
+  quick.compute_uncertainty = false;
+  double mirrored_rms = 0.0;
+  try {
+    mirrored_rms = FitCamera(flipped, Kept(pixels, left_out), size, quick).rms_px;
+  } catch (const std::exception&) {
+    return;  // no camera of the mirrored world
+  }
+  const double n = static_cast<double>(flipped.size());
+  const double sigma2 = noise.sigma_px * noise.sigma_px;
+  if (n * mirrored_rms * mirrored_rms / sigma2 + kSignificantChi2 <
+      n * fit.rms_px * fit.rms_px / sigma2) {
+    throw SceneError(SceneError::Reason::kMirroredWorld,
+                     "the points fit a camera better with one world axis flipped (rms " +
+                         Px(mirrored_rms) + " against " + Px(fit.rms_px) +
+                         "): they are seen as through a mirror, i.e. the world frame is "
+                         "left-handed. Flip one world axis (e.g. negate Z of every point, and "
+                         "again in anything you render) and refit");
+  }
+}
+
 // The model selection on the points not in `left_out`.
 internal::Selection SelectOn(const std::vector<Eigen::Vector3d>& points,
                              const std::vector<Eigen::Vector2d>& pixels,
@@ -105,6 +159,7 @@ FitResult Assess(internal::Selection selection, const std::vector<int>& left_out
   result.median_px = internal::Median(kept);
   result.max_px = *std::max_element(kept.begin(), kept.end());
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
+  RefuseIfMirrorFitsBetter(result, selection.options, left_out, points, pixels, size, noise);
   result.consistency = internal::CheckConsistency(
       kept, static_cast<int>(result.free_parameters.size()), noise, options);
   if (!result.consistency.passed) {
@@ -165,66 +220,94 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
     method = "ransac";
     selection = SelectOn(points, pixels, left_out, size, options);
   } else {
+    // Screen every point with the simplest model that can show a mis-click; if it fails, the
+    // outlier stage looks for the points to leave out. Then the model selection on the rest,
+    // and its gate; a clean screen whose selection still fails the gate gets the search too.
+    std::string screen;
+    const bool screened = internal::ScreenIsConsistent(points, pixels, size, options, noise, &screen);
+    std::optional<internal::OutlierSearch> search;
+    auto run_search = [&] {
+      search = internal::FindOutliers(points, pixels, size, options, noise, names);
+      if (search->found) {
+        left_out = search->outliers;
+        method = search->method;
+      }
+    };
+    if (!screened && options.find_outliers) run_search();
     std::optional<SceneError> refusal;
-    std::string problem;  // what the fit of every point showed
-    try {
-      selection = SelectOn(points, pixels, {}, size, options);
-      const internal::Selection& s = *selection;
-      std::vector<double> lengths;
-      for (const auto& r : s.fit.residuals_px) lengths.push_back(r.norm());
+    std::string problem;
+    auto select = [&] {
+      refusal.reset();
+      selection.reset();
+      // After a failed screen that no outliers explain, a richer model must leave N equations
+      // to spare (model_select.h, min_redundancy).
+      AutoFitOptions guarded = options;
+      if (!screened && left_out.empty()) {
+        guarded.min_redundancy = std::max(options.min_redundancy, static_cast<int>(points.size()));
+      }
+      try {
+        selection = SelectOn(points, pixels, left_out, size, guarded);
+      } catch (const SceneError& e) {
+        if (Final(e.reason())) throw;
+        refusal = e;
+        return;
+      }
+      FitResult kept = selection->fit;
+      kept.residuals_px =
+          internal::ResidualsAgainst(kept.camera, points, pixels, options.fit.pixel_origin);
       const ConsistencyCheck check = internal::CheckConsistency(
-          lengths, static_cast<int>(s.fit.free_parameters.size()), noise, options);
+          internal::KeptResidualLengths(kept, left_out),
+          static_cast<int>(kept.free_parameters.size()), noise, options);
       if (!check.passed) {
-        problem = "the best camera for all " + std::to_string(points.size()) + " points (" +
-                  s.fit.model + ", rms " + Px(s.fit.rms_px) + ") does not explain them: " +
+        problem = "the best camera for " +
+                  (left_out.empty() ? "all " + std::to_string(points.size()) + " points"
+                                    : "the " + std::to_string(points.size() - left_out.size()) +
+                                          " points kept") +
+                  " (" + kept.model + ", rms " + Px(kept.rms_px) + ") does not explain them: " +
                   check.summary + "; largest residuals " +
-                  WorstPoints(s.fit.residuals_px, {}, names);
+                  WorstPoints(kept.residuals_px, left_out, names);
         selection.reset();
       }
-    } catch (const SceneError& e) {
-      if (Final(e.reason())) throw;
-      refusal = e;
+    };
+    select();
+    if (!selection && left_out.empty() && options.find_outliers && !search) {
+      run_search();
+      if (!left_out.empty()) select();
     }
-    if (!selection) {
-      if (!options.find_outliers) {
-        if (refusal) throw *refusal;
-        throw SceneError(SceneError::Reason::kInconsistent,
-                         problem + ". Check those points, or drop --keep-all to let the fit find "
-                                   "and leave out the points that disagree");
-      }
-      const internal::OutlierSearch search =
-          internal::FindOutliers(points, pixels, size, options, noise, names);
-      if (!search.found) {
-        if (refusal) throw *refusal;
-        throw SceneError(SceneError::Reason::kContaminated,
-                         problem + "; and " + search.why_not +
-                             ". Check the correspondences (ids, order, mis-clicks) and refit");
-      }
-      left_out = search.outliers;
-      method = search.method;
-      try {
-        selection = SelectOn(points, pixels, left_out, size, options);
-      } catch (const SceneError&) {
-        if (refusal) throw *refusal;
-        throw;
-      }
-      if (method == "lo-ransac") {
-        // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at
-        // the noise the inliers show, and select once more if it changed.
-        FitResult all = selection->fit;
-        all.residuals_px =
-            internal::ResidualsAgainst(all.camera, points, pixels, options.fit.pixel_origin);
-        const std::vector<int> reread = internal::OutliersAgainst(all, left_out, noise, options);
-        if (reread != left_out && 2 * (points.size() - reread.size()) > points.size() / 2) {
-          try {
-            internal::Selection again = SelectOn(points, pixels, reread, size, options);
-            selection = std::move(again);
-            left_out = reread;
-          } catch (const SceneError&) {
-            // Keep RANSAC's consensus.
-          }
+    if (selection && method == "lo-ransac") {
+      // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at
+      // the noise the inliers show, and select once more if it changed.
+      FitResult all = selection->fit;
+      all.residuals_px =
+          internal::ResidualsAgainst(all.camera, points, pixels, options.fit.pixel_origin);
+      const std::vector<int> reread = internal::OutliersAgainst(all, left_out, noise, options);
+      if (reread != left_out && 2 * (points.size() - reread.size()) > points.size() / 2) {
+        const std::vector<int> before = left_out;
+        std::optional<internal::Selection> kept = std::move(selection);
+        left_out = reread;
+        select();
+        if (!selection) {
+          left_out = before;
+          selection = std::move(kept);
         }
       }
+    }
+    if (!selection) {
+      MirrorDiagnosis(points, pixels, size, options, noise);
+      if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
+      std::string text = problem.empty() ? "the points do not fit one camera (" + screen + ")"
+                                         : problem;
+      if (!options.find_outliers) {
+        throw SceneError(SceneError::Reason::kInconsistent,
+                         text + ". Check those points, or drop --keep-all to let the fit find "
+                                "and leave out the points that disagree");
+      }
+      if (search && !search->found) text += "; and " + search->why_not;
+      throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
+                                                : SceneError::Reason::kInconsistent,
+                       text + ". Check the correspondences (ids, order, mis-clicks) and refit" +
+                           (noise.given ? std::string()
+                                        : "; if your points are this noisy, give --sigma PX"));
     }
   }
   FitResult result =

@@ -27,7 +27,15 @@ struct FitRecord {
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;
   int num_points = 0;       // points used (without RANSAC's outliers)
-  std::vector<int> outliers;  // 0-based indices of points RANSAC left out
+  std::vector<int> outliers;  // 0-based indices of the points left out of the fit
+  std::string outlier_method;  // how they were found: ransac | leave-one-out | leave-two-out | lo-ransac
+  struct OutlierPoint {
+    int index = 0;             // 0-based, as `outliers`
+    double residual_px = 0.0;  // against this camera
+    double rms_with_px = 0.0;  // the same model fitted with the point put back (0: not computed)
+  };
+  std::vector<OutlierPoint> outlier_points;
+  std::string consistency;  // the consistency gate's verdict in words (automatic fit only)
   std::string start;        // closed-form start: dlt | homography | pnp | pnp-focal-sweep
   std::string model;        // "pose+focal+principal-point": the free intrinsics
   // Automatic model selection (empty otherwise): criterion, the noise it used, every model tried.

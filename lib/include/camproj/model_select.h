@@ -75,10 +75,12 @@ struct AutoFitOptions {
   // residual exceeds sqrt(2 ln(N / significance)) times the robust noise estimate (median
   // residual, corrected for the fit's leverage). Failing either is SceneError kInconsistent.
   double significance = 1e-3;
-  double noise_tolerance = 2.0;
+  double noise_tolerance = 1.5;
 
   // A model is only freed beyond pose + focal when it leaves at least this many redundant
-  // equations (2N - p): with fewer, its residuals cannot show that it is wrong.
+  // equations (2N - p): with fewer, its residuals cannot show that it is wrong. When the screen
+  // (pose + focal + principal point) fails and no outliers explain why, a richer model needs N
+  // redundant equations: at 8 points skew, k1 and k2 would otherwise absorb a mis-click.
   int min_redundancy = 3;
 
   // Below this many points, refine the chosen model from several starts (the other models'

@@ -43,6 +43,7 @@ struct SubsetFit {
   bool fitted = false;
   bool consistent = false;
   double rms_px = 0.0;
+  std::string summary;  // the gate's, or the last refusal
 };
 
 SubsetFit FitSubset(const std::vector<Eigen::Vector3d>& points,
@@ -66,12 +67,15 @@ SubsetFit FitSubset(const std::vector<Eigen::Vector3d>& points,
       const FitResult fit = FitCamera(x, u, size, model);
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
+      const ConsistencyCheck check = CheckConsistency(lengths, p, noise, options);
       subset.fitted = true;
       subset.rms_px = fit.rms_px;
-      subset.consistent = CheckConsistency(lengths, p, noise, options).passed;
+      subset.consistent = check.passed;
+      subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
       return subset;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
       // Not determined by this subset (or a numerical failure): try the next model.
+      subset.summary = e.what();
     }
   }
   return subset;
@@ -90,15 +94,32 @@ OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
                          const AutoFitOptions& options, const NoiseReference& noise,
                          const std::vector<std::string>& names) {
   const int n = static_cast<int>(points.size());
-  const std::vector<FitOptions> models = DetectionModels(options);
+  // The subsets are judged with the model the screen used (the richest detection model every
+  // point determines): a simpler one would call a projector's lens shift a mis-click.
+  std::vector<FitOptions> models;
+  for (const FitOptions& model : DetectionModels(options)) {
+    if (2 * n - NumParameters(model) >= options.min_redundancy) {
+      models.push_back(model);
+      break;
+    }
+  }
   OutlierSearch search;
+  if (models.empty()) {
+    search.why_not = "too few points to tell which disagree";
+    return search;
+  }
+  const int p = NumParameters(models.front());
   for (int k = 1; k <= 2; ++k) {
-    // Whether any subset of n - k points can be checked at all.
-    const int smallest = NumParameters(models.back());
-    if (2 * (n - k) - smallest < options.min_redundancy) {
-      search.why_not = "with " + std::to_string(n - k) + " points left the rest could not be "
-                       "checked (" + std::to_string(2 * (n - k)) + " equations for " +
-                       std::to_string(smallest) + " unknowns)";
+    // Whether a subset of n - k points can be checked well enough to convict the k left out:
+    // the redundancy the model needs anyway plus the 2k equations the left-out points would
+    // have added (with less, a subset that kept a mis-click passes as often as the right one).
+    const int needed = options.min_redundancy + 2 * k;
+    if (2 * (n - k) - p < needed) {
+      search.why_not = "with a point left out, the " + std::to_string(n - k) + " others could not "
+                       "show that they fit (" + std::to_string(2 * (n - k)) + " equations for " +
+                       std::to_string(p) + " unknowns, fewer than " + std::to_string(needed) +
+                       " to spare): add points";
+      if (k == 2) search.why_not = "no single point explains the disagreement, and " + search.why_not;
       return search;
     }
     std::vector<std::vector<int>> explaining;
@@ -167,6 +188,15 @@ OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
 }
 
 }  // namespace
+
+bool ScreenIsConsistent(const std::vector<Eigen::Vector3d>& points,
+                        const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                        const AutoFitOptions& options, const NoiseReference& noise,
+                        std::string* summary) {
+  const SubsetFit fit = FitSubset(points, pixels, {}, size, DetectionModels(options), options, noise);
+  *summary = fit.summary;
+  return fit.consistent;
+}
 
 OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points,
                            const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,

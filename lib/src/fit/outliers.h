@@ -26,6 +26,16 @@ struct OutlierSearch {
   std::string why_not;        // when !found: what the search saw, in words (names points)
 };
 
+// Whether every point is consistent with the simplest model that can show a mis-click: pose +
+// focal + principal point where the scene determines it with min_redundancy equations to spare,
+// else pose + focal (the caller's forced or given intrinsics as they are). Run before the model
+// selection, whose richer models (skew, k1, k2 at 8 points) can absorb a mis-click. `summary`
+// receives the gate's verdict or the refusal.
+bool ScreenIsConsistent(const std::vector<Eigen::Vector3d>& points_in_world,
+                        const std::vector<Eigen::Vector2d>& observed_pixels,
+                        const ImageSize& image_size, const AutoFitOptions& options,
+                        const NoiseReference& noise, std::string* summary);
+
 // `names` name the points in messages. Never throws a SceneError: a search that finds no unique
 // subset says why in why_not.
 OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points_in_world,

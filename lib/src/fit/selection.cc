@@ -103,11 +103,12 @@ std::string Fixed(double value, int digits = 3) {
   return buffer;
 }
 
-// A criterion difference in words: "BIC +3.3 against pose+focal (higher: worse)".
+// A criterion difference in words: "BIC 2.15 above pose+focal+principal-point's: its better
+// fit does not pay for its extra parameters".
 std::string Versus(const char* criterion, double delta, const std::string& against) {
-  return std::string(criterion) + " " + (delta >= 0.0 ? "+" : "") + Fixed(delta) + " against " +
-         against + (delta < 0.0 ? " (lower: the data support it)"
-                                : " (not lower: the data do not need it)");
+  return std::string(criterion) + " " + Fixed(std::abs(delta)) + (delta < 0.0 ? " below " : " above ") +
+         against + "'s: " + (delta < 0.0 ? "its better fit pays for its extra parameters"
+                                           : "its better fit does not pay for its extra parameters");
 }
 
 // Why a model was not tried: "2N - p = 2 redundant equations, fewer than 3 (its residuals could
@@ -406,8 +407,8 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       throw SceneError(SceneError::Reason::kMirroredWorld,
                        "the points fit a perspective camera only with one world axis flipped "
                        "(rms " + Fixed(e.fit->rms_px) + " px; the best camera of this world is "
-                       "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): the "
-                       "world frame is left-handed. Flip one world axis (e.g. negate Z of every "
+                       "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): they "
+                       "are seen as through a mirror, i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of every "
                        "point, and again in anything you render) and refit");
     }
   }
