@@ -958,6 +958,14 @@ std::string ShellLine(const std::string& command) {
   return line;
 }
 
+// "1.23 0.98 0.50" from /proc/loadavg, "unknown" elsewhere.
+std::string LoadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (!(in >> one >> five >> fifteen)) return "unknown";
+  return one + " " + five + " " + fifteen;
+}
+
 // The source's commit, marked when lib/ or apps/ differ from it.
 std::string GitDescription() {
   const std::string dir = CAMPROJ_SOURCE_DIR;
@@ -1156,8 +1164,9 @@ would see).
 
 ## Columns
 
+- **band**: variant and N (a range: N drawn uniformly in it per scene).
 - **answered / refused / errors**: the default's answers, SceneError refusals (by reason), other
-  exceptions (messages below).
+  exceptions (their messages in the sections after the tables).
 - **default p50 / p90 px**: median and 90th percentile (nearest rank) over the default's answers of
   the unseen error. **oracle p50 / p90 px**: the same for the oracle on the scenes the default
   answered (where the oracle answered too). **p90 ratio** = default p90 / oracle p90, "(on k of
@@ -1169,10 +1178,11 @@ would see).
   in how many scenes).
 - **SILENT**: silent failures = answers with unseen error > 10 px; in the mirrored band every
   answer (no proper camera is right in a mirrored world).
-- **t default / t oracle**: median wall time per call (refusals included), one core.
+- **t default / t oracle**: median wall time per call (refusals included), one core; other work
+  on the machine inflates them (load average in the header).
 - Second table: the oracle over all scenes of the band (answers, refusals, unseen error, answers
-  > 10 px), OpenCV's answers and errors (its exceptions count as not answered; its 'silent' uses
-  the same rule), and the models the default chose.
+  more than 10 px off), OpenCV's answers and errors (its exceptions count as not answered; its
+  'silent' uses the same rule), and the models the default chose.
 )md";
 
 // ---------------------------------------------------------------------------------------------
@@ -1217,6 +1227,7 @@ int Main(const ClicksOptions& options) {
                "representative\n";
 #endif
   const Clock::time_point begin = Clock::now();
+  const std::string load_before = LoadAverage();
   const std::vector<Band> bands = MakeBands();
   const int scenes = options.scenes > 0 ? options.scenes : options.quick ? 5 : 100;
 
@@ -1276,6 +1287,7 @@ int Main(const ClicksOptions& options) {
         << "| scenes | " << scenes << " per band, " << bands.size() << " bands, "
         << scenes * static_cast<int>(bands.size()) << " scenes; " << Format(seconds, "%.0f")
         << " s wall time, single-threaded |\n"
+        << "| load average | " << load_before << " at the start (1, 5, 15 min) |\n"
         << "| silent failures of the default | " << silent << " |\n\n"
         << "## Results\n\n"
         << main_table << '\n'
