@@ -2,6 +2,7 @@
 // every method, in one process. What is measured and why: docs/bench/README.md.
 //
 //   bench [--quick] [--out DIR] [--scenes-scale X] [--mapamok-literal-focal]
+//   bench --clicks [--quick] [--out DIR] [--scenes N]     (the click benchmark: clicks.h)
 //
 // Writes DIR/results.csv, DIR/results.json and DIR/table.md. Single-threaded (OpenCV is set to
 // one thread, Ceres runs with one), so 1 / median time is fits per second per core.
@@ -30,6 +31,7 @@
 #include "camproj/model_select.h"
 #include "camproj/fit.h"
 #include "camproj/synth.h"
+#include "clicks.h"
 
 #ifndef CAMPROJ_CERES_VERSION
 #define CAMPROJ_CERES_VERSION "unknown"
@@ -88,6 +90,9 @@ const char* kUsage =
     "\n"
     "Exit codes: 0 ok; 1 usage; 2 error; 3 a camproj method failed on a noise-free scene (the\n"
     "results are still written).\n"
+    "\n"
+    "bench --clicks [...] runs the click benchmark of the default fitting path instead\n"
+    "(bench --clicks --help).\n"
     "\n"
     "Example:\n"
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
@@ -994,6 +999,9 @@ int Main(const BenchOptions& options) {
 }  // namespace camproj
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--clicks") return camproj::bench::ClicksMain(argc, argv);
+  }
   camproj::bench::BenchOptions options;
   options.command = "bench";
   for (int i = 1; i < argc; ++i) {
