@@ -2,7 +2,9 @@
 //
 // FitCamera starts from a closed form (Hartley-normalized DLT for >= 6 non-coplanar points, a
 // homography with constrained intrinsics for planar scenes, SQPnP when the intrinsics are known or
-// only the focal length is free with few points), then refines with Ceres: residuals are
+// only the focal length is free with few points), then refines -- least squares by the
+// project's own Levenberg-Marquardt on normal equations accumulated point by point, then a
+// Gauss-Newton polish; Ceres (ceres::Problem) only for a robust loss -- where residuals are
 // predicted - observed pixels; rotation on a quaternion manifold, translation in a world frame
 // centred and scaled to the points (so units and offsets do not matter); fixed intrinsics are
 // constants, not penalties. Conventions: docs/conventions.md.
