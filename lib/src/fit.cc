@@ -17,6 +17,7 @@
 #include "check.h"
 #include "closed_form.h"
 #include "fit_common.h"
+#include "fit/statistics.h"
 #include "orthographic_fit.h"
 #include "reprojection_error.h"
 
@@ -861,17 +862,6 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   return converged();
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double median = values[mid];
-  if (values.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
-  }
-  return median;
-}
-
 // One least-squares refinement: Levenberg-Marquardt, then the Gauss-Newton polish, with its trace.
 struct LeastSquaresOutcome {
   bool ok = false;
@@ -1385,7 +1375,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                                       "mis-clicked points); check them or use a robust loss"));
   }
   result.rms_px = std::sqrt(sum_squares / n);
-  result.median_px = Median(norms);
+  result.median_px = internal::Median(norms);
   result.max_px = *std::max_element(norms.begin(), norms.end());
   result.start_method = start_method;
   result.planar = planar;
@@ -1396,7 +1386,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   camera.z_far = options.z_far.value_or(*max_depth * (1.0 + options.depth_margin));
   Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
           camera.z_far, ")");
-  result.views = ViewsOfCamera(camera, Median(depths));
+  result.views = ViewsOfCamera(camera, internal::Median(depths));
 
   // Parameter names in the user parameterization.
   std::vector<std::string> names = {"rotation_x_deg", "rotation_y_deg", "rotation_z_deg",

@@ -25,11 +25,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string Px(double value) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.3g px", value);
-  return buffer;
-}
+std::string Px(double value) { return internal::PxText(value); }
 
 std::vector<std::string> NamesOf(const AutoFitOptions& options, size_t n) {
   if (!options.point_names.empty()) return options.point_names;

@@ -11,13 +11,15 @@ namespace internal {
 
 namespace {
 
-std::string Px(double value) {
+std::string Px(double value) { return PxText(value); }
+
+}  // namespace
+
+std::string PxText(double value) {
   char buffer[48];
   std::snprintf(buffer, sizeof buffer, "%.3g px", value);
   return buffer;
 }
-
-}  // namespace
 
 std::string NoiseReference::Source() const {
   return given ? "given" : "assumed: the default for clicked points; set it with --sigma";

@@ -15,6 +15,9 @@
 namespace camproj {
 namespace internal {
 
+// "3.14 px": a pixel distance in messages.
+std::string PxText(double value);
+
 // The noise the residuals are tested against: FitOptions::pixel_sigma when given, else
 // AutoFitOptions::prior_sigma_px.
 struct NoiseReference {

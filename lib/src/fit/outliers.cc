@@ -12,11 +12,7 @@ namespace internal {
 
 namespace {
 
-std::string Px(double value) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.3g px", value);
-  return buffer;
-}
+std::string Px(double value) { return internal::PxText(value); }
 
 // The models the exhaustive search fits each subset with, richest first: pose + focal +
 // principal point (a projector's lens shift), then pose + focal; the caller's forced or given
