@@ -31,6 +31,7 @@
 #include "camproj/model_select.h"
 #include "camproj/fit.h"
 #include "camproj/synth.h"
+#include "common.h"
 #include "clicks.h"
 
 #ifndef CAMPROJ_CERES_VERSION
@@ -233,27 +234,6 @@ double MicrosecondsBetween(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::micro>(b - a).count();
 }
 
-Rigid3 RigidFromCv(const cv::Mat& rvec, const cv::Mat& tvec) {
-  cv::Mat r;
-  cv::Rodrigues(rvec, r);
-  Rigid3 rigid;
-  for (int i = 0; i < 3; ++i) {
-    rigid.translation(i) = tvec.at<double>(i);
-    for (int j = 0; j < 3; ++j) rigid.rotation(i, j) = r.at<double>(i, j);
-  }
-  return rigid;
-}
-
-Intrinsics IntrinsicsFromCv(const cv::Mat& k) {
-  Intrinsics intrinsics;
-  intrinsics.fx = k.at<double>(0, 0);
-  intrinsics.fy = k.at<double>(1, 1);
-  intrinsics.cx = k.at<double>(0, 2);
-  intrinsics.cy = k.at<double>(1, 2);
-  intrinsics.skew = k.at<double>(0, 1);
-  return intrinsics;
-}
-
 // calibrateCamera on the one view: aspect fixed at the guess's (1), no distortion, principal
 // point free unless `fix_principal_point`. Returns the estimate.
 Estimate CvCalibrate(const SceneInput& in, double focal, double cx, double cy,
@@ -439,21 +419,6 @@ struct Samples {
   std::map<std::string, int> errors;  // refusal message (truncated) -> count
   std::map<std::string, int> notes;   // Outcome::note -> count
 };
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t mid = v.size() / 2;
-  return v.size() % 2 ? v[mid] : 0.5 * (v[mid - 1] + v[mid]);
-}
-
-// Nearest-rank 90th percentile.
-double Percentile90(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t rank = static_cast<size_t>(std::ceil(0.9 * static_cast<double>(v.size())));
-  return v[std::max<size_t>(rank, 1) - 1];
-}
 
 struct CellKey {
   int n;

@@ -33,6 +33,7 @@
 #include "camproj/look_at.h"
 #include "camproj/model_select.h"
 #include "camproj/pose.h"
+#include "common.h"
 
 #ifndef CAMPROJ_BUILD_TYPE
 #define CAMPROJ_BUILD_TYPE "unknown"
@@ -679,27 +680,6 @@ double MillisecondsBetween(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-Intrinsics IntrinsicsFromCv(const cv::Mat& k) {
-  Intrinsics intrinsics;
-  intrinsics.fx = k.at<double>(0, 0);
-  intrinsics.fy = k.at<double>(1, 1);
-  intrinsics.cx = k.at<double>(0, 2);
-  intrinsics.cy = k.at<double>(1, 2);
-  intrinsics.skew = k.at<double>(0, 1);
-  return intrinsics;
-}
-
-Rigid3 RigidFromCv(const cv::Mat& rvec, const cv::Mat& tvec) {
-  cv::Mat r;
-  cv::Rodrigues(rvec, r);
-  Rigid3 rigid;
-  for (int i = 0; i < 3; ++i) {
-    rigid.translation(i) = tvec.at<double>(i);
-    for (int j = 0; j < 3; ++j) rigid.rotation(i, j) = r.at<double>(i, j);
-  }
-  return rigid;
-}
-
 // As bench.cc's cv-calib method: calibrateCamera on the one view from a guess (60 deg horizontal
 // field of view, principal point at the image centre), aspect fixed at 1, no distortion.
 Camera CvCalibrate(const std::vector<Eigen::Vector3d>& points,
@@ -797,21 +777,6 @@ bool Silent(const Outcome& o, const Band& band) {
 
 // ---------------------------------------------------------------------------------------------
 // Statistics per band
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t mid = v.size() / 2;
-  return v.size() % 2 ? v[mid] : 0.5 * (v[mid - 1] + v[mid]);
-}
-
-// Nearest-rank 90th percentile (bench.cc's).
-double Percentile90(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t rank = static_cast<size_t>(std::ceil(0.9 * static_cast<double>(v.size())));
-  return v[std::max<size_t>(rank, 1) - 1];
-}
 
 // A message with its numbers replaced by '#', so equal causes count together.
 std::string MessageKind(const std::string& message) {
