@@ -1,6 +1,6 @@
-// FitCameraAuto: the default path as a pipeline of stages (lib/src/fit/): model selection on
-// every point -> consistency gate -> (outlier stage -> model selection on the inliers) ->
-// assessment of the returned camera. Each stage's contract is in its header.
+// FitCameraAuto: the default path as a pipeline of stages (lib/src/fit/): screen -> (outlier
+// stage) -> model selection on the points kept -> assessment of the returned camera (mirror
+// test, consistency gate). The order and why: model_select.h, docs/model-selection.md.
 #include "camproj/model_select.h"
 
 #include <algorithm>
@@ -25,7 +25,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string Px(double value) { return internal::PxText(value); }
+using internal::Px;
 
 std::vector<std::string> NamesOf(const AutoFitOptions& options, size_t n) {
   if (!options.point_names.empty()) return options.point_names;
@@ -44,6 +44,14 @@ std::vector<T> Kept(const std::vector<T>& values, const std::vector<int>& left_o
     }
   }
   return kept;
+}
+
+// Lengths of the residuals of the points not in `left_out` (sorted).
+std::vector<double> KeptLengths(const std::vector<Eigen::Vector2d>& residuals,
+                                const std::vector<int>& left_out) {
+  std::vector<double> lengths;
+  for (const Eigen::Vector2d& r : Kept(residuals, left_out)) lengths.push_back(r.norm());
+  return lengths;
 }
 
 // "c4 (118 px), c2 (3.1 px), c7 (2.9 px)": the largest residuals among the kept points.
@@ -73,6 +81,12 @@ bool Final(SceneError::Reason reason) {
          reason == SceneError::Reason::kPlanarUnderdetermined;
 }
 
+// The points with the world's z negated: the same scene seen through a mirror.
+std::vector<Eigen::Vector3d> Mirrored(std::vector<Eigen::Vector3d> points) {
+  for (auto& x : points) x.z() = -x.z();
+  return points;
+}
+
 // A scene that no camera explains may be a mirrored world whose reading the fit could not
 // tell: if the screen's model fits every point consistently once the world's z is negated,
 // throws kMirroredWorld with the advice to flip an axis.
@@ -80,15 +94,13 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                      const AutoFitOptions& options, const internal::NoiseReference& noise) {
   if (options.fit.projection != Projection::kPerspective) return;
-  std::vector<Eigen::Vector3d> flipped(points);
-  for (auto& x : flipped) x.z() = -x.z();
-  std::string summary;
-  if (internal::ScreenIsConsistent(flipped, pixels, size, options, noise, &summary)) {
+  const internal::Screen screen = internal::ScreenPoints(Mirrored(points), pixels, size, options, noise);
+  if (screen.consistent) {
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "no camera explains these points, but with one world axis flipped they fit "
-                     "one (" + summary + "): the points are seen as through a mirror, i.e. the "
-                     "world frame is left-handed. Flip one world axis (e.g. negate Z of every "
-                     "point, and again in anything you render) and refit");
+                     "one (" + screen.summary + "): the points are seen as through a mirror, "
+                     "i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of "
+                     "every point, and again in anything you render) and refit");
   }
 }
 
@@ -97,77 +109,90 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
 // and either may win by noise. Refuses as mirrored when the mirrored reading fits significantly
 // better: by more than the chi-square 99.9 % quantile of one degree of freedom (10.83) in units
 // of the noise.
-void RefuseIfMirrorFitsBetter(const FitResult& fit, const FitOptions& model,
-                              const std::vector<int>& left_out,
-                              const std::vector<Eigen::Vector3d>& points,
-                              const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
-                              const internal::NoiseReference& noise) {
+void RefuseIfMirrorFitsBetter(double rms_px, const FitOptions& model,
+                              const std::vector<Eigen::Vector3d>& kept_points,
+                              const std::vector<Eigen::Vector2d>& kept_pixels,
+                              const ImageSize& size, const internal::NoiseReference& noise) {
   constexpr double kSignificantChi2 = 10.83;
   if (model.projection != Projection::kPerspective) return;
-  std::vector<Eigen::Vector3d> flipped = Kept(points, left_out);
-  for (auto& x : flipped) x.z() = -x.z();
   FitOptions quick = model;
   quick.compute_uncertainty = false;
   double mirrored_rms = 0.0;
   try {
-    mirrored_rms = FitCamera(flipped, Kept(pixels, left_out), size, quick).rms_px;
+    mirrored_rms = FitCamera(Mirrored(kept_points), kept_pixels, size, quick).rms_px;
   } catch (const std::exception&) {
     return;  // no camera of the mirrored world
   }
-  const double n = static_cast<double>(flipped.size());
+  const double n = static_cast<double>(kept_points.size());
   const double sigma2 = noise.sigma_px * noise.sigma_px;
-  if (n * mirrored_rms * mirrored_rms / sigma2 + kSignificantChi2 <
-      n * fit.rms_px * fit.rms_px / sigma2) {
+  if (n * mirrored_rms * mirrored_rms / sigma2 + kSignificantChi2 < n * rms_px * rms_px / sigma2) {
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "the points fit a camera better with one world axis flipped (rms " +
-                         Px(mirrored_rms) + " against " + Px(fit.rms_px) +
+                         Px(mirrored_rms) + " against " + Px(rms_px) +
                          "): they are seen as through a mirror, i.e. the world frame is "
                          "left-handed. Flip one world axis (e.g. negate Z of every point, and "
                          "again in anything you render) and refit");
   }
 }
 
-// The model selection on the points not in `left_out`.
-internal::Selection SelectOn(const std::vector<Eigen::Vector3d>& points,
-                             const std::vector<Eigen::Vector2d>& pixels,
-                             const std::vector<int>& left_out, const ImageSize& size,
-                             const AutoFitOptions& options) {
-  return internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options);
+// A selection with every point's residual against its camera, recomputed in world coordinates
+// from the camera as returned (and as the camera file stores it), and the gate on the points
+// kept: computed once per selection, read by the pipeline and by the assessment.
+struct Gated {
+  internal::Selection selection;
+  std::vector<Eigen::Vector2d> residuals_px;  // every point, in the caller's order
+  ConsistencyCheck check;                     // over the points kept
+};
+
+Gated Gate(internal::Selection selection, const std::vector<int>& left_out,
+           const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& pixels,
+           const AutoFitOptions& options, const internal::NoiseReference& noise) {
+  Gated gated;
+  gated.residuals_px = internal::ResidualsAgainst(selection.fit.camera, points, pixels,
+                                                  options.fit.pixel_origin);
+  gated.check = internal::CheckConsistency(
+      KeptLengths(gated.residuals_px, left_out), static_cast<int>(selection.fit.free_parameters.size()), noise, options);
+  gated.selection = std::move(selection);
+  return gated;
 }
 
-// The assessment: every point's residual against the chosen camera, recomputed in world
-// coordinates from the camera as returned (and as the camera file stores it), the statistics
-// over the kept points, the left-out points' report, and the gate. Throws kInconsistent when the
-// gate fails.
-FitResult Assess(internal::Selection selection, const std::vector<int>& left_out,
-                 const std::string& method, const std::vector<Eigen::Vector3d>& points,
+// The model selection on the points not in `left_out`, gated.
+Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
+               const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& left_out,
+               const ImageSize& size, const AutoFitOptions& options,
+               const internal::NoiseReference& noise) {
+  return Gate(internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options),
+              left_out, points, pixels, options, noise);
+}
+
+// The assessment of the gated selection: the statistics over the kept points, the mirror test,
+// the gate's verdict (kInconsistent when it failed: only the forced-RANSAC path gets here with a
+// failed gate), and the left-out points' report.
+FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::string& method,
+                 const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                  const AutoFitOptions& options, const std::vector<std::string>& names) {
-  FitResult result = std::move(selection.fit);
-  result.residuals_px =
-      internal::ResidualsAgainst(result.camera, points, pixels, options.fit.pixel_origin);
+  FitResult result = std::move(gated.selection.fit);
+  result.residuals_px = std::move(gated.residuals_px);
   result.outliers = left_out;
   result.outlier_method = left_out.empty() ? "" : method;
-  const std::vector<double> kept = internal::KeptResidualLengths(result, left_out);
-  double sum_squares = 0.0;
-  for (const double r : kept) sum_squares += r * r;
-  result.rms_px = std::sqrt(sum_squares / kept.size());
-  result.median_px = internal::Median(kept);
-  result.max_px = *std::max_element(kept.begin(), kept.end());
+  result.rms_px = gated.check.rms_px;
+  result.median_px = internal::Median(KeptLengths(result.residuals_px, left_out));
+  result.max_px = gated.check.max_residual_px;
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
-  RefuseIfMirrorFitsBetter(result, selection.options, left_out, points, pixels, size, noise);
-  result.consistency = internal::CheckConsistency(
-      kept, static_cast<int>(result.free_parameters.size()), noise, options);
+  RefuseIfMirrorFitsBetter(result.rms_px, gated.selection.options, Kept(points, left_out),
+                           Kept(pixels, left_out), size, noise);
+  result.consistency = gated.check;
   if (!result.consistency.passed) {
     throw SceneError(SceneError::Reason::kInconsistent,
                      "no camera explains these points: " + result.consistency.summary +
                          ". Largest residuals: " + WorstPoints(result.residuals_px, left_out, names) +
                          ". Check those points" +
                          (noise.given ? std::string()
-                                      : "; if your points are this noisy, give --sigma PX") );
+                                      : "; if your points are this noisy, give --sigma PX"));
   }
   constexpr size_t kMaxRefits = 10;  // beyond, rms_with_px is not computed (0)
-  FitOptions refit = selection.options;
+  FitOptions refit = gated.selection.options;
   refit.compute_uncertainty = false;
   for (const int i : left_out) {
     LeftOutPoint p;
@@ -189,6 +214,53 @@ FitResult Assess(internal::Selection selection, const std::vector<int>& left_out
   return result;
 }
 
+// --ransac PX: RANSAC at the caller's threshold, with the principal point and aspect free where
+// they are candidates (the simplest model if the scene cannot determine them), then the
+// selection on its consensus. Sets `left_out`.
+Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                   const AutoFitOptions& options, const internal::NoiseReference& noise,
+                   std::vector<int>* left_out) {
+  FitOptions consensus = options.fit;
+  if (consensus.focal.kind == ParameterMode::Kind::kDefault) consensus.focal = ParameterMode::Free();
+  FitOptions simplest = consensus;
+  for (ParameterMode* mode : {&consensus.principal_point, &consensus.aspect}) {
+    if (mode->kind == ParameterMode::Kind::kDefault) *mode = ParameterMode::Free();
+  }
+  consensus.compute_uncertainty = simplest.compute_uncertainty = false;
+  try {
+    *left_out = FitCamera(points, pixels, size, consensus).outliers;
+  } catch (const SceneError&) {
+    *left_out = FitCamera(points, pixels, size, simplest).outliers;
+  }
+  return SelectOn(points, pixels, *left_out, size, options, noise);
+}
+
+// The refusal of a scene no selection explained, with what the pipeline saw: a mirror if that
+// explains it, else the selection's own refusal or the gate's verdict and the search's outcome.
+[[noreturn]] void Refuse(const std::vector<Eigen::Vector3d>& points,
+                         const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
+                         const AutoFitOptions& options, const internal::NoiseReference& noise,
+                         const std::optional<SceneError>& refusal, const std::string& problem,
+                         const internal::Screen& screen, const std::vector<int>& left_out,
+                         const std::optional<internal::OutlierSearch>& search) {
+  MirrorDiagnosis(points, pixels, size, options, noise);
+  if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
+  std::string text =
+      problem.empty() ? "the points do not fit one camera (" + screen.summary + ")" : problem;
+  if (!options.find_outliers) {
+    throw SceneError(SceneError::Reason::kInconsistent,
+                     text + ". Check those points, or drop --keep-all to let the fit find "
+                            "and leave out the points that disagree");
+  }
+  if (search && !search->found) text += "; and " + search->why_not;
+  throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
+                                            : SceneError::Reason::kInconsistent,
+                   text + ". Check the correspondences (ids, order, mis-clicks) and refit" +
+                       (noise.given ? std::string()
+                                    : "; if your points are this noisy, give --sigma PX"));
+}
+
 FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
                       const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                       const AutoFitOptions& options, Clock::time_point start) {
@@ -196,31 +268,15 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
   std::vector<int> left_out;
   std::string method;
-  std::optional<internal::Selection> selection;
+  std::optional<Gated> gated;
   if (options.fit.ransac) {
-    // RANSAC at the caller's threshold, with the principal point and aspect free where they are
-    // candidates (the simplest model if the scene cannot determine them), then the selection on
-    // its consensus.
-    FitOptions consensus = options.fit;
-    if (consensus.focal.kind == ParameterMode::Kind::kDefault) consensus.focal = ParameterMode::Free();
-    FitOptions simplest = consensus;
-    for (ParameterMode* mode : {&consensus.principal_point, &consensus.aspect}) {
-      if (mode->kind == ParameterMode::Kind::kDefault) *mode = ParameterMode::Free();
-    }
-    consensus.compute_uncertainty = simplest.compute_uncertainty = false;
-    try {
-      left_out = FitCamera(points, pixels, size, consensus).outliers;
-    } catch (const SceneError&) {
-      left_out = FitCamera(points, pixels, size, simplest).outliers;
-    }
+    gated = ForcedRansac(points, pixels, size, options, noise, &left_out);
     method = "ransac";
-    selection = SelectOn(points, pixels, left_out, size, options);
   } else {
     // Screen every point with the simplest model that can show a mis-click; if it fails, the
     // outlier stage looks for the points to leave out. Then the model selection on the rest,
     // and its gate; a clean screen whose selection still fails the gate gets the search too.
-    std::string screen;
-    const bool screened = internal::ScreenIsConsistent(points, pixels, size, options, noise, &screen);
+    const internal::Screen screen = internal::ScreenPoints(points, pixels, size, options, noise);
     std::optional<internal::OutlierSearch> search;
     auto run_search = [&] {
       search = internal::FindOutliers(points, pixels, size, options, noise, names);
@@ -229,85 +285,61 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
         method = search->method;
       }
     };
-    if (!screened && options.find_outliers) run_search();
+    if (!screen.consistent && options.find_outliers) run_search();
     std::optional<SceneError> refusal;
     std::string problem;
     auto select = [&] {
       refusal.reset();
-      selection.reset();
+      gated.reset();
       // After a failed screen that no outliers explain, a richer model must leave N equations
       // to spare (model_select.h, min_redundancy).
       AutoFitOptions guarded = options;
-      if (!screened && left_out.empty()) {
+      if (!screen.consistent && left_out.empty()) {
         guarded.min_redundancy = std::max(options.min_redundancy, static_cast<int>(points.size()));
       }
       try {
-        selection = SelectOn(points, pixels, left_out, size, guarded);
+        gated = SelectOn(points, pixels, left_out, size, guarded, noise);
       } catch (const SceneError& e) {
         if (Final(e.reason())) throw;
         refusal = e;
         return;
       }
-      FitResult kept = selection->fit;
-      kept.residuals_px =
-          internal::ResidualsAgainst(kept.camera, points, pixels, options.fit.pixel_origin);
-      const ConsistencyCheck check = internal::CheckConsistency(
-          internal::KeptResidualLengths(kept, left_out),
-          static_cast<int>(kept.free_parameters.size()), noise, options);
-      if (!check.passed) {
+      if (!gated->check.passed) {
         problem = "the best camera for " +
                   (left_out.empty() ? "all " + std::to_string(points.size()) + " points"
                                     : "the " + std::to_string(points.size() - left_out.size()) +
                                           " points kept") +
-                  " (" + kept.model + ", rms " + Px(kept.rms_px) + ") does not explain them: " +
-                  check.summary + "; largest residuals " +
-                  WorstPoints(kept.residuals_px, left_out, names);
-        selection.reset();
+                  " (" + gated->selection.fit.model + ", rms " + Px(gated->check.rms_px) +
+                  ") does not explain them: " + gated->check.summary + "; largest residuals " +
+                  WorstPoints(gated->residuals_px, left_out, names);
+        gated.reset();
       }
     };
     select();
-    if (!selection && left_out.empty() && options.find_outliers && !search) {
+    if (!gated && left_out.empty() && options.find_outliers && !search) {
       run_search();
       if (!left_out.empty()) select();
     }
-    if (selection && method == "lo-ransac") {
+    if (gated && method == "lo-ransac") {
       // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at
       // the noise the inliers show, and select once more if it changed.
-      FitResult all = selection->fit;
-      all.residuals_px =
-          internal::ResidualsAgainst(all.camera, points, pixels, options.fit.pixel_origin);
-      const std::vector<int> reread = internal::OutliersAgainst(all, left_out, noise, options);
+      const std::vector<int> reread =
+          internal::OutliersAgainst(gated->residuals_px, gated->check, noise, options);
       if (reread != left_out && 2 * (points.size() - reread.size()) > points.size() / 2) {
         const std::vector<int> before = left_out;
-        std::optional<internal::Selection> kept = std::move(selection);
+        std::optional<Gated> kept = std::move(gated);
         left_out = reread;
         select();
-        if (!selection) {
+        if (!gated) {
           left_out = before;
-          selection = std::move(kept);
+          gated = std::move(kept);
         }
       }
     }
-    if (!selection) {
-      MirrorDiagnosis(points, pixels, size, options, noise);
-      if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
-      std::string text = problem.empty() ? "the points do not fit one camera (" + screen + ")"
-                                         : problem;
-      if (!options.find_outliers) {
-        throw SceneError(SceneError::Reason::kInconsistent,
-                         text + ". Check those points, or drop --keep-all to let the fit find "
-                                "and leave out the points that disagree");
-      }
-      if (search && !search->found) text += "; and " + search->why_not;
-      throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
-                                                : SceneError::Reason::kInconsistent,
-                       text + ". Check the correspondences (ids, order, mis-clicks) and refit" +
-                           (noise.given ? std::string()
-                                        : "; if your points are this noisy, give --sigma PX"));
-    }
+    if (!gated) Refuse(points, pixels, size, options, noise, refusal, problem, screen, left_out, search);
   }
   FitResult result =
-      Assess(std::move(*selection), left_out, method, points, pixels, size, options, names);
+      Assess(std::move(*gated), left_out, method, points, pixels, size, options, names);
   result.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   return result;
 }
@@ -332,12 +364,6 @@ void AutoFitOptions::Check() const {
   Require(std::isfinite(noise_tolerance) && noise_tolerance >= 1.0,
           "noise_tolerance must be >= 1, got ", noise_tolerance);
   Require(min_redundancy >= 0, "min_redundancy must be >= 0, got ", min_redundancy);
-  Require(multi_start_below_points >= 0, "multi_start_below_points must be >= 0, got ",
-          multi_start_below_points);
-  Require(std::isfinite(ambiguity_criterion_gap) && ambiguity_criterion_gap >= 0.0,
-          "ambiguity_criterion_gap must be >= 0, got ", ambiguity_criterion_gap);
-  Require(std::isfinite(ambiguity_px) && ambiguity_px > 0.0, "ambiguity_px must be positive, got ",
-          ambiguity_px);
 }
 
 FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,

@@ -83,17 +83,9 @@ struct AutoFitOptions {
   // redundant equations: at 8 points skew, k1 and k2 would otherwise absorb a mis-click.
   int min_redundancy = 3;
 
-  // Below this many points, refine the chosen model from several starts (the other models'
-  // cameras, focal lengths 0.5x and 2x); if another minimum fits about as well (criterion within
-  // ambiguity_criterion_gap) but moves a point of the scene's bounding box by more than
-  // ambiguity_px, refuse (SceneError kAmbiguous).
   // Names of the points in messages and FitResult's text (the CSV's ids); empty: "point 1",
   // "point 2", ... Its size must match the points' when given.
   std::vector<std::string> point_names;
-
-  int multi_start_below_points = 20;
-  double ambiguity_criterion_gap = 4.0;
-  double ambiguity_px = 5.0;
 
   void Check() const;  // throws std::invalid_argument naming the field
 };
@@ -104,9 +96,10 @@ struct AutoFitOptions {
 // at the corner, bound 55 px"; "left out: delta AIC +3.1 against the chosen model: not
 // supported by the data"). Throws like FitCamera when even the simplest model is refused.
 //
-// This is what `camproj fit` runs, as a pipeline: validated scene -> model selection on every
-// point -> consistency gate; if it fails, the outlier stage and the selection again on the
-// inliers -> several starts at small N (ambiguity) -> the gate on the returned camera. A result
+// This is what `camproj fit` runs, as a pipeline: a screen of every point with pose + focal +
+// principal point (gated) -> if it fails, the outlier stage -> model selection on the points
+// kept, gated (a failure with every point kept also gets the outlier stage) -> the mirror test
+// and the gate on the returned camera. A result
 // is returned only if FitResult::consistency.passed; every refusal of well-formed input is a
 // SceneError whose message says what to fix (std::invalid_argument only for bad options or
 // mismatched sizes). FitResult::rms_px etc. are recomputed from the returned camera in world

@@ -9,13 +9,7 @@
 namespace camproj {
 namespace internal {
 
-namespace {
-
-std::string Px(double value) { return PxText(value); }
-
-}  // namespace
-
-std::string PxText(double value) {
+std::string Px(double value) {
   char buffer[48];
   std::snprintf(buffer, sizeof buffer, "%.3g px", value);
   return buffer;
@@ -82,16 +76,6 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
                     " for the others' noise (" + Px(check.robust_noise_px) + ") at " + alpha;
   }
   return check;
-}
-
-std::vector<double> KeptResidualLengths(const FitResult& fit, const std::vector<int>& left_out) {
-  std::vector<double> lengths;
-  lengths.reserve(fit.residuals_px.size());
-  for (size_t i = 0; i < fit.residuals_px.size(); ++i) {
-    if (std::binary_search(left_out.begin(), left_out.end(), static_cast<int>(i))) continue;
-    lengths.push_back(fit.residuals_px[i].norm());
-  }
-  return lengths;
 }
 
 }  // namespace internal

@@ -16,7 +16,7 @@ namespace camproj {
 namespace internal {
 
 // "3.14 px": a pixel distance in messages.
-std::string PxText(double value);
+std::string Px(double value);
 
 // The noise the residuals are tested against: FitOptions::pixel_sigma when given, else
 // AutoFitOptions::prior_sigma_px.
@@ -35,9 +35,6 @@ NoiseReference NoiseReferenceOf(const AutoFitOptions& options);
 // redundant equation (2N <= p) nothing can be tested and the check passes, saying so.
 ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px, int num_params,
                                   const NoiseReference& noise, const AutoFitOptions& options);
-
-// Lengths of the residuals of the points not listed in `left_out` (sorted indices).
-std::vector<double> KeptResidualLengths(const FitResult& fit, const std::vector<int>& left_out);
 
 }  // namespace internal
 }  // namespace camproj

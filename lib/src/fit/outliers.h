@@ -26,15 +26,20 @@ struct OutlierSearch {
   std::string why_not;        // when !found: what the search saw, in words (names points)
 };
 
-// Whether every point is consistent with the simplest model that can show a mis-click: pose +
+// The screen: every point fitted with the simplest model that can show a mis-click -- pose +
 // focal + principal point where the scene determines it with min_redundancy equations to spare,
-// else pose + focal (the caller's forced or given intrinsics as they are). Run before the model
-// selection, whose richer models (skew, k1, k2 at 8 points) can absorb a mis-click. `summary`
-// receives the gate's verdict or the refusal.
-bool ScreenIsConsistent(const std::vector<Eigen::Vector3d>& points_in_world,
-                        const std::vector<Eigen::Vector2d>& observed_pixels,
-                        const ImageSize& image_size, const AutoFitOptions& options,
-                        const NoiseReference& noise, std::string* summary);
+// else pose + focal (the caller's forced or given intrinsics as they are) -- and gated. Run
+// before the model selection, whose richer models (skew, k1, k2 at 8 points) can absorb a
+// mis-click.
+struct Screen {
+  bool consistent = false;
+  std::string summary;  // the gate's verdict, or the last refusal
+};
+
+Screen ScreenPoints(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const AutoFitOptions& options,
+                    const NoiseReference& noise);
 
 // `names` name the points in messages. Never throws a SceneError: a search that finds no unique
 // subset says why in why_not.
@@ -43,10 +48,12 @@ OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points_in_world,
                            const ImageSize& image_size, const AutoFitOptions& options,
                            const NoiseReference& noise, const std::vector<std::string>& names);
 
-// The points whose residual against `fit` (all points) exceeds the gate's outlier bound for the
-// kept points' robust noise: LO-RANSAC's consensus re-read at the noise the data show.
-std::vector<int> OutliersAgainst(const FitResult& fit, const std::vector<int>& left_out,
-                                 const NoiseReference& noise, const AutoFitOptions& options);
+// The points whose residual (every point's, against one camera) exceeds the gate's outlier
+// bound for the robust noise of the points kept (`kept_check`, the gate's record over them):
+// LO-RANSAC's consensus re-read at the noise the data show.
+std::vector<int> OutliersAgainst(const std::vector<Eigen::Vector2d>& residuals_px,
+                                 const ConsistencyCheck& kept_check, const NoiseReference& noise,
+                                 const AutoFitOptions& options);
 
 }  // namespace internal
 }  // namespace camproj

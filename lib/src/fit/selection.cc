@@ -216,7 +216,6 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
                                  std::hypot(0.5 * image_size.width, 0.5 * image_size.height);
 
   std::vector<ModelCandidate> tried;
-  std::vector<Camera> cameras;  // of every fitted trial, for Selection::others
   auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
     ModelCandidate c;
     c.name = name;
@@ -227,7 +226,6 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       c.sum_squares_px2 = e.sum_squares;
       c.rms_px = e.fit->rms_px;
       c.criterion = criterion_of(e);
-      cameras.push_back(e.fit->camera);
     }
     c.verdict = verdict;
     tried.push_back(c);
@@ -269,10 +267,13 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     std::string why_left_out[kNumGroups];
   };
   auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
-                        const std::vector<int>& groups) {
+                        const std::vector<int>& groups, const Evaluation* evaluated_base) {
     Ladder ladder;
     ladder.final_options = base_options;
-    ladder.final = Evaluate(points, pixels, image_size, base_options);
+    // The base fitted before the noise was known has the same camera and residuals (the noise
+    // only scales its sigmas, which the ladder does not read for the base).
+    ladder.final = evaluated_base != nullptr ? *evaluated_base
+                                             : Evaluate(points, pixels, image_size, base_options);
     ladder.final_index = record(ladder.final, base_name,
                                 ladder.final.fit ? "simplest model"
                                                  : "not determined: " + ladder.final.refusal);
@@ -343,7 +344,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // skew); the family whose final model has the lower criterion wins.
   const std::string base_name =
       base.projection == Projection::kOrthographic ? "orthographic" : "pose+focal";
-  Ladder chosen = run_ladder(base, base_name, candidates);
+  Ladder chosen = run_ladder(base, base_name, candidates, &base_fit);
   bool orthographic_chosen = base.projection == Projection::kOrthographic;
   if (orthographic_allowed) {
     FitOptions ortho_options = base;
@@ -361,7 +362,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
                        : std::numeric_limits<double>::infinity();
     Ladder ortho;
     if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
-      ortho = run_ladder(ortho_options, "orthographic", ortho_groups);
+      ortho = run_ladder(ortho_options, "orthographic", ortho_groups, nullptr);
     } else {
       ModelCandidate c;
       c.name = "orthographic";  // with the forced groups, as its ladder would name it
@@ -434,7 +435,6 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       if (p.name == kFixedNames[g] && !chosen.why_left_out[g].empty()) p.why = chosen.why_left_out[g];
     }
   }
-  selection.others = std::move(cameras);
   selection.fit.candidates = std::move(tried);
   selection.fit.criterion = criterion_name;
   selection.fit.selection_sigma_px = sigma;

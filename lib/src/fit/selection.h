@@ -18,7 +18,6 @@ struct Selection {
   // ::selection_sigma_px and every left-out group's reason in ::fixed_parameters).
   FitResult fit;
   FitOptions options;             // the chosen model (pixel_sigma: the noise its sigmas use)
-  std::vector<Camera> others;     // the other fitted candidates' cameras (starts to try)
   double sigma_px = 0.0;          // the noise the criterion used
 };
 
