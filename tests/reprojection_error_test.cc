@@ -1,6 +1,6 @@
-// White-box test of the fitter's analytic Jacobian (lib/src/reprojection_error.h) against
+// White-box test of the fitter's analytic Jacobian (lib/src/fit/reprojection_error.h) against
 // Ceres' automatic differentiation of the templated functor the library's model is written in.
-#include "reprojection_error.h"
+#include "fit/reprojection_error.h"
 
 #include <random>
 

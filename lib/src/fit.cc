@@ -15,11 +15,11 @@
 #include <Eigen/Dense>
 
 #include "check.h"
-#include "closed_form.h"
-#include "fit_common.h"
+#include "fit/closed_form.h"
+#include "fit/common.h"
+#include "fit/orthographic_fit.h"
+#include "fit/reprojection_error.h"
 #include "fit/statistics.h"
-#include "orthographic_fit.h"
-#include "reprojection_error.h"
 
 namespace camproj {
 

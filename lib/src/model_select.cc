@@ -11,11 +11,11 @@
 #include <string>
 
 #include "check.h"
+#include "fit/common.h"
 #include "fit/gate.h"
 #include "fit/outliers.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
-#include "fit_common.h"
 
 namespace camproj {
 

@@ -1,4 +1,4 @@
-#include "orthographic_fit.h"
+#include "fit/orthographic_fit.h"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 
 #include "check.h"
-#include "fit_common.h"
+#include "fit/common.h"
 
 namespace camproj {
 namespace internal {

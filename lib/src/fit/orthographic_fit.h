@@ -1,7 +1,7 @@
 // The orthographic camera fit (private; FitCamera dispatches to it for
 // FitOptions::projection == kOrthographic).
-#ifndef CAMPROJ_SRC_ORTHOGRAPHIC_FIT_H_
-#define CAMPROJ_SRC_ORTHOGRAPHIC_FIT_H_
+#ifndef CAMPROJ_SRC_FIT_ORTHOGRAPHIC_FIT_H_
+#define CAMPROJ_SRC_FIT_ORTHOGRAPHIC_FIT_H_
 
 #include <vector>
 
@@ -23,4 +23,4 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
 }  // namespace internal
 }  // namespace camproj
 
-#endif  // CAMPROJ_SRC_ORTHOGRAPHIC_FIT_H_
+#endif  // CAMPROJ_SRC_FIT_ORTHOGRAPHIC_FIT_H_

@@ -1,6 +1,6 @@
 // The fitter's reprojection residual (private): templated for Ceres' Jets, and analytic.
-#ifndef CAMPROJ_SRC_REPROJECTION_ERROR_H_
-#define CAMPROJ_SRC_REPROJECTION_ERROR_H_
+#ifndef CAMPROJ_SRC_FIT_REPROJECTION_ERROR_H_
+#define CAMPROJ_SRC_FIT_REPROJECTION_ERROR_H_
 
 #include <vector>
 
@@ -164,4 +164,4 @@ class PointReprojectionCost : public ceres::SizedCostFunction<2, 4, 3, kFitIntri
 }  // namespace internal
 }  // namespace camproj
 
-#endif  // CAMPROJ_SRC_REPROJECTION_ERROR_H_
+#endif  // CAMPROJ_SRC_FIT_REPROJECTION_ERROR_H_

@@ -1,7 +1,7 @@
 // Closed-form starts for the fitter (private). All work in the normalized world frame of
 // fit.cc: points centred on their centroid and scaled to unit RMS distance.
-#ifndef CAMPROJ_SRC_CLOSED_FORM_H_
-#define CAMPROJ_SRC_CLOSED_FORM_H_
+#ifndef CAMPROJ_SRC_FIT_CLOSED_FORM_H_
+#define CAMPROJ_SRC_FIT_CLOSED_FORM_H_
 
 #include <vector>
 
@@ -63,4 +63,4 @@ bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
 }  // namespace internal
 }  // namespace camproj
 
-#endif  // CAMPROJ_SRC_CLOSED_FORM_H_
+#endif  // CAMPROJ_SRC_FIT_CLOSED_FORM_H_

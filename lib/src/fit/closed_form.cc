@@ -1,4 +1,4 @@
-#include "closed_form.h"
+#include "fit/closed_form.h"
 
 #include <algorithm>
 #include <cmath>
