@@ -1,7 +1,9 @@
-// Pieces both fitters (fit.cc, orthographic_fit.cc) and the model selection share (private).
+// Pieces both fitters (fit.cc with its stages in fit/, and fit/orthographic_fit.cc) and the
+// model selection share (private).
 #ifndef CAMPROJ_SRC_FIT_COMMON_H_
 #define CAMPROJ_SRC_FIT_COMMON_H_
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -16,6 +18,14 @@
 
 namespace camproj {
 namespace internal {
+
+// The perspective fitter's clock: FitResult::time_ms and the trace's elapsed times count from
+// FitCamera's start.
+using Clock = std::chrono::steady_clock;
+
+inline double MicrosecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
 
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest
 // eigenvalue is the reciprocal condition the fitters refuse on (kDegenerate), and its inverse

@@ -1,0 +1,393 @@
+#include "fit/least_squares.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+// The least-squares problem Levenberg-Marquardt solves, on the chart u = [omega (3), center (3),
+// free intrinsic slots] with R = exp(omega) R_start, fixed for the whole solve. At omega != 0,
+// dtheta = J_l(omega) domega, J_l the left Jacobian of SO(3).
+class ChartProblem {
+ public:
+  ChartProblem(const std::vector<Eigen::Vector3d>& points,
+               const std::vector<Eigen::Vector2d>& pixels, const Eigen::Matrix3d& start_rotation,
+               const Model& model)
+      : points_(points), pixels_(pixels), start_rotation_(start_rotation), model_(model),
+        columns_(model) {}
+
+  int NumPoints() const { return static_cast<int>(points_.size()); }
+
+  ParamVector Pack(const Eigen::Vector3d& center) const {
+    ParamVector u(6 + model_.NumFree());
+    u.head<3>().setZero();
+    u.segment<3>(3) = center;
+    int next = 6;
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) u(next++) = model_.value[slot];
+    }
+    return u;
+  }
+
+  void Unpack(const ParamVector& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
+              Model* model) const {
+    *model = model_;
+    Unpack(u, rotation, center, &model->value);
+  }
+
+  // The normal equations at u on the chart; `local` receives them before the change of variables
+  // (what ComputeNormalEquations would rebuild at the same camera, for the polish).
+  bool Linearize(const ParamVector& u, NormalEquations* chart, NormalEquations* local) const {
+    Eigen::Matrix3d rotation;
+    Eigen::Vector3d center;
+    IntrinsicValues intrinsics;
+    Unpack(u, &rotation, &center, &intrinsics);
+    if (!LocalNormalEquations(points_, pixels_, rotation, center, intrinsics, columns_, local)) {
+      return false;
+    }
+    *chart = *local;
+    ToChart(LeftJacobian(u), rotation, chart);
+    return true;
+  }
+
+ private:
+  // Unpack without copying the model's descriptions (strings): for every pass over the points.
+  void Unpack(const ParamVector& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
+              IntrinsicValues* intrinsics) const {
+    *rotation = Rotation(u) * start_rotation_;
+    *center = u.segment<3>(3);
+    *intrinsics = model_.value;
+    int next = 6;
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) (*intrinsics)[slot] = u(next++);
+    }
+  }
+
+  static Eigen::Matrix3d Rotation(const ParamVector& omega) {
+    const Eigen::Vector3d w = omega.head<3>();
+    const double angle = w.norm();
+    return angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                       : Eigen::Matrix3d::Identity();
+  }
+
+  static Eigen::Matrix3d Skew(const Eigen::Vector3d& e) {
+    Eigen::Matrix3d m;
+    m << 0.0, -e.z(), e.y(), e.z(), 0.0, -e.x(), -e.y(), e.x(), 0.0;
+    return m;
+  }
+
+  // J_l(w) = I + (1 - cos t)/t^2 [w]x + (t - sin t)/t^3 [w]x^2, t = |w| (series near 0).
+  static Eigen::Matrix3d LeftJacobian(const ParamVector& omega) {
+    const Eigen::Vector3d w = omega.head<3>();
+    const double t2 = w.squaredNorm();
+    const Eigen::Matrix3d k = Skew(w);
+    double a, b;
+    if (t2 < 1e-8) {
+      a = 0.5 - t2 / 24.0;
+      b = 1.0 / 6.0 - t2 / 120.0;
+    } else {
+      const double t = std::sqrt(t2);
+      a = (1.0 - std::cos(t)) / t2;
+      b = (t - std::sin(t)) / (t2 * t);
+    }
+    return Eigen::Matrix3d::Identity() + a * k + b * k * k;
+  }
+
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& pixels_;
+  Eigen::Matrix3d start_rotation_;
+  Model model_;
+  JacobianColumns columns_;
+};
+
+// Why Levenberg-Marquardt stopped; the texts are Ceres' (TinySolver's statuses).
+enum class LmStatus {
+  kGradientTooSmall,
+  kRelativeStepTooSmall,
+  kCostTooSmall,
+  kMaxIterations,
+  kCostChangeTooSmall,
+};
+
+std::string LmStatusText(LmStatus status) {
+  switch (status) {
+    case LmStatus::kGradientTooSmall: return "CONVERGENCE: gradient below tolerance";
+    case LmStatus::kRelativeStepTooSmall: return "CONVERGENCE: relative step below tolerance";
+    case LmStatus::kCostTooSmall: return "CONVERGENCE: cost below threshold";
+    case LmStatus::kCostChangeTooSmall: return "CONVERGENCE: cost change below tolerance";
+    case LmStatus::kMaxIterations: break;
+  }
+  return "NO_CONVERGENCE: maximum number of iterations reached";
+}
+
+struct LmSummary {
+  int iterations = 0;
+  LmStatus status = LmStatus::kMaxIterations;
+  // The local normal equations at the returned u (the polish's first), if they were formed there.
+  bool local_at_solution = false;
+  NormalEquations local;
+};
+
+// Levenberg-Marquardt exactly as ceres::TinySolver (Ceres 2.1) runs it -- Jacobi scaling fixed at
+// the start, the same damping and trust-region updates, stopping rules and defaults -- but on
+// normal equations accumulated point by point: TinySolver forms the 2N x p Jacobian and multiplies
+// it out (J^T J by GEMM), which cost more than the residuals themselves. Two further differences:
+// a candidate step is evaluated with its normal equations, not its cost alone, because nearly
+// every candidate is accepted and then needs them (TinySolver evaluates it twice); and a candidate
+// that puts a point behind the camera is rejected and the damping raised (TinySolver ignores the
+// failed evaluation and compares stale residuals). Each accepted iterate is recorded in the trace.
+LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptions& options,
+                                     Clock::time_point start_time, ParamVector* u,
+                                     std::vector<TraceEntry>* trace) {
+  // TinySolver's defaults where FitOptions has no say.
+  const double cost_threshold = std::numeric_limits<double>::epsilon();
+  constexpr double kInitialTrustRegionRadius = 1e4;
+  constexpr double kMinDiagonal = 1e-6;
+  constexpr double kMaxDiagonal = 1e32;
+  const int max_iterations = std::max(1, options.max_iterations + 1);
+
+  LmSummary summary;
+  // The Jacobi-scaled system at u: J_s = J D with D = diag(1 / (1 + |column of J|)) at the start,
+  // jtj = J_s^T J_s, gradient = -J_s^T r; cost = r^T r / 2.
+  ParamVector scaling;
+  ParamMatrix jtj;
+  ParamVector gradient;
+  double cost = 0.0;
+  double function_tolerance = 0.0;
+  // Makes (chart, local), the normal equations at `at`, the current iterate.
+  auto accept = [&](const ParamVector& at, const NormalEquations& chart,
+                    const NormalEquations& local) {
+    *u = at;
+    if (scaling.size() == 0) {
+      scaling = (1.0 + chart.jtj.diagonal().array().sqrt()).inverse().matrix();
+      // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
+      function_tolerance = options.function_tolerance * std::max(chart.cost, 1e-300);
+    }
+    jtj = scaling.asDiagonal() * chart.jtj * scaling.asDiagonal();
+    gradient = -(scaling.asDiagonal() * chart.jtr);
+    cost = chart.cost / 2.0;
+    summary.local = local;
+    summary.local_at_solution = true;
+    trace->push_back({static_cast<int>(trace->size()), MicrosecondsSince(start_time),
+                      std::sqrt(chart.cost / problem.NumPoints())});
+  };
+
+  NormalEquations chart;
+  NormalEquations local;
+  summary.iterations = 0;
+  // A point behind the start: nothing to minimize (the polish refuses it too).
+  if (!problem.Linearize(*u, &chart, &local)) return summary;
+  accept(*u, chart, local);
+  if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
+    summary.status = LmStatus::kGradientTooSmall;
+    return summary;
+  }
+  if (cost < cost_threshold) {
+    summary.status = LmStatus::kCostTooSmall;
+    return summary;
+  }
+  double damping = 1.0 / kInitialTrustRegionRadius;
+  double damping_factor = 2.0;
+  Eigen::LDLT<ParamMatrix> ldlt;
+  for (summary.iterations = 1; summary.iterations < max_iterations; ++summary.iterations) {
+    ParamMatrix regularized = jtj;
+    for (int i = 0; i < regularized.rows(); ++i) {
+      const double lm_diagonal =
+          std::sqrt(damping * std::min(std::max(jtj(i, i), kMinDiagonal), kMaxDiagonal));
+      regularized(i, i) += lm_diagonal * lm_diagonal;
+    }
+    ldlt.compute(regularized);
+    const ParamVector lm_step = ldlt.solve(gradient);
+    const ParamVector step = scaling.asDiagonal() * lm_step;
+    // Adding parameter_tolerance to |u| keeps the test meaningful near u = 0.
+    if (step.norm() < options.parameter_tolerance * (u->norm() + options.parameter_tolerance)) {
+      summary.status = LmStatus::kRelativeStepTooSmall;
+      break;
+    }
+    const ParamVector candidate = *u + step;
+    if (!problem.Linearize(candidate, &chart, &local)) {
+      // A point behind the camera: no cost to compare. Shrink the trust region as for a
+      // rejected step.
+      damping *= damping_factor;
+      damping_factor *= 2.0;
+      continue;
+    }
+    const double cost_change = 2.0 * cost - chart.cost;
+    const double model_cost_change = lm_step.dot(2.0 * gradient - jtj * lm_step);
+    // rho: the actual reduction over the reduction the linear model predicts.
+    const double rho = cost_change / model_cost_change;
+    if (rho > 0.0) {
+      accept(candidate, chart, local);
+      if (std::abs(cost_change) < function_tolerance) {
+        summary.status = LmStatus::kCostChangeTooSmall;
+        break;
+      }
+      if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
+        summary.status = LmStatus::kGradientTooSmall;
+        break;
+      }
+      if (cost < cost_threshold) {
+        summary.status = LmStatus::kCostTooSmall;
+        break;
+      }
+      const double t = 2.0 * rho - 1.0;
+      damping *= std::max(1.0 / 3.0, 1.0 - t * t * t);
+      damping_factor = 2.0;
+    } else {
+      if (std::abs(cost_change) < function_tolerance) {
+        summary.status = LmStatus::kCostChangeTooSmall;
+        break;
+      }
+      damping *= damping_factor;
+      damping_factor *= 2.0;
+    }
+  }
+  return summary;
+}
+
+// Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
+// (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
+// flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
+// holds the normal equations (ComputeNormalEquations) at the start on entry; on return, those
+// at the final parameters, or one settling step (under kSettledStepPx) before them. Returns
+// whether it settled: a step under kSettledStepPx, or steps that stopped shrinking at the
+// rounding floor (under kRoundingFloorPx). It does not settle where LM stopped short of the
+// minimum on a curved valley: there Gauss-Newton steps overshoot and raise the cost.
+bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
+                       const std::vector<Eigen::Vector2d>& pixels,
+                       Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
+                       NormalEquations* normal) {
+  constexpr int kMaxSteps = 6;
+  // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
+  // their pixel-noise sigma per px of noise).
+  constexpr double kSettledStepPx = 1e-9;
+  // Converged when the last Gauss-Newton step, taken or not, changes the residual vector by at
+  // most kConvergedFraction of the residuals' own sigma (|J delta| in px against
+  // sqrt(cost / (2N - p))), or by rounding alone (kRoundingStepPx): the parameters are then
+  // within 1e-3 of their standard deviation of the minimum in the joint (Mahalanobis) sense.
+  // Where LM stops short on a curved valley, most of the residual is still removable and the
+  // step is about sqrt(2N - p) sigmas.
+  constexpr double kConvergedFraction = 1e-3;
+  constexpr double kRoundingStepPx = 1e-8;
+  double last_step_px = std::numeric_limits<double>::infinity();
+  const double dof = std::max(1.0, 2.0 * points.size() - normal->jtj.rows());
+  auto converged = [&] {
+    const double noise_px = std::sqrt(normal->cost / dof);
+    return last_step_px <= std::max(kConvergedFraction * noise_px, kRoundingStepPx);
+  };
+  const JacobianColumns columns(*model);
+  double previous_step_px = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+    const ParamVector delta =
+        -(scale.asDiagonal() * (scale.asDiagonal() * normal->jtj * scale.asDiagonal())
+                                   .ldlt()
+                                   .solve(scale.asDiagonal() * normal->jtr));
+    if (!delta.allFinite()) return false;
+    Eigen::Matrix3d new_rotation = *rotation;
+    const double angle = delta.head<3>().norm();
+    if (angle > 0.0) {
+      new_rotation =
+          Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix() * *rotation;
+    }
+    const Eigen::Vector3d new_center = *center + delta.segment<3>(3);
+    IntrinsicValues new_intrinsics = model->value;
+    int next = 6;
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (model->free[slot]) new_intrinsics[slot] += delta(next++);
+    }
+    // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
+    const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
+    // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
+    last_step_px = std::sqrt(std::max(0.0, delta.dot(normal->jtj * delta)));
+    if (step_px <= kSettledStepPx) {
+      // The last step: take it without another pass over the points. The normal equations stay
+      // those one step back, where J^T J differs by ~1e-12 relative (the step's size against
+      // the parameters' scales) and the cost by far less than its own rounding.
+      *rotation = new_rotation;
+      *center = new_center;
+      model->value = new_intrinsics;
+      return true;
+    }
+    NormalEquations new_normal;
+    if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_intrinsics, columns,
+                                &new_normal)) {
+      return false;  // a point behind the camera
+    }
+    // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
+    // ~1e-16), so accept rounding-level increases and stop on the step's size instead.
+    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) {
+      return converged();
+    }
+    *rotation = new_rotation;
+    *center = new_center;
+    model->value = new_intrinsics;
+    *normal = std::move(new_normal);
+    // A step that stops shrinking has reached the rounding floor.
+    if (step_px > 0.5 * previous_step_px) return converged();
+    previous_step_px = step_px;
+  }
+  return converged();
+}
+
+}  // namespace
+
+LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<Eigen::Vector2d>& pixels,
+                                       const Eigen::Matrix3d& start_rotation,
+                                       const Eigen::Vector3d& start_center, const Model& model,
+                                       const FitOptions& options, Clock::time_point start_time) {
+  LeastSquaresOutcome outcome;
+  outcome.rotation = start_rotation;
+  outcome.center = start_center;
+  outcome.model = model;
+  // LM's stopping rules can fire while it crawls along a curved, nearly flat valley (a nearly
+  // planar scene with the full model: 100 iterations left it 6 sigma from the optimum; at
+  // thickness 1e-4 it needs 700). The polish then does not converge, and LM resumes from where it
+  // stopped; after kMaxRounds the caller refuses rather than return a camera short of the minimum.
+  constexpr int kMaxRounds = 20;
+  bool have_normal = false;
+  for (int round = 0; round < kMaxRounds && !outcome.converged; ++round) {
+    const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
+    ParamVector u = problem.Pack(outcome.center);
+    const LmSummary summary =
+        MinimizeLevenbergMarquardt(problem, options, start_time, &u, &outcome.trace);
+    problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
+    outcome.iterations += summary.iterations;
+    outcome.termination = LmStatusText(summary.status);
+    // LM's last normal equations, when they are at its answer, are the polish's first (the local
+    // ones at the same camera: only the change of variables differs).
+    have_normal = summary.local_at_solution;
+    if (have_normal) {
+      outcome.normal = summary.local;
+      ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
+    } else {
+      have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
+                                           outcome.model, &outcome.normal);
+    }
+    if (!have_normal) break;
+    outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
+                                          &outcome.model, &outcome.normal);
+  }
+  if (!have_normal) outcome.normal = NormalEquations();
+  // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned
+  // half a turn: neither is an answer (the caller refuses).
+  outcome.ok = outcome.normal.jtj.size() > 0 && std::isfinite(outcome.normal.cost) &&
+               outcome.model.value[0] > 0.0 && outcome.model.value[1] > 0.0;
+  // The polish's result closes the trace, so it ends at the reported RMS.
+  outcome.trace.push_back({static_cast<int>(outcome.trace.size()), MicrosecondsSince(start_time),
+                           std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
+  return outcome;
+}
+
+}  // namespace internal
+}  // namespace camproj

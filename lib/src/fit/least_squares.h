@@ -1,0 +1,53 @@
+// Least squares on a fixed set of points (private): Levenberg-Marquardt on normal equations
+// accumulated point by point (ceres::TinySolver's algorithm, normal_equations.h), then undamped
+// Gauss-Newton steps to the minimum, from a start camera and Model in the scene's normalized
+// world. Takes the points, their pixels (kCenter), the start and the stopping rules; returns the
+// camera with its normal equations and whether it reached the minimum, leaving the refusal to the
+// caller. The refinement stage (refine.h) runs it, and so does the start (start.h) to decide a
+// DLT that reads the world as mirrored.
+#ifndef CAMPROJ_SRC_FIT_LEAST_SQUARES_H_
+#define CAMPROJ_SRC_FIT_LEAST_SQUARES_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/fit.h"
+#include "fit/common.h"
+#include "fit/model.h"
+#include "fit/normal_equations.h"
+
+namespace camproj {
+namespace internal {
+
+// One least-squares refinement: Levenberg-Marquardt, then the Gauss-Newton polish, with its trace.
+struct LeastSquaresOutcome {
+  bool ok = false;
+  bool converged = false;  // the polish settled (see PolishGaussNewton in least_squares.cc)
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d center;
+  Model model;
+  NormalEquations normal;
+  int iterations = 0;
+  std::string termination;
+  std::vector<TraceEntry> trace;
+};
+
+// Refines the camera point_in_cam = start_rotation * (point - start_center) with `model`'s free
+// slots over `points` (normalized world) and `pixels` (kCenter), under options' stopping rules
+// (max_iterations, function, gradient and parameter tolerances). Where the polish does not
+// settle, LM resumes from where it stopped, up to 20 rounds. `ok` is false when a point ends
+// behind the camera or the focal length or aspect is not positive (normal is then empty if the
+// normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one settling
+// step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
+LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<Eigen::Vector2d>& pixels,
+                                       const Eigen::Matrix3d& start_rotation,
+                                       const Eigen::Vector3d& start_center, const Model& model,
+                                       const FitOptions& options, Clock::time_point start_time);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_LEAST_SQUARES_H_

@@ -1,0 +1,96 @@
+#include "fit/model.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+#include "check.h"
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+// Names of the fit-intrinsics slots, in reprojection_error.h's layout.
+const std::array<const char*, kFitIntrinsicsSize> kSlotNames = {
+    "focal", "aspect", "cx", "cy", "skew", "k1", "k2"};
+
+// A value as internal::Concat writes it (printf's %.17g in the "C" locale), without a stream:
+// MakeModel describes every fixed slot on every fit, and a stream costs ~5000 instructions.
+std::string ValueText(double value) {
+  char text[32];
+  const char* end =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::general, 17).ptr;
+  return std::string(static_cast<const char*>(text), end);
+}
+
+}  // namespace
+
+Model MakeModel(const FitOptions& options, const ImageSize& size) {
+  Model model;
+  if (options.known_intrinsics) {
+    const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
+                                            PixelOrigin::kCenter);
+    model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2};
+    model.fixed.push_back({"intrinsics", Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx,
+                                                ", cy ", k.cy, ", skew ", k.skew, ", k1 ", k.k1,
+                                                ", k2 ", k.k2),
+                           "given: pose only"});
+    return model;
+  }
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value,
+                 const char* default_why) {
+    model.free[slot] = mode.IsFree();
+    model.value[slot] = mode.kind == ParameterMode::Kind::kFixed ? fixed_value : default_value;
+    if (mode.IsFree() || slot == 3) return;  // cy is described with cx
+    std::string name = kSlotNames[slot];
+    std::string value = ValueText(model.value[slot]);
+    if (slot == 2) {
+      name = "principal point";
+      value += ", " + ValueText(mode.kind == ParameterMode::Kind::kFixed
+                                    ? options.principal_point.value2 + shift
+                                    : 0.5 * (size.height - 1.0));
+    }
+    model.fixed.push_back({name, value,
+                           mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
+  };
+  // A free focal length's start comes from the closed form; 1 is a placeholder.
+  set(0, options.focal, 1.0, options.focal.value, "");
+  set(1, options.aspect, 1.0, options.aspect.value, "default: square pixels");
+  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift,
+      "default: image centre");
+  set(3, options.principal_point, 0.5 * (size.height - 1.0),
+      options.principal_point.value2 + shift, "");
+  set(4, options.skew, 0.0, options.skew.value, "default: no skew");
+  set(5, options.k1, 0.0, options.k1.value, "default: no distortion");
+  set(6, options.k2, 0.0, options.k2.value, "default: no distortion");
+  return model;
+}
+
+Model ProjectOntoModel(const Model& model, const Intrinsics& k0) {
+  Model projected = model;
+  if (projected.free[0]) {
+    projected.value[0] = projected.free[1] ? k0.fx : std::sqrt(k0.fx * k0.fy / projected.value[1]);
+  }
+  if (projected.free[1]) projected.value[1] = k0.fy / projected.value[0];
+  if (projected.free[2]) projected.value[2] = k0.cx;
+  if (projected.free[3]) projected.value[3] = k0.cy;
+  if (projected.free[4]) projected.value[4] = k0.skew;
+  return projected;
+}
+
+std::string FreeLinearNames(const Model& model) {
+  std::string names;
+  const char* labels[] = {"focal", "aspect", "principal point", "", "skew"};
+  for (int slot = 0; slot < 5; ++slot) {
+    if (slot == 3 || !model.free[slot]) continue;
+    if (!names.empty()) names += ", ";
+    names += labels[slot];
+  }
+  return names;
+}
+
+}  // namespace internal
+}  // namespace camproj
