@@ -2,17 +2,14 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
-#include <chrono>
 #include <cmath>
-#include <limits>
-#include <memory>
-#include <numeric>
 #include <optional>
-#include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <ceres/ceres.h>
-#include <Eigen/Dense>
+#include <Eigen/Core>
 
 #include "check.h"
 #include "fit/closed_form.h"
@@ -21,23 +18,23 @@
 #include "fit/model.h"
 #include "fit/normal_equations.h"
 #include "fit/orthographic_fit.h"
+#include "fit/ransac.h"
 #include "fit/reprojection_error.h"
+#include "fit/scene.h"
+#include "fit/start.h"
 #include "fit/statistics.h"
 
 namespace camproj {
 
 using internal::Clock;
 using internal::ComputeNormalEquations;
-using internal::FreeLinearNames;
 using internal::LeastSquaresOutcome;
-using internal::MakeModel;
 using internal::MicrosecondsSince;
 using internal::Model;
 using internal::NormalEquations;
 using internal::ParamMatrix;
 using internal::ParamVector;
 using internal::PixelOfCamPoint;
-using internal::ProjectOntoModel;
 using internal::RefineLeastSquares;
 using internal::Require;
 
@@ -45,135 +42,12 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegPerRad = 180.0 / kPi;
-
-// The point cloud's singular values s1 >= s2 >= s3 (RMS extents along its principal axes):
-// collinear below s2 / s1 = kCollinearRatio, exactly planar (for counting what a plane
-// determines) below s3 / s2 = kPlanarRatio, started from a homography below kPlanarStartRatio
-// (the DLT's 3D information is then too weak to trust under noise). Thickness is measured
-// against s2, not s1: a narrow field of view makes a deep but slender cloud, not a plane.
-constexpr double kCollinearRatio = 1e-9;
-constexpr double kPlanarRatio = 1e-9;
-constexpr double kPlanarStartRatio = 1e-2;
 // Below this reciprocal condition number of the Jacobi-scaled normal equations the parameters
 // are not determined by the points (double precision leaves ~1e-16; 1e-12 keeps a margin).
 constexpr double kSingularRcond = 1e-12;
-// Re-solve the DLT's pose by PnP when projecting its K onto the model moves an intrinsic by more
-// than this fraction of the focal length (below it, LM corrects the pose in an iteration or two).
-constexpr double kPoseResolveChange = 0.02;
 // Below this many points a DLT start with the principal point free gets a second start from
 // the image centre (the DLT's principal point is poorly determined there).
 constexpr int kSecondStartBelowPoints = 20;
-// A DLT that sees the world mirrored is believed when the mirrored reading's refined cost is
-// below the best proper camera's (both have the same parameters). Below kMirroredAmbiguousRatio
-// times the mirrored cost the refusal says the data cannot tell (add points) rather than that
-// the frame is left-handed. Measured on 400 six-point projector scenes: a right-handed world
-// flips the DLT in 4 / 12 scenes at sigma 2 / 5 px, with cost ratios (proper / mirrored)
-// 0.03-70; 1 / 7 of them are refused as "cannot tell" (all 4 / 13 were refused as left-handed
-// before); a left-handed world's ratios are above 10 in all but a few percent of scenes.
-constexpr double kMirroredAmbiguousRatio = 100.0;
-
-// Indices of the points within `threshold` px of the camera (rotation, center, model).
-std::vector<int> InliersOf(const std::vector<Eigen::Vector3d>& points,
-                           const std::vector<Eigen::Vector2d>& pixels,
-                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                           const Model& model, double threshold) {
-  std::vector<int> inliers;
-  const double threshold2 = threshold * threshold;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const std::optional<Eigen::Vector2d> pixel =
-        PixelOfCamPoint(model, rotation * (points[i] - center));
-    if (pixel && (*pixel - pixels[i]).squaredNorm() <= threshold2) {
-      inliers.push_back(static_cast<int>(i));
-    }
-  }
-  return inliers;
-}
-
-// A closed-form camera from the points `subset`: SQPnP for known intrinsics, the constrained
-// homography for a plane, the DLT otherwise. False where the subset is degenerate.
-bool SolveSubset(const std::vector<Eigen::Vector3d>& points,
-                 const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& subset,
-                 const Model& model, bool known, bool planar, const Eigen::Matrix3d& plane_basis,
-                 internal::StartCamera* camera, Model* fitted_model) {
-  std::vector<Eigen::Vector3d> x;
-  std::vector<Eigen::Vector2d> u;
-  for (const int i : subset) {
-    x.push_back(points[i]);
-    u.push_back(pixels[i]);
-  }
-  const Intrinsics guess = model.ToIntrinsics();
-  bool ok = false;
-  if (known) {
-    ok = internal::PnpStart(x, u, guess, camera);
-  } else if (planar) {
-    ok = internal::HomographyStart(x, u, plane_basis, guess, model.free[0], model.free[1], camera);
-  } else {
-    try {
-      *camera = internal::DltStart(x, u);
-      ok = !camera->mirrored;  // a mirrored sample is no camera of this world
-    } catch (const SceneError&) {
-      ok = false;
-    }
-  }
-  if (!ok || !camera->rotation.allFinite() || !camera->center.allFinite()) return false;
-  *fitted_model = known ? model : ProjectOntoModel(model, camera->intrinsics);
-  return std::all_of(fitted_model->value.begin(), fitted_model->value.end(),
-                     [](double v) { return std::isfinite(v); }) &&
-         fitted_model->value[0] > 0.0 && fitted_model->value[1] > 0.0;
-}
-
-// RANSAC on minimal closed-form samples (4 points for known intrinsics or a plane, 6 for the
-// DLT), with a local optimization (the closed form on all inliers) whenever the best consensus
-// grows, and the adaptive stopping rule k = log(1 - confidence) / log(1 - w^s).
-std::vector<int> RansacInliers(const std::vector<Eigen::Vector3d>& points,
-                               const std::vector<Eigen::Vector2d>& pixels, const Model& model,
-                               bool known, bool planar, const Eigen::Matrix3d& plane_basis,
-                               const FitOptions& options) {
-  const int n = static_cast<int>(points.size());
-  const int sample_size = known || planar ? 4 : 6;
-  std::mt19937_64 rng(options.ransac_seed);
-  std::vector<int> best;
-  long iterations_needed = options.ransac_max_iterations;
-  std::vector<int> sample(sample_size);
-  for (long iteration = 0; iteration < iterations_needed; ++iteration) {
-    for (int j = 0; j < sample_size; ++j) {
-      int candidate = 0;
-      do {
-        candidate = static_cast<int>(rng() % static_cast<uint64_t>(n));
-      } while (std::find(sample.begin(), sample.begin() + j, candidate) != sample.begin() + j);
-      sample[j] = candidate;
-    }
-    internal::StartCamera camera;
-    Model fitted;
-    if (!SolveSubset(points, pixels, sample, model, known, planar, plane_basis, &camera, &fitted)) {
-      continue;
-    }
-    std::vector<int> inliers =
-        InliersOf(points, pixels, camera.rotation, camera.center, fitted, options.ransac_threshold_px);
-    if (inliers.size() <= best.size()) continue;
-    // Local optimization: the closed form on the consensus, repeated while it grows.
-    for (int round = 0; round < 3 && static_cast<int>(inliers.size()) > sample_size; ++round) {
-      internal::StartCamera refit;
-      Model refit_model;
-      if (!SolveSubset(points, pixels, inliers, model, known, planar, plane_basis, &refit,
-                       &refit_model)) {
-        break;
-      }
-      std::vector<int> grown = InliersOf(points, pixels, refit.rotation, refit.center,
-                                         refit_model, options.ransac_threshold_px);
-      if (grown.size() <= inliers.size()) break;
-      inliers.swap(grown);
-    }
-    best.swap(inliers);
-    const double w = static_cast<double>(best.size()) / n;
-    const double all_inliers = std::pow(w, sample_size);
-    if (all_inliers >= 1.0) break;
-    const double needed = std::log(1.0 - options.ransac_confidence) / std::log(1.0 - all_inliers);
-    iterations_needed = std::min<long>(options.ransac_max_iterations,
-                                       static_cast<long>(std::ceil(needed)));
-  }
-  return best;
-}
 
 // Records (iteration, elapsed, RMS) after every Ceres iteration.
 class TraceCallback : public ceres::IterationCallback {
@@ -211,64 +85,6 @@ class TraceCallback : public ceres::IterationCallback {
   Clock::time_point start_;
   std::vector<TraceEntry>* trace_;
 };
-
-// The DLT saw the points as through a mirror. A truly left-handed world fits no proper camera;
-// a right-handed one whose DLT flipped under noise (few points, nearly degenerate) fits one at
-// least about as well as the mirrored reading. Refine both (the same parameters) and refuse
-// unless a proper camera fits better; return the best proper camera found. The DLT's K belongs
-// to the mirrored reading, so the proper side also starts from the image centre (focal sweep).
-internal::StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& points,
-                                          const std::vector<Eigen::Vector2d>& pixels,
-                                          const internal::StartCamera& dlt,
-                                          const Model& start_model, const ImageSize& image_size,
-                                          const FitOptions& options,
-                                          Clock::time_point start_time) {
-  const Model dlt_model = ProjectOntoModel(start_model, dlt.intrinsics);
-  double proper_cost = std::numeric_limits<double>::infinity();
-  internal::StartCamera proper;
-  auto refine = [&](const std::vector<Eigen::Vector3d>& x, const internal::StartCamera& s,
-                    const Model& model, internal::StartCamera* best) {
-    const LeastSquaresOutcome outcome =
-        RefineLeastSquares(x, pixels, s.rotation, s.center, model, options, start_time);
-    if (!outcome.ok) return std::numeric_limits<double>::infinity();
-    if (best != nullptr && outcome.normal.cost < proper_cost) {
-      proper_cost = outcome.normal.cost;
-      best->rotation = outcome.rotation;
-      best->center = outcome.center;
-      best->intrinsics = outcome.model.ToIntrinsics();
-    }
-    return outcome.normal.cost;
-  };
-  std::vector<Eigen::Vector3d> flipped(points);
-  for (auto& x : flipped) x.z() = -x.z();
-  const double mirrored_cost = refine(flipped, dlt, dlt_model, nullptr);
-  internal::StartCamera start;
-  if (internal::PnpStart(points, pixels, dlt_model.ToIntrinsics(), &start)) {
-    refine(points, start, dlt_model, &proper);
-  }
-  if (start_model.free[0] &&
-      internal::FocalSweepStart(points, pixels, start_model.ToIntrinsics(), start_model.value[1],
-                                image_size.width, &start)) {
-    refine(points, start, ProjectOntoModel(start_model, start.intrinsics), &proper);
-  }
-  if (!(proper_cost <= mirrored_cost)) {
-    const std::string fits = internal::Concat(
-        "the best right-handed camera's RMS is ", std::sqrt(proper_cost / points.size()),
-        " px, the mirrored one's ", std::sqrt(mirrored_cost / points.size()), " px");
-    if (proper_cost <= kMirroredAmbiguousRatio * mirrored_cost) {
-      throw SceneError(SceneError::Reason::kAmbiguous,
-                       "the points fit a camera seen through a mirror (a left-handed world frame) "
-                       "somewhat better than a proper one (" + fits + "): too few points or too "
-                       "much noise to tell. Add points spread in depth, or check the world "
-                       "frame's handedness");
-    }
-    throw SceneError(SceneError::Reason::kMirroredWorld,
-                     "the points are seen as through a mirror: the world frame is left-handed (" +
-                         fits + "). Flip one world axis (e.g. negate Z of every point, and again "
-                         "in anything you render) and refit");
-  }
-  return proper;
-}
 
 }  // namespace
 
@@ -323,88 +139,24 @@ void FitOptions::Check() const {
           "strong correlation threshold must be in (0, 1], got ", strong_correlation);
 }
 
+// The stages in lib/src/fit/, in the order the data flows: scene -> (RANSAC: the consensus, fitted
+// without RANSAC) -> closed-form start -> refinement -> assessment.
 FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options) {
-  const Clock::time_point start_time = Clock::now();
+  const internal::Clock::time_point start_time = internal::Clock::now();
   options.Check();
   image_size.Check();
-  Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
-          " 3D points but ", observed_pixels.size(), " pixels");
-  const int n = static_cast<int>(points_in_world.size());
-  for (int i = 0; i < n; ++i) {
-    if (!points_in_world[i].allFinite() || !observed_pixels[i].allFinite()) {
-      throw SceneError(SceneError::Reason::kNonFiniteInput,
-                       internal::Concat("point ", i, " is not finite (X = ",
-                                        points_in_world[i].transpose(), ", pixel = ",
-                                        observed_pixels[i].transpose(), "): remove or fix it"));
-    }
-  }
+  internal::CheckCorrespondences(points_in_world, observed_pixels);
   if (options.projection == Projection::kOrthographic) {
     return internal::FitOrthographic(points_in_world, observed_pixels, image_size, options);
   }
-  const Model start_model = MakeModel(options, image_size);
-  const int num_params = 6 + start_model.NumFree();
-  // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
-  if (2 * n < num_params || n < 4) {
-    throw SceneError(SceneError::Reason::kTooFewPoints,
-                     internal::Concat(n, " points give ", 2 * n, " equations, but the model has ",
-                                      num_params, " unknowns (pose 6 + ", start_model.NumFree(),
-                                      " free intrinsics) and a unique pose needs 4 points: add "
-                                      "points (at least ", std::max(4, (num_params + 1) / 2),
-                                      ") or fix intrinsics"));
-  }
-
-  // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
-  // offsets reach the numerics.
-  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
-  std::vector<Eigen::Vector2d> pixels(observed_pixels);
-  for (auto& p : pixels) p += Eigen::Vector2d(shift, shift);
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& x : points_in_world) centroid += x;
-  centroid /= n;
-  Eigen::MatrixXd centred(n, 3);
-  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
-  const double scale = std::sqrt(centred.squaredNorm() / n);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
-  const Eigen::Vector3d extents = shape.singularValues();
-  if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
-    throw SceneError(SceneError::Reason::kCollinearPoints,
-                     "the 3D points are collinear (or coincide): a line does not determine a "
-                     "camera's rotation about it; add points off the line");
-  }
-  std::vector<Eigen::Vector3d> points(n);
-  for (int i = 0; i < n; ++i) points[i] = centred.row(i).transpose() / scale;
-  const bool planar = extents(2) <= kPlanarRatio * extents(1);
-  const bool planar_start = extents(2) <= kPlanarStartRatio * extents(1);
-
-  const bool known = options.known_intrinsics.has_value();
-  if (planar && start_model.NumFreeLinear() > 2) {
-    throw SceneError(
-        SceneError::Reason::kPlanarUnderdetermined,
-        "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
-        "principal point (2) and skew, but " + FreeLinearNames(start_model) +
-            " are free. Fix the principal point (at the image centre by default) and the "
-            "aspect (square pixels), or add points off the plane");
-  }
-
-  const Eigen::Matrix3d plane_basis =
-      shape.matrixV().determinant() > 0
-          ? Eigen::Matrix3d(shape.matrixV())
-          : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal());
+  const internal::Scene scene =
+      internal::ValidateScene(points_in_world, observed_pixels, image_size, options);
 
   if (options.ransac) {
     // Find the consensus, fit it without RANSAC, then report every point against that camera.
-    const std::vector<int> inliers = RansacInliers(points, pixels, start_model, known,
-                                                   planar_start, plane_basis, options);
-    const int minimum = std::max(known || planar_start ? 4 : 6, (num_params + 1) / 2);
-    if (static_cast<int>(inliers.size()) < minimum) {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       internal::Concat("RANSAC found no camera that ", minimum,
-                                        " or more points agree on within ",
-                                        options.ransac_threshold_px,
-                                        " px: check the correspondences or raise the threshold"));
-    }
+    const std::vector<int> inliers = internal::RansacConsensus(scene, options);
     FitOptions inner = options;
     inner.ransac = false;
     std::vector<Eigen::Vector3d> inlier_points;
@@ -416,114 +168,36 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     FitResult result = FitCamera(inlier_points, inlier_pixels, image_size, inner);
     result.residuals_px = internal::ResidualsAgainst(result.camera, points_in_world,
                                                      observed_pixels, options.pixel_origin);
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < scene.NumPoints(); ++i) {
       if (!(result.residuals_px[i].norm() <= options.ransac_threshold_px)) {
         result.outliers.push_back(i);
       }
     }
     result.start_method = "ransac+" + result.start_method;
-    result.time_ms = MicrosecondsSince(start_time) / 1000.0;
+    result.time_ms = internal::MicrosecondsSince(start_time) / 1000.0;
     return result;
   }
 
-  // Closed-form start.
-  internal::StartCamera start;
-  std::string start_method;
-  Model model = start_model;
-  const Intrinsics guess = start_model.ToIntrinsics();
-  if (known) {
-    if (!internal::PnpStart(points, pixels, guess, &start)) {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       "SQPnP found no pose for the known intrinsics: check the correspondences "
-                       "and the intrinsics' pixel convention");
-    }
-    start_method = "pnp";
-  } else if (planar_start) {
-    if (n < 4) {
-      throw SceneError(SceneError::Reason::kTooFewPoints,
-                       internal::Concat("a planar scene needs at least 4 points, got ", n));
-    }
-    Intrinsics plane_guess = guess;
-    const bool focal_free = start_model.free[0];
-    if (internal::HomographyStart(points, pixels, plane_basis, plane_guess, focal_free,
-                                  start_model.free[1], &start)) {
-      start_method = "homography";
-    } else if (focal_free && internal::FocalSweepStart(points, pixels, guess, start_model.value[1],
-                                                       image_size.width, &start)) {
-      start_method = "pnp-focal-sweep";
-    } else {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       "the plane's homography does not determine the focal length (the plane "
-                       "is seen nearly head-on, or the points are mismatched): fix the focal "
-                       "length (--focal / --fovy) or add points off the plane");
-    }
-  } else if (n >= 6) {
-    start = internal::DltStart(points, pixels);
-    start_method = "dlt";
-    if (start.mirrored) {
-      start = ProperStartOrRefuse(points, pixels, start, start_model, image_size, options,
-                                  start_time);
-    }
-  } else if (start_model.NumFreeLinear() <= 1 && !start_model.free[1] && !start_model.free[2] &&
-             !start_model.free[4]) {
-    const bool ok = start_model.free[0]
-                        ? internal::FocalSweepStart(points, pixels, guess, start_model.value[1],
-                                                    image_size.width, &start)
-                        : internal::PnpStart(points, pixels, guess, &start);
-    if (!ok) {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       "no camera found for these few points: check the correspondences");
-    }
-    start_method = start_model.free[0] ? "pnp-focal-sweep" : "pnp";
-  } else {
-    throw SceneError(SceneError::Reason::kTooFewPoints,
-                     internal::Concat("the linear start (DLT) needs 6 non-coplanar points to "
-                                      "free ", FreeLinearNames(start_model), "; got ", n,
-                                      ": add points or fix all but the focal length"));
-  }
-
-  // Start values of the free slots from the closed form, fixed ones as given. DLT's K is
-  // projected onto the model (square pixels: geometric mean of fx, fy).
-  const Intrinsics& k0 = start.intrinsics;
-  if (!known) model = ProjectOntoModel(start_model, k0);
-  const Intrinsics projected = model.ToIntrinsics();
-  const double projection_change =
-      std::max({std::abs(projected.fx - k0.fx), std::abs(projected.fy - k0.fy),
-                std::abs(projected.cx - k0.cx), std::abs(projected.cy - k0.cy),
-                std::abs(projected.skew - k0.skew)}) / k0.fx;
-  if (start_method == "dlt" && projection_change > kPoseResolveChange) {
-    // Holding intrinsics moved K away from the DLT's: its pose belongs to another K. Re-solve
-    // the pose for this one and keep whichever reprojects better.
-    internal::StartCamera pnp;
-    if (internal::PnpStart(points, pixels, projected, &pnp)) {
-      auto sum_squares = [&](const internal::StartCamera& camera) {
-        double sum = 0.0;
-        for (int i = 0; i < n; ++i) {
-          const std::optional<Eigen::Vector2d> pixel =
-              PixelOfCamPoint(model, camera.rotation * (points[i] - camera.center));
-          if (!pixel) return std::numeric_limits<double>::infinity();
-          sum += (*pixel - pixels[i]).squaredNorm();
-        }
-        return sum;
-      };
-      if (sum_squares(pnp) < sum_squares(start)) {
-        start.rotation = pnp.rotation;
-        start.center = pnp.center;
-      }
-    }
-  }
+  const internal::Start start = internal::ClosedFormStart(scene, options, start_time);
+  const std::vector<Eigen::Vector3d>& points = scene.points;
+  const std::vector<Eigen::Vector2d>& pixels = scene.pixels;
+  const int n = scene.NumPoints();
+  const Model& start_model = scene.model;
+  const int num_params = 6 + start_model.NumFree();
+  const std::string& start_method = start.method;
+  Model model = start.model;
 
   // Refinement: without a loss, Levenberg-Marquardt on normal equations accumulated point by
   // point (MinimizeLevenbergMarquardt: TinySolver's algorithm) on the chart R = exp(omega) R_start,
   // then the Gauss-Newton polish; with a robust loss, a ceres::Problem with one block per point,
   // the rotation on EigenQuaternionManifold and fixed intrinsics held by a SubsetManifold.
   FitResult result;
-  Eigen::Matrix3d rotation_matrix = start.rotation;
-  Eigen::Vector3d center = start.center;
+  Eigen::Matrix3d rotation_matrix = start.camera.rotation;
+  Eigen::Vector3d center = start.camera.center;
   NormalEquations normal_equations;
   if (options.refine && options.loss == LossType::kNone) {
-    LeastSquaresOutcome best = RefineLeastSquares(points, pixels, start.rotation, start.center,
-                                                  model, options, start_time);
+    LeastSquaresOutcome best = RefineLeastSquares(points, pixels, start.camera.rotation,
+                                                  start.camera.center, model, options, start_time);
     if (start_method == "dlt" && n < kSecondStartBelowPoints && start_model.free[2]) {
       // With few points the DLT's principal point can be far off and LM stop in a local minimum
       // (seen at 6 points: cy 96 px for 540). Refine also from the image centre (SQPnP pose for
@@ -570,7 +244,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
     result.termination = best.termination;
     result.trace = std::move(best.trace);
   } else if (options.refine) {
-    Eigen::Quaterniond rotation(start.rotation);
+    Eigen::Quaterniond rotation(start.camera.rotation);
     rotation.normalize();
     std::array<double, internal::kFitIntrinsicsSize> intrinsics = model.value;
     ceres::Problem problem;
@@ -636,10 +310,10 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
 
   // Residuals and depths.
   Camera& camera = result.camera;
-  camera.image_size = image_size;
+  camera.image_size = scene.image_size;
   camera.intrinsics = model.ToIntrinsics();
   camera.intrinsics.skew += 0.0;  // no -0 in files
-  camera.cam_from_world = CamFromWorldFromCenter(rotation_matrix, centroid + scale * center);
+  camera.cam_from_world = CamFromWorldFromCenter(rotation_matrix, scene.centroid + scene.scale * center);
   std::vector<double> depths(n);
   std::vector<double> norms(n);
   double sum_squares = 0.0;
@@ -647,7 +321,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.residuals_px.resize(n);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d p = rotation_matrix * (points[i] - center);
-    depths[i] = p.z() * scale;
+    depths[i] = p.z() * scene.scale;
     const std::optional<Eigen::Vector2d> pixel = PixelOfCamPoint(model, p);
     if (!pixel) {
       ++behind;
@@ -667,7 +341,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   result.median_px = internal::Median(norms);
   result.max_px = *std::max_element(norms.begin(), norms.end());
   result.start_method = start_method;
-  result.planar = planar;
+  result.planar = scene.planar;
 
   // Depth range and views.
   const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
@@ -726,7 +400,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
         result.pixel_sigma * result.pixel_sigma * scaled_normal.Inverse();
     ParamMatrix l = ParamMatrix::Identity(num_params, num_params);
     for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
-    for (int j = 3; j < 6; ++j) l(j, j) = scale;
+    for (int j = 3; j < 6; ++j) l(j, j) = scene.scale;
     if (model.free[1]) {
       // fy = aspect * f: d fy = aspect d f + f d aspect.
       const int aspect_index = 6 + (model.free[0] ? 1 : 0);

@@ -100,7 +100,7 @@ bool SqPnp(const std::vector<Eigen::Vector3d>& points, const std::vector<cv::Poi
 
 Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
                                           const std::vector<Eigen::Vector2d>& pixels) {
-  // The 3D points arrive centred and unit-scaled (fit.cc); the pixels are normalized here. With
+  // The 3D points arrive centred and unit-scaled (scene.h); the pixels are normalized here. With
   // both normalized, the 12 x 12 normal matrix A^T A is well conditioned enough that its
   // smallest eigenvector is the DLT solution to ~1e-12 at O(N) cost (A's SVD is O(N) too but
   // with a far larger constant).
@@ -194,7 +194,7 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
   if (m.determinant() < 0.0) {
     // K R (X - C) = K (R F) (F X - F C) with F = diag(1, 1, -1): a proper rotation R F in the
     // world with z negated. Under noise a nearly degenerate scene can flip the sign, so the
-    // fitter decides (fit.cc) whether the world is really mirrored.
+    // fitter decides (start.cc) whether the world is really mirrored.
     const Eigen::Vector3d flip(1.0, 1.0, -1.0);
     start.rotation = r * flip.asDiagonal();
     start.center = flip.asDiagonal() * start.center;

@@ -1,5 +1,5 @@
-// Closed-form starts for the fitter (private). All work in the normalized world frame of
-// fit.cc: points centred on their centroid and scaled to unit RMS distance.
+// Closed-form starts for the fitter (private). All work in the normalized world frame of the
+// validated scene (scene.h): points centred on their centroid and scaled to unit RMS distance.
 #ifndef CAMPROJ_SRC_FIT_CLOSED_FORM_H_
 #define CAMPROJ_SRC_FIT_CLOSED_FORM_H_
 

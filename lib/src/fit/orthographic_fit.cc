@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 // Below this ratio of the point cloud's smallest to middle RMS extent the points are taken as
-// coplanar (as in fit.cc): a plane seen orthographically has two mirror-image poses.
+// coplanar (as in scene.cc): a plane seen orthographically has two mirror-image poses.
 constexpr double kOrthoPlanarRatio = 1e-6;
 constexpr double kOrthoCollinearRatio = 1e-9;
 // Reciprocal condition of the Jacobi-scaled normal equations below which parameters are not

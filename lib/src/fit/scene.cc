@@ -1,0 +1,103 @@
+#include "fit/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "camproj/conventions.h"
+#include "check.h"
+
+namespace camproj {
+namespace internal {
+
+namespace {
+
+// The point cloud's singular values s1 >= s2 >= s3 (RMS extents along its principal axes):
+// collinear below s2 / s1 = kCollinearRatio, exactly planar (for counting what a plane
+// determines) below s3 / s2 = kPlanarRatio, started from a homography below kPlanarStartRatio
+// (the DLT's 3D information is then too weak to trust under noise). Thickness is measured
+// against s2, not s1: a narrow field of view makes a deep but slender cloud, not a plane.
+constexpr double kCollinearRatio = 1e-9;
+constexpr double kPlanarRatio = 1e-9;
+constexpr double kPlanarStartRatio = 1e-2;
+
+}  // namespace
+
+void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
+                          const std::vector<Eigen::Vector2d>& observed_pixels) {
+  Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
+          " 3D points but ", observed_pixels.size(), " pixels");
+  const int n = static_cast<int>(points_in_world.size());
+  for (int i = 0; i < n; ++i) {
+    if (!points_in_world[i].allFinite() || !observed_pixels[i].allFinite()) {
+      throw SceneError(SceneError::Reason::kNonFiniteInput,
+                       Concat("point ", i, " is not finite (X = ", points_in_world[i].transpose(),
+                              ", pixel = ", observed_pixels[i].transpose(),
+                              "): remove or fix it"));
+    }
+  }
+}
+
+Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options) {
+  Scene scene;
+  scene.image_size = image_size;
+  scene.model = MakeModel(options, image_size);
+  const int n = static_cast<int>(points_in_world.size());
+  const int num_params = 6 + scene.model.NumFree();
+  // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
+  if (2 * n < num_params || n < 4) {
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     Concat(n, " points give ", 2 * n, " equations, but the model has ",
+                            num_params, " unknowns (pose 6 + ", scene.model.NumFree(),
+                            " free intrinsics) and a unique pose needs 4 points: add points (at "
+                            "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
+  }
+
+  // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
+  // offsets reach the numerics.
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  scene.pixels = observed_pixels;
+  for (auto& p : scene.pixels) p += Eigen::Vector2d(shift, shift);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& x : points_in_world) centroid += x;
+  centroid /= n;
+  Eigen::MatrixXd centred(n, 3);
+  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
+  const double scale = std::sqrt(centred.squaredNorm() / n);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
+  const Eigen::Vector3d extents = shape.singularValues();
+  if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
+    throw SceneError(SceneError::Reason::kCollinearPoints,
+                     "the 3D points are collinear (or coincide): a line does not determine a "
+                     "camera's rotation about it; add points off the line");
+  }
+  scene.centroid = centroid;
+  scene.scale = scale;
+  scene.points.resize(n);
+  for (int i = 0; i < n; ++i) scene.points[i] = centred.row(i).transpose() / scale;
+  scene.planar = extents(2) <= kPlanarRatio * extents(1);
+  scene.planar_start = extents(2) <= kPlanarStartRatio * extents(1);
+
+  if (scene.planar && scene.model.NumFreeLinear() > 2) {
+    throw SceneError(
+        SceneError::Reason::kPlanarUnderdetermined,
+        "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
+        "principal point (2) and skew, but " + FreeLinearNames(scene.model) +
+            " are free. Fix the principal point (at the image centre by default) and the "
+            "aspect (square pixels), or add points off the plane");
+  }
+
+  scene.plane_basis =
+      shape.matrixV().determinant() > 0
+          ? Eigen::Matrix3d(shape.matrixV())
+          : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal());
+  return scene;
+}
+
+}  // namespace internal
+}  // namespace camproj

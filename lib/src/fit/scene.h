@@ -1,0 +1,60 @@
+// The validated scene, the fitter's first stage (private). CheckCorrespondences refuses
+// mismatched sizes and non-finite values; ValidateScene builds the intrinsic Model the options
+// ask for, puts the pixels in kCenter and the world in a normalized frame -- centred on the
+// points' centroid and scaled to unit RMS distance, so that neither units nor offsets reach the
+// numerics -- and reads the cloud's shape from its singular values. It refuses too few points for
+// the model, collinear points, and a plane that cannot determine the free intrinsics. Every later
+// stage (RANSAC, start, refinement, assessment) works on the Scene it returns.
+#ifndef CAMPROJ_SRC_FIT_SCENE_H_
+#define CAMPROJ_SRC_FIT_SCENE_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/fit.h"
+#include "camproj/intrinsics.h"
+#include "fit/model.h"
+
+namespace camproj {
+namespace internal {
+
+struct Scene {
+  // The points in the normalized world (point_in_world = centroid + scale * point) and their
+  // observed pixels in kCenter, in input order.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double scale = 1.0;
+  // From the centred cloud's singular values s1 >= s2 >= s3 (see scene.cc): exactly planar, for
+  // counting what the scene determines (FitResult::planar), and planar enough that the start
+  // trusts a homography rather than the DLT.
+  bool planar = false;
+  bool planar_start = false;
+  // The cloud's principal axes as a rotation: for a plane, its in-plane axes, then its normal.
+  Eigen::Matrix3d plane_basis = Eigen::Matrix3d::Identity();
+  // The model the options ask for, before the closed-form start sets its free values.
+  Model model;
+  ImageSize image_size;
+
+  int NumPoints() const { return static_cast<int>(points.size()); }
+};
+
+// Throws std::invalid_argument when the numbers of points and pixels differ, and SceneError
+// kNonFiniteInput naming the first point with a non-finite coordinate (X or pixel).
+void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
+                          const std::vector<Eigen::Vector2d>& observed_pixels);
+
+// The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
+// `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when
+// 2N < 6 + free intrinsics or N < 4, kCollinearPoints when the points are collinear or coincide,
+// kPlanarUnderdetermined when coplanar points must determine more than 2 of focal, aspect,
+// principal point and skew.
+Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_SCENE_H_

@@ -1,0 +1,41 @@
+// The closed-form start, the fitter's second stage (private): a camera to refine from, in the
+// scene's normalized world. SQPnP for known intrinsics; for a plane, the constrained homography
+// (a focal sweep when it does not determine the focal length); for 6 or more points, the DLT --
+// when it reads the world as mirrored, both readings are refined and the fit refused unless a
+// proper camera fits better -- and for 4 or 5, a focal sweep or SQPnP with at most the focal
+// length free. The closed form's K is projected onto the scene's model and, for the DLT, the pose
+// re-solved when that moved K. Takes the validated scene; returns the start camera, the method
+// that found it and the model with its start values.
+#ifndef CAMPROJ_SRC_FIT_START_H_
+#define CAMPROJ_SRC_FIT_START_H_
+
+#include <string>
+
+#include "camproj/fit.h"
+#include "fit/closed_form.h"
+#include "fit/common.h"
+#include "fit/model.h"
+#include "fit/scene.h"
+
+namespace camproj {
+namespace internal {
+
+struct Start {
+  // rotation and center: the start pose; intrinsics: the closed form's K, before projection.
+  StartCamera camera;
+  std::string method;  // FitResult::start_method: "pnp", "homography", "pnp-focal-sweep", "dlt"
+  Model model;         // the scene's model, its free slots from the closed form
+};
+
+// Throws SceneError where no start exists: kDegenerate (no pose, focal length or camera found),
+// kTooFewPoints (fewer than 6 points with more than the focal length free), kMirroredWorld (a
+// mirrored reading fits much better than any proper camera), kAmbiguous (it fits better, but
+// not by enough to tell), kPointsBehindCamera (the DLT finds no camera with every point in
+// front). start_time: for the traces of the refinements that decide a mirrored DLT (discarded).
+Start ClosedFormStart(const Scene& scene, const FitOptions& options,
+                      Clock::time_point start_time);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_START_H_
