@@ -419,7 +419,7 @@ double PerturbationNorm(const Scenario& s) {
 }
 
 // The condition number of the scaled Jacobian at the true camera, in the fitter's
-// parameterization (fit.h, fit.cc): pose in the world centred on the points and scaled to unit
+// parameterization (fit.h, src/fit/): pose in the world centred on the points and scaled to unit
 // RMS distance, rotation R = exp(omega) R_true, then the free slots focal, aspect (fy / fx), cx,
 // cy, skew; columns scaled to unit norm. Central differences in long double (step 1e-6 relative:
 // truncation ~1e-12, rounding ~1e-19 / 1e-6 = 1e-13 relative), independent of the fitter's code.

@@ -26,7 +26,7 @@ constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 constexpr double kOrthoPlanarRatio = 1e-6;
 constexpr double kOrthoCollinearRatio = 1e-9;
 // Reciprocal condition of the Jacobi-scaled normal equations below which parameters are not
-// determined (as in fit.cc).
+// determined (as in assess.cc).
 constexpr double kOrthoSingularRcond = 1e-12;
 
 // Intrinsics block: [scale, aspect, skew] in px per normalized world unit; fx = scale,
