@@ -83,11 +83,12 @@ TEST(FitAutoTest, MirroredWorldsAreRefused) {
 }
 
 // One click among 8 moved by 60-200 px: never a camera that kept it (every seed), and it is
-// named as the only point left out in at least 88 % of 200 seeds; otherwise the scene is refused.
-// Measured 187 / 200 (93.5 %); the target is 95 %, not reached yet: the other 13 are
-// refused (more than one leave-one-out subset passes the gate at 7 points, or none does). The
-// bound is 3 binomial sigmas below the measured rate: 0.935 - 3 * sqrt(0.935 * 0.065 / 200)
-// = 0.883.
+// named as the only point left out -- by an answer, or by a refusal whose 7 other points do not
+// determine the camera (the message says to fix that point first) -- in at least 89 % of 200
+// seeds; otherwise the scene is refused. Measured 189 / 200 (94.5 %), just short of the issue's
+// 95 %: the other 11 are refused by the outlier stage (several leave-one-out subsets pass the
+// gate at 7 points, or none does). The bound is 3 binomial sigmas below the measured rate:
+// 0.945 - 3 * sqrt(0.945 * 0.055 / 200) = 0.897.
 TEST(FitAutoTest, OneMisclickAmongEightIsNamed) {
   std::mt19937_64 rng(8);
   int named = 0;
@@ -108,11 +109,16 @@ TEST(FitAutoTest, OneMisclickAmongEightIsNamed) {
       EXPECT_GT(fit.left_out[0].rms_with_px, 5.0 * fit.rms_px);
       ++named;
     } catch (const SceneError& e) {
-      // A refusal is allowed; a wrong answer is not.
+      // A refusal is allowed; a wrong answer is not. It names the mis-click if it says to fix it.
+      const std::string what = e.what();
+      if (what.find("Fix or drop point " + std::to_string(bad + 1) + " (") != std::string::npos &&
+          what.find("puts it), ") == std::string::npos) {
+        ++named;
+      }
     }
   }
   RecordProperty("named", named);
-  EXPECT_GE(named, 0.88 * kSeeds);
+  EXPECT_GE(named, 0.89 * kSeeds);
 }
 
 // Six points and one mis-click: leaving any point out leaves too few to check the rest, so the

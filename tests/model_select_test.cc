@@ -44,7 +44,15 @@ FitResult Auto(const SynthScene& scene, const AutoFitOptions& options = {}) {
 TEST(ModelSelectTest, PerspectiveCameraKeepsTheSimplestModel) {
   int simplest = 0;
   for (uint64_t seed = 1; seed <= 200; ++seed) {
-    const FitResult fit = Auto(Projector(seed, 30, 1.0, 0.0));
+    FitResult fit;
+    try {
+      fit = Auto(Projector(seed, 30, 1.0, 0.0));
+    } catch (const SceneError& e) {
+      // The one refusal allowed: a chance extra parameter (BIC keeps one with probability
+      // P(chi2_1 > ln 60) = 4 %) whose camera the simpler model puts elsewhere.
+      EXPECT_EQ(e.reason(), SceneError::Reason::kAmbiguous) << "seed " << seed << ": " << e.what();
+      continue;
+    }
     if (fit.model == "pose+focal") ++simplest;
     // Every candidate not in the model is listed with its reason.
     for (const char* name : {"aspect", "principal point", "skew", "k1", "k2"}) {

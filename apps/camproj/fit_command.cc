@@ -49,6 +49,7 @@ struct FitArgs {
   bool keep_all = false;
   double ransac_px = 0.0;
   double sigma = 0.0;
+  double max_uncertainty = 0.0;  // 0: AutoFitOptions' default
   double z_near = 0.0;
   double z_far = 0.0;
   int max_iterations = 100;
@@ -211,6 +212,7 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
     options.focal = ParameterMode::Free();
   }
   request.auto_options.find_outliers = !args.keep_all;
+  if (args.max_uncertainty > 0.0) request.auto_options.max_uncertainty_px = args.max_uncertainty;
   try {
     if (request.automatic) {
       request.auto_options.Check();
@@ -337,14 +339,17 @@ Command AddFitCommand(CLI::App& root) {
       "POINTS.csv has a header naming X,Y,Z,u,v (any order, extra columns ignored, optional id,\n"
       "'#' comments). The model is chosen automatically (--model auto): from pose + focal length\n"
       "(square pixels, centred principal point) it frees principal point, aspect, skew, k1, k2\n"
-      "one at a time while the criterion (BIC by default) says the data support them and the\n"
-      "scene determines them, and lists what it left out and why. --model focal+principal-point\n"
+      "one at a time while the criterion (BIC by default) says the data support them, and\n"
+      "lists what it left out and why. --model focal+principal-point\n"
       "(any '+' list) forces a model; --free forces a parameter in, --fix (or a value: --focal,\n"
       "--aspect, ...) keeps it out.\n"
       "Points that disagree with the rest (mis-clicks) are found and left out, each named with\n"
       "its distance from the camera's prediction (--keep-all keeps every point). A camera is\n"
       "written only if its residuals are consistent with the pixel noise (--sigma; default: a\n"
       "1 px prior for clicked points); otherwise exit 3 names the worst points and what to do.\n"
+      "It must also be determined to --max-uncertainty px (1 sigma, default 5) over the box the\n"
+      "points span, and no model that fits about as well may put the scene further away than\n"
+      "that; otherwise exit 3 says where points are missing.\n"
       "Prints a summary (parameters +- 1 sigma, residuals, worst points, time); -o writes the\n"
       "camera file (docs/camera-file.md) atomically.\n\n"
       "Examples:\n"
@@ -399,6 +404,9 @@ Command AddFitCommand(CLI::App& root) {
                   "pixel noise per axis (px): the model selection, the consistency check and the "
                   "uncertainties use it; default: a 1 px prior for clicked points, combined with "
                   "the residuals")->check(CLI::PositiveNumber);
+  app->add_option("--max-uncertainty", args->max_uncertainty,
+                  "refuse a camera the points determine more loosely than this (px, 1 sigma over "
+                  "the box the points span; default 5)")->check(CLI::PositiveNumber);
   app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")
       ->check(CLI::PositiveNumber);
   app->add_option("--far", args->z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);

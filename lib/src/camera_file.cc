@@ -262,6 +262,7 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
       if (!points.empty()) record["outlier_points"] = points;
     }
     if (!fit->consistency.empty()) record["consistency"] = fit->consistency;
+    if (!fit->determination.empty()) record["determination"] = fit->determination;
     record["start"] = fit->start;
     record["model"] = fit->model;
     if (!fit->candidates.empty()) {

@@ -54,6 +54,7 @@ FitRecord FitRecordOf(const FitResult& fit) {
     record.outlier_points.push_back({p.index, p.residual_px, p.rms_with_px});
   }
   if (fit.consistency.checked) record.consistency = fit.consistency.summary;
+  if (fit.determination.checked) record.determination = fit.determination.summary;
   record.pixel_sigma = fit.pixel_sigma;
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
@@ -177,6 +178,7 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
     out << "\n";
   }
   if (fit.consistency.checked) out << "check: " << fit.consistency.summary << "\n";
+  if (fit.determination.checked) out << "determination: " << fit.determination.summary << "\n";
   out << "worst points:";
   for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {
     const int index = order[i];

@@ -4,6 +4,7 @@
 #include "camproj/model_select.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 
 #include "check.h"
 #include "fit/common.h"
+#include "fit/determination.h"
 #include "fit/gate.h"
 #include "fit/outliers.h"
 #include "fit/selection.h"
@@ -135,6 +137,44 @@ void RefuseIfMirrorFitsBetter(double rms_px, const FitOptions& model,
   }
 }
 
+// "c4 (118 px from where the camera puts it), c7 (64 px ...)": the left-out points.
+std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
+                        const std::vector<int>& left_out, const std::vector<std::string>& names) {
+  std::string text;
+  for (const int i : left_out) {
+    text += (text.empty() ? "" : ", ") + names[i] + " (" + Px(residuals[i].norm()) +
+            " from where the camera puts it)";
+  }
+  return text;
+}
+
+std::string Capitalized(std::string text) {
+  if (!text.empty()) text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+  return text;
+}
+
+// The refusals of the determination check: a camera the points do not pin down to the bound
+// (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
+void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
+                          const std::string& left_out) {
+  if (check.passed) return;
+  const std::string advice =
+      (left_out.empty() ? "" : "Fix or drop " + left_out + " (left out: they disagree with the "
+                                                             "rest by far more than the noise); ") +
+      "add points where the image has none (toward that pixel) and spread in depth, or fix "
+      "the intrinsics you know (--model, or their values)";
+  if (check.max_sigma_px > check.bound_px) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the points do not determine the camera well enough: it is " +
+                         check.summary + " (--max-uncertainty). " + Capitalized(advice));
+  }
+  throw SceneError(SceneError::Reason::kAmbiguous,
+                   "the points cannot tell " + model + " from " + check.rival +
+                       ": both fit about as well, but they put the scene up to " +
+                       Px(check.rival_shift_px) + " apart (bound " + Px(check.bound_px) +
+                       ", --max-uncertainty). " + Capitalized(advice));
+}
+
 // A selection with every point's residual against its camera, recomputed in world coordinates
 // from the camera as returned (and as the camera file stores it), and the gate on the points
 // kept: computed once per selection, read by the pipeline and by the assessment.
@@ -172,6 +212,8 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                  const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                  const AutoFitOptions& options, const std::vector<std::string>& names) {
+  const DeterminationCheck determination =
+      internal::CheckDetermination(gated.selection, Kept(points, left_out), options);
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);
   result.outliers = left_out;
@@ -191,6 +233,8 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                          (noise.given ? std::string()
                                       : "; if your points are this noisy, give --sigma PX"));
   }
+  result.determination = determination;
+  RefuseIfUndetermined(determination, result.model, LeftOutText(result.residuals_px, left_out, names));
   constexpr size_t kMaxRefits = 10;  // beyond, rms_with_px is not computed (0)
   FitOptions refit = gated.selection.options;
   refit.compute_uncertainty = false;
@@ -351,8 +395,8 @@ void AutoFitOptions::Check() const {
   Require(fit.loss == LossType::kNone,
           "automatic model selection compares least-squares fits: use RANSAC for outliers, or "
           "give the model explicitly to use a robust loss");
-  Require(std::isfinite(max_corner_sigma_fraction) && max_corner_sigma_fraction > 0.0,
-          "max_corner_sigma_fraction must be positive, got ", max_corner_sigma_fraction);
+  Require(max_uncertainty_px > 0.0, "max_uncertainty_px must be positive, got ",
+          max_uncertainty_px);
   Require(exhaustive_max_points >= 0 && exhaustive_max_points <= 40,
           "exhaustive_max_points must be in [0, 40], got ", exhaustive_max_points);
   Require(std::isfinite(prior_sigma_px) && prior_sigma_px > 0.0,

@@ -210,6 +210,23 @@ struct ConsistencyCheck {
   std::string summary;         // one line in words
 };
 
+// FitCameraAuto's check that the points determine the returned camera where it is used
+// (docs/model-selection.md): the linearized 1-sigma reprojection uncertainty of the test points
+// -- the corners and face centres of the box the kept points span along their principal axes,
+// and the points, where they are in the image -- at the selection's noise, and whether a model
+// that fits about as well (BIC within kEqualFitCriterion) puts them elsewhere. A result is only
+// returned when `passed`.
+struct DeterminationCheck {
+  bool checked = false;
+  bool passed = false;
+  double max_sigma_px = 0.0;  // the largest 1-sigma uncertainty over the test points
+  Eigen::Vector2d worst_pixel = Eigen::Vector2d::Zero();  // where (kCenter)
+  double bound_px = 0.0;      // AutoFitOptions::max_uncertainty_px
+  std::string rival;          // the model that fits about as well and moves a test point most
+  double rival_shift_px = 0.0;  // by how much (0: no such model)
+  std::string summary;        // one line in words
+};
+
 struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
@@ -223,6 +240,7 @@ struct FitResult {
   std::vector<LeftOutPoint> left_out;
   std::string outlier_method;  // "", "ransac", "leave-one-out", "leave-two-out", "lo-ransac"
   ConsistencyCheck consistency;
+  DeterminationCheck determination;
   double rms_px = 0.0;     // sqrt(mean(du^2 + dv^2))
   double median_px = 0.0;  // median |residual|
   double max_px = 0.0;

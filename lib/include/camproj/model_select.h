@@ -1,11 +1,12 @@
 // Automatic model selection: fit only the intrinsics the scene determines and needs.
 //
 // Starting from pose + focal length (a gluPerspective camera: square pixels, principal point at
-// the image centre), FitCameraAuto frees one group at a time in the order principal point
-// (an off-axis frustum) -> aspect -> skew -> k1 -> k2 (k2 only after k1), each round keeping the
-// group that lowers the criterion most, and stops when none does. A group is never freed when
-// the scene does not determine it: when the fit is refused, or when 1 sigma of a freed parameter
-// moves the image corner by more than max_corner_sigma_fraction of the image half-diagonal.
+// the image centre), FitCameraAuto frees one group at a time among principal point (an off-axis
+// frustum), aspect, skew, k1 and k2 (k2 only after k1), each round keeping the group that lowers
+// the criterion most, and stops when none does, or when the next model would leave fewer than
+// min_redundancy equations to spare. Whether the chosen camera is then determined well enough is
+// the assessment's question (AutoFitOptions::max_uncertainty_px), not the ladder's: a group the
+// residuals ask for is never left out because its own sigma is large.
 // Criterion (geometric AIC, Kanatani; the 3D points are exact, so it is J / sigma^2 + 2 p):
 //   AIC = J / sigma^2 + 2 p,   BIC = J / sigma^2 + p ln(2 N),
 // J the sum of squared reprojection errors (px^2), p the number of parameters (pose 6 + free
@@ -29,6 +30,10 @@ enum class ModelCriterion { kAic, kBic };
 // rounding would otherwise count as evidence for every extra parameter.
 inline constexpr double kMinNoisePx = 1e-4;
 
+// Two models "fit about as well" when their criteria differ by at most this (a BIC difference
+// below 6 is not strong evidence for either: Kass & Raftery 1995).
+inline constexpr double kEqualFitCriterion = 6.0;
+
 struct AutoFitOptions {
   // Everything but the model: pixel origin, RANSAC, sigma, near/far, stopping rules. Its
   // intrinsics decide what the ladder may change: kDefault = a candidate (left at its default
@@ -45,9 +50,14 @@ struct AutoFitOptions {
   // BIC by default: it keeps a parameter that does not matter with probability P(chi2_1 >
   // ln 2N) (5 % at N = 20, 1 % at N = 500), AIC with P(chi2_1 > 2) = 16 % per candidate.
   ModelCriterion criterion = ModelCriterion::kBic;
-  // A freed parameter is "not determined" when 1 sigma of it moves the image corner by more than
-  // this fraction of the image half-diagonal (0.05 of 1101 px = 55 px for 1920 x 1080).
-  double max_corner_sigma_fraction = 0.05;
+  // The returned camera must be determined to this many pixels (1 sigma, linearized) over the
+  // scene: the box the kept points span and the points themselves, where they are in the image
+  // (FitResult::determination). A camera this uncertain is refused
+  // (SceneError kDegenerate, saying where points are missing); so is one that a model fitting
+  // about as well (BIC within kEqualFitCriterion) puts more than this much elsewhere
+  // (kAmbiguous). At 6-8 clicked points this is what stands between a fit that passes every
+  // residual test and a camera that is tens of pixels off across the rest of the object.
+  double max_uncertainty_px = 5.0;
   // Also consider an orthographic camera (scale, then aspect and skew): chosen when the
   // criterion prefers it to pose + focal (the perspective is not observable: a telephoto or
   // satellite-like view whose depth range is tiny against its distance), or when no perspective
@@ -92,9 +102,8 @@ struct AutoFitOptions {
 
 // Fits the simplest model the data support. The result is FitCamera's for the chosen model,
 // plus FitResult::model, ::candidates (every model tried, in order) and, in fixed_parameters,
-// every candidate left out with the reason ("left out: not determined: sigma would be 180 px
-// at the corner, bound 55 px"; "left out: delta AIC +3.1 against the chosen model: not
-// supported by the data"). Throws like FitCamera when even the simplest model is refused.
+// every candidate left out with the reason ("left out: BIC 2.15 above pose+focal's: its better
+// fit does not pay for its extra parameters"). Throws like FitCamera when even the simplest model is refused.
 //
 // This is what `camproj fit` runs, as a pipeline: a screen of every point with pose + focal +
 // principal point (gated) -> if it fails, the outlier stage -> model selection on the points

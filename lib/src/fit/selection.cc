@@ -30,20 +30,10 @@ ParameterMode& ModeOf(FitOptions& options, int group) {
   }
 }
 
-// The free parameters' names in FitResult::sigmas that belong to a group.
-std::vector<std::string> SigmaNamesOf(int group) {
-  switch (group) {
-    case kPrincipalPoint: return {"cx", "cy"};
-    case kAspect: return {"fy"};
-    case kSkew: return {"skew"};
-    case kK1: return {"k1"};
-    default: return {"k2"};
-  }
-}
-
 // One model fitted, or refused. Any failure is caught: one candidate never aborts the selection.
 struct Evaluation {
   std::optional<FitResult> fit;
+  FitOptions options;   // the model
   std::string refusal;  // the refusal's message
   SceneError::Reason reason = SceneError::Reason::kDegenerate;
   double sum_squares = 0.0;
@@ -54,6 +44,7 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                     const FitOptions& options) {
   Evaluation e;
+  e.options = options;
   e.num_params = NumParameters(options);
   try {
     e.fit = FitCamera(points, pixels, size, options);
@@ -67,22 +58,6 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
     e.reason = SceneError::Reason::kNumerical;
   }
   return e;
-}
-
-// Pixels that 1 sigma of the parameter moves the image corner by: the principal point shifts
-// every pixel; focal, fy and skew scale offsets from the centre (fx: the half-diagonal, fy and
-// skew: the half-height); k1, k2 the radial displacement k r^2 (r^4) * r at the corner.
-double CornerEffectPx(const ParameterSigma& s, const Intrinsics& k, const ImageSize& size) {
-  const double half_width = 0.5 * size.width;
-  const double half_height = 0.5 * size.height;
-  const double corner_px = std::hypot(half_width, half_height);
-  const double corner_normalized = corner_px / std::sqrt(k.fx * k.fy);
-  const double r2 = corner_normalized * corner_normalized;
-  if (s.name == "fx") return s.sigma * corner_px / k.fx;
-  if (s.name == "fy" || s.name == "skew") return s.sigma * half_height / k.fy;
-  if (s.name == "k1") return s.sigma * r2 * corner_px;
-  if (s.name == "k2") return s.sigma * r2 * r2 * corner_px;
-  return s.sigma;  // cx, cy
 }
 
 // Whether the caller's options allow an orthographic camera: nothing only a perspective camera
@@ -212,10 +187,8 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   auto criterion_or_inf = [&](const Evaluation& e) {
     return e.fit ? criterion_of(e) : std::numeric_limits<double>::infinity();
   };
-  const double corner_bound_px = options.max_corner_sigma_fraction *
-                                 std::hypot(0.5 * image_size.width, 0.5 * image_size.height);
-
   std::vector<ModelCandidate> tried;
+  std::vector<Rival> rivals;  // every fitted model
   auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
     ModelCandidate c;
     c.name = name;
@@ -226,6 +199,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       c.sum_squares_px2 = e.sum_squares;
       c.rms_px = e.fit->rms_px;
       c.criterion = criterion_of(e);
+      rivals.push_back({e.fit->model, e.options, e.fit->camera, c.criterion});
     }
     c.verdict = verdict;
     tried.push_back(c);
@@ -236,27 +210,10 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   base.pixel_sigma = sigma;
   base.compute_uncertainty = true;
 
-  // "" when 1 sigma of each named parameter moves the image corner by at most the bound, else
-  // what moves it most and by how much.
-  auto undetermined = [&](const FitResult& fit, const std::vector<std::string>& sigma_names) {
-    double worst_effect = 0.0;
-    std::string worst_name;
-    for (const ParameterSigma& s : fit.sigmas) {
-      if (std::find(sigma_names.begin(), sigma_names.end(), s.name) == sigma_names.end()) continue;
-      const double effect = CornerEffectPx(s, fit.camera.intrinsics, image_size);
-      if (!(effect <= worst_effect)) {
-        worst_effect = effect;
-        worst_name = s.name;
-      }
-    }
-    if (worst_effect <= corner_bound_px) return std::string();
-    return "1 sigma of " + worst_name + " would move the image corner by " + Fixed(worst_effect) +
-           " px (bound " + Fixed(corner_bound_px) + " px)";
-  };
-
   // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
-  // improves, the scene determines the group and the model keeps min_redundancy equations to
-  // spare. A refused base is a model of infinite criterion that any fitted trial improves on (so
+  // improves, the fit with it is not refused and the model keeps min_redundancy equations to
+  // spare (whether the chosen camera is determined well enough is the assessment's question:
+  // leaving out a group the residuals ask for only hides its uncertainty in a biased camera). A refused base is a model of infinite criterion that any fitted trial improves on (so
   // a perspective camera whose principal point is far from the centre is still found). Records
   // every model tried and why each group was left out.
   struct Ladder {
@@ -312,12 +269,6 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
           ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
                                    trial.refusal + ")";
           record(trial, name, "not determined: refused");
-          continue;
-        }
-        const std::string problem = undetermined(*trial.fit, SigmaNamesOf(g));
-        if (!problem.empty()) {
-          ladder.why_left_out[g] = "left out: not determined: " + problem;
-          record(trial, name, "not determined: " + problem);
           continue;
         }
         const double delta = criterion_of(trial) - criterion_or_inf(ladder.final);
@@ -434,6 +385,10 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     for (FixedParameter& p : selection.fit.fixed_parameters) {
       if (p.name == kFixedNames[g] && !chosen.why_left_out[g].empty()) p.why = chosen.why_left_out[g];
     }
+  }
+  selection.criterion = tried[chosen.final_index].criterion;
+  for (Rival& r : rivals) {
+    if (r.model != selection.fit.model) selection.rivals.push_back(std::move(r));
   }
   selection.fit.candidates = std::move(tried);
   selection.fit.criterion = criterion_name;

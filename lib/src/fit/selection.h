@@ -3,6 +3,7 @@
 #ifndef CAMPROJ_SRC_FIT_SELECTION_H_
 #define CAMPROJ_SRC_FIT_SELECTION_H_
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,12 +14,23 @@
 namespace camproj {
 namespace internal {
 
+// A fitted model the selection did not choose, with its camera: the assessment asks whether
+// one that fits about as well predicts the scene differently.
+struct Rival {
+  std::string model;
+  FitOptions options;
+  Camera camera;
+  double criterion = 0.0;
+};
+
 struct Selection {
   // The chosen model's fit (FitCamera's result, with ::model, ::candidates, ::criterion,
   // ::selection_sigma_px and every left-out group's reason in ::fixed_parameters).
   FitResult fit;
   FitOptions options;             // the chosen model (pixel_sigma: the noise its sigmas use)
   double sigma_px = 0.0;          // the noise the criterion used
+  double criterion = 0.0;         // the chosen model's
+  std::vector<Rival> rivals;      // every other model fitted, either family
 };
 
 // The noise the criterion uses without a given sigma: the prior combined with the residuals

@@ -1,0 +1,48 @@
+// How well the points determine the camera where it is used (private; part of the assessment):
+// the linearized reprojection uncertainty of test points across the scene, from the covariance
+// of the fitted parameters. A fit of few points can pass every residual test and still put the
+// rest of the scene tens of pixels off; this is the number that shows it.
+#ifndef CAMPROJ_SRC_FIT_DETERMINATION_H_
+#define CAMPROJ_SRC_FIT_DETERMINATION_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/camera.h"
+#include "camproj/fit.h"
+#include "camproj/model_select.h"
+#include "fit/selection.h"
+
+namespace camproj {
+namespace internal {
+
+// The points where the camera is judged: the corners and face centres of the box the fitted
+// points span along their principal axes (flat for a plane), and the points themselves, kept
+// where they are in front of `camera` and inside its image.
+std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
+                                             const std::vector<Eigen::Vector3d>& points_in_world);
+
+// For each test point, the 1-sigma length of its reprojection error, sqrt(trace(C)) with
+// C = sigma_px^2 J_x (J^T J)^-1 J_x^T, J the Jacobian of the fitted points' pixels and J_x the
+// test point's, both with respect to the parameters `model` frees (pose; focal, aspect,
+// principal point, skew, k1, k2 as free there), at `camera`. The result does not depend on how
+// the pose is parameterized. +inf for every point where J^T J is singular. Throws
+// std::invalid_argument if a fitted point is not in front of the camera.
+std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& model,
+                                        const std::vector<Eigen::Vector3d>& fitted_points,
+                                        double sigma_px,
+                                        const std::vector<Eigen::Vector3d>& test_points);
+
+// The assessment's check of a selection fitted on `kept_points` (model_select.h,
+// AutoFitOptions::max_uncertainty_px): the test points' uncertainty at the noise the selection's
+// sigmas use, and the largest shift of a test point by a rival that fits about as well. Pixels
+// in messages are in options.fit.pixel_origin.
+DeterminationCheck CheckDetermination(const Selection& selection,
+                                      const std::vector<Eigen::Vector3d>& kept_points,
+                                      const AutoFitOptions& options);
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_DETERMINATION_H_

@@ -1,0 +1,89 @@
+// The determination check's uncertainty (lib/src/fit/determination.h): exact on the fitted
+// points (the hat matrix's trace), and calibrated against the scatter of repeated fits.
+#include "fit/determination.h"
+
+#include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "camproj/fit.h"
+#include "camproj/synth.h"
+
+namespace camproj {
+namespace {
+
+SynthScene Scene(uint64_t seed, double noise_px) {
+  SynthOptions synth;
+  synth.seed = seed;
+  synth.num_points = 12;
+  synth.noise_px = noise_px;
+  synth.principal_point_offset = Eigen::Vector2d(0.0, 0.3);
+  return SynthesizeScene(synth);
+}
+
+FitOptions Model(bool principal_point, bool k1) {
+  FitOptions model;
+  model.aspect = ParameterMode::Default();
+  model.principal_point = principal_point ? ParameterMode::Free() : ParameterMode::Default();
+  model.k1 = k1 ? ParameterMode::Free() : ParameterMode::Default();
+  return model;
+}
+
+// At the fitted points with sigma = 1, sum_i trace(J_i (J^T J)^-1 J_i^T) = trace of the hat
+// matrix = the number of parameters, whatever the camera. The Jacobian is a central difference
+// (step 1e-6: truncation ~1e-12, rounding ~1e-10 relative per entry), amplified by the scaled
+// normal equations' condition (below 1e4 here): 1e-6 relative.
+TEST(DeterminationTest, FittedPointsSumToTheNumberOfParameters) {
+  constexpr double kTolerance = 1e-6;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    const SynthScene scene = Scene(seed, 0.0);
+    const std::vector<Eigen::Vector3d>& points = scene.correspondences.points_in_world;
+    for (const auto& [model, num_params] :
+         {std::pair{Model(false, false), 7}, {Model(true, false), 9}, {Model(true, true), 10}}) {
+      const std::vector<double> sigmas =
+          internal::ReprojectionSigmaPx(scene.truth, model, points, 1.0, points);
+      double sum = 0.0;
+      for (const double s : sigmas) sum += s * s;
+      EXPECT_NEAR(sum, num_params, kTolerance * num_params) << "seed " << seed;
+    }
+  }
+}
+
+// Calibration: fit 400 noisy copies of one scene with the true model; the mean of
+// |pixel(fit) - pixel(truth)|^2 / sigma_predicted^2 at a box corner is 1 up to linearization
+// (noise 0.3 px: negligible). |d|^2 / sigma^2 has variance at most 2 (two correlated unit
+// Gaussians), so the mean of 400 has a standard error of at most sqrt(2 / 400) = 0.071:
+// 4 standard errors, 0.28.
+TEST(DeterminationTest, PredictsTheScatterOfRepeatedFits) {
+  constexpr int kTrials = 400;
+  constexpr double kNoisePx = 0.3;
+  const FitOptions model = Model(true, false);
+  const SynthScene reference = Scene(7, 0.0);
+  const std::vector<Eigen::Vector3d>& points = reference.correspondences.points_in_world;
+  const std::vector<Eigen::Vector3d> test = internal::SceneTestPoints(reference.truth, points);
+  ASSERT_FALSE(test.empty());
+  const std::vector<double> predicted =
+      internal::ReprojectionSigmaPx(reference.truth, model, points, kNoisePx, test);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal(0.0, kNoisePx);
+  std::vector<double> mean_ratio(test.size(), 0.0);
+  for (int trial = 0; trial < kTrials; ++trial) {
+    std::vector<Eigen::Vector2d> pixels = reference.correspondences.pixels;
+    for (Eigen::Vector2d& u : pixels) u += Eigen::Vector2d(normal(rng), normal(rng));
+    FitOptions options = model;
+    options.compute_uncertainty = false;
+    const FitResult fit = FitCamera(points, pixels, reference.truth.image_size, options);
+    for (size_t i = 0; i < test.size(); ++i) {
+      const Eigen::Vector2d d =
+          *PixelFromWorld(fit.camera, test[i]) - *PixelFromWorld(reference.truth, test[i]);
+      mean_ratio[i] += d.squaredNorm() / (predicted[i] * predicted[i]) / kTrials;
+    }
+  }
+  for (size_t i = 0; i < test.size(); ++i) EXPECT_NEAR(mean_ratio[i], 1.0, 0.28) << "point " << i;
+}
+
+}  // namespace
+}  // namespace camproj
