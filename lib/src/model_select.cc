@@ -4,7 +4,6 @@
 #include "camproj/model_select.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -148,31 +147,28 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
   return text;
 }
 
-std::string Capitalized(std::string text) {
-  if (!text.empty()) text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
-  return text;
-}
-
 // The refusals of the determination check: a camera the points do not pin down to the bound
 // (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
 void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
                           const std::string& left_out) {
   if (check.passed) return;
+  const std::string add_points =
+      "points where the image has none (toward that pixel) and spread in depth, or fix the "
+      "intrinsics you know (--model, or their values)";
   const std::string advice =
-      (left_out.empty() ? "" : "Fix or drop " + left_out + " (left out: they disagree with the "
-                                                             "rest by far more than the noise); ") +
-      "add points where the image has none (toward that pixel) and spread in depth, or fix "
-      "the intrinsics you know (--model, or their values)";
+      left_out.empty() ? "Add " + add_points
+                       : "Fix or drop " + left_out + " (left out: they disagree with the rest by "
+                                                     "far more than the noise); add " + add_points;
   if (check.max_sigma_px > check.bound_px) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the points do not determine the camera well enough: it is " +
-                         check.summary + " (--max-uncertainty). " + Capitalized(advice));
+                         check.summary + " (--max-uncertainty). " + advice);
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
                    "the points cannot tell " + model + " from " + check.rival +
                        ": both fit about as well, but they put the scene up to " +
                        Px(check.rival_shift_px) + " apart (bound " + Px(check.bound_px) +
-                       ", --max-uncertainty). " + Capitalized(advice));
+                       ", --max-uncertainty). " + advice);
 }
 
 // A selection with every point's residual against its camera, recomputed in world coordinates
@@ -212,8 +208,24 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                  const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                  const AutoFitOptions& options, const std::vector<std::string>& names) {
+  // The refusals first, in order (mirror, gate, determination), on the selection as gated.
+  const std::vector<Eigen::Vector3d> kept_points = Kept(points, left_out);
+  const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
+  RefuseIfMirrorFitsBetter(gated.check.rms_px, gated.selection.options, kept_points,
+                           Kept(pixels, left_out), size, noise);
+  if (!gated.check.passed) {
+    throw SceneError(SceneError::Reason::kInconsistent,
+                     "no camera explains these points: " + gated.check.summary +
+                         ". Largest residuals: " + WorstPoints(gated.residuals_px, left_out, names) +
+                         ". Check those points" +
+                         (noise.given ? std::string()
+                                      : "; if your points are this noisy, give --sigma PX"));
+  }
   const DeterminationCheck determination =
-      internal::CheckDetermination(gated.selection, Kept(points, left_out), options);
+      internal::CheckDetermination(gated.selection, kept_points, options);
+  RefuseIfUndetermined(determination, gated.selection.fit.model,
+                       LeftOutText(gated.residuals_px, left_out, names));
+
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);
   result.outliers = left_out;
@@ -221,20 +233,8 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   result.rms_px = gated.check.rms_px;
   result.median_px = internal::Median(KeptLengths(result.residuals_px, left_out));
   result.max_px = gated.check.max_residual_px;
-  const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
-  RefuseIfMirrorFitsBetter(result.rms_px, gated.selection.options, Kept(points, left_out),
-                           Kept(pixels, left_out), size, noise);
   result.consistency = gated.check;
-  if (!result.consistency.passed) {
-    throw SceneError(SceneError::Reason::kInconsistent,
-                     "no camera explains these points: " + result.consistency.summary +
-                         ". Largest residuals: " + WorstPoints(result.residuals_px, left_out, names) +
-                         ". Check those points" +
-                         (noise.given ? std::string()
-                                      : "; if your points are this noisy, give --sigma PX"));
-  }
   result.determination = determination;
-  RefuseIfUndetermined(determination, result.model, LeftOutText(result.residuals_px, left_out, names));
   constexpr size_t kMaxRefits = 10;  // beyond, rms_with_px is not computed (0)
   FitOptions refit = gated.selection.options;
   refit.compute_uncertainty = false;

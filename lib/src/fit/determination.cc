@@ -58,7 +58,7 @@ std::vector<Parameter> ParametersOf(const Camera& camera, const FitOptions& mode
 Camera Moved(const Camera& camera, const Parameter& p, double amount, double length_scale) {
   Camera moved = camera;
   const Eigen::Matrix3d& r = camera.cam_from_world.rotation;
-  const Eigen::Vector3d eye = -r.transpose() * camera.cam_from_world.translation;
+  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
   Intrinsics& k = moved.intrinsics;
   const double f = camera.intrinsics.fx;
   switch (p.kind) {
@@ -155,8 +155,7 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
   Require(!fitted_points.empty(), "no fitted points");
   const std::vector<Parameter> params = ParametersOf(camera, model);
   // The eye's step scale: the median distance from the eye to the fitted points.
-  const Eigen::Matrix3d& r = camera.cam_from_world.rotation;
-  const Eigen::Vector3d eye = -r.transpose() * camera.cam_from_world.translation;
+  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
   std::vector<double> distances;
   for (const Eigen::Vector3d& x : fitted_points) distances.push_back((x - eye).norm());
   std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
@@ -235,8 +234,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   }
   check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px;
   const Eigen::Vector2d where =
-      check.worst_pixel +
-      Eigen::Vector2d::Constant(PixelOriginShift(PixelOrigin::kCenter, options.fit.pixel_origin));
+      ConvertPixelOrigin(check.worst_pixel, PixelOrigin::kCenter, options.fit.pixel_origin);
   check.summary = "uncertain by up to " + Px(check.max_sigma_px) +
                   " (1 sigma) over the box the points span, most near pixel (" +
                   std::to_string(static_cast<long>(std::lround(where.x()))) + ", " +

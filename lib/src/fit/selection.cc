@@ -213,8 +213,9 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
   // improves, the fit with it is not refused and the model keeps min_redundancy equations to
   // spare (whether the chosen camera is determined well enough is the assessment's question:
-  // leaving out a group the residuals ask for only hides its uncertainty in a biased camera). A refused base is a model of infinite criterion that any fitted trial improves on (so
-  // a perspective camera whose principal point is far from the centre is still found). Records
+  // leaving out a group the residuals ask for only hides its uncertainty in a biased camera).
+  // A refused base is a model of infinite criterion that any fitted trial improves on (so a
+  // perspective camera whose principal point is far from the centre is still found). Records
   // every model tried and why each group was left out.
   struct Ladder {
     Evaluation final;
