@@ -513,13 +513,6 @@ double Slope(const std::vector<std::pair<int, double>>& points, int min_n) {
 // ---------------------------------------------------------------------------------------------
 // Output
 
-std::string Format(double v, const char* format = "%.3g") {
-  if (std::isnan(v)) return "-";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
-}
-
 std::string FormatTime(double us) {
   if (std::isnan(us)) return "-";
   if (us < 1000.0) return Format(us, "%.3g") + " µs";

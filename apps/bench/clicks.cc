@@ -882,14 +882,6 @@ void Accumulate(const Band& band, const Case& c, const std::vector<Outcome>& out
 // ---------------------------------------------------------------------------------------------
 // Output
 
-std::string Format(double v, const char* format = "%.3g") {
-  if (std::isnan(v)) return "-";
-  if (std::isinf(v)) return "inf";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
-}
-
 // Pixel errors: 3 significant digits, no exponent below 1e5.
 std::string FormatPx(double v) {
   if (std::isnan(v) || std::isinf(v)) return Format(v);

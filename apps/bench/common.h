@@ -1,10 +1,12 @@
 // Helpers both benchmarks (bench.cc: error against run time; clicks.cc: the default path on
-// clicked scenes) use: order statistics and OpenCV's camera -> camproj's.
+// clicked scenes) use: table numbers, order statistics and OpenCV's camera -> camproj's.
 #ifndef CAMPROJ_APPS_BENCH_COMMON_H_
 #define CAMPROJ_APPS_BENCH_COMMON_H_
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
@@ -15,6 +17,15 @@
 
 namespace camproj {
 namespace bench {
+
+// A number in a table: printf `format`, "-" for NaN (no value), "inf" / "-inf" as printf writes
+// them.
+inline std::string Format(double v, const char* format = "%.3g") {
+  if (std::isnan(v)) return "-";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
 
 // NaN for no values.
 inline double Median(std::vector<double> v) {
