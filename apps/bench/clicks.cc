@@ -4,6 +4,7 @@
 #include "clicks.h"
 
 #include <algorithm>
+#include <cctype>
 #include <functional>
 #include <chrono>
 #include <cmath>
@@ -29,9 +30,11 @@
 #include <opencv2/core.hpp>
 
 #include "camproj/camera.h"
+#include "camproj/camera_file.h"
 #include "camproj/fit.h"
 #include "camproj/look_at.h"
 #include "camproj/model_select.h"
+#include "camproj/points_file.h"
 #include "camproj/pose.h"
 #include "common.h"
 
@@ -1142,12 +1145,43 @@ would see).
   'silent' uses the same rule), and the models the default chose.
 )md";
 
+// A scene as files a user can fit by hand: the clicks as given (mirrored world included), the
+// true camera, and the unseen points with their true pixels (in the given world).
+void DumpCase(const std::string& dir, const Band& band, const Case& c) {
+  std::string stem = band.name + "-" + std::to_string(c.index);
+  for (char& ch : stem) {
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-') ch = '_';
+  }
+  const std::filesystem::path base = std::filesystem::path(dir) / stem;
+  auto write = [](const std::filesystem::path& path, const std::string& text) {
+    std::ofstream out(path);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+  };
+  Correspondences clicks;
+  clicks.points_in_world = c.points;
+  clicks.pixels = c.pixels;
+  for (int i = 0; i < c.n; ++i) clicks.ids.push_back(std::to_string(i + 1));
+  write(base.string() + ".csv", CorrespondencesToCsvText(clicks));
+  write(base.string() + "-truth.json", CameraToJsonText(c.scene.truth));
+  Correspondences unseen;
+  for (const Eigen::Vector3d& x : c.scene.unseen_points) {
+    Eigen::Vector3d given = x;
+    if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
+    unseen.points_in_world.push_back(given);
+    unseen.pixels.push_back(*PixelFromWorld(c.scene.truth, x));
+    unseen.ids.push_back(std::to_string(unseen.ids.size() + 1));
+  }
+  write(base.string() + "-unseen.csv", CorrespondencesToCsvText(unseen));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Options and main
 
 struct ClicksOptions {
   bool quick = false;
   std::string out_dir = "clicks-results";
+  std::string dump_dir;  // non-empty: each silent failure's scene is written there
   int scenes = 0;  // per band; 0: 100, or 5 with --quick
   std::string command;
 };
@@ -1155,7 +1189,7 @@ struct ClicksOptions {
 const char* kClicksUsage =
     "bench --clicks: the click benchmark of the default fitting path.\n"
     "\n"
-    "Usage: bench --clicks [--quick] [--out DIR] [--scenes N]\n"
+    "Usage: bench --clicks [--quick] [--out DIR] [--scenes N] [--dump DIR]\n"
     "\n"
     "Fits seeded projection-mapping scenes (1-3 boxes, a 1920x1080 projector with lens shift,\n"
     "6-12 clicked corners rounded to pixels, sigma 0.7 px; a mis-click; a mirrored world model;\n"
@@ -1169,6 +1203,9 @@ const char* kClicksUsage =
     "  --quick      5 scenes per band (a smoke test)\n"
     "  --out DIR    output directory (default clicks-results): clicks.md, clicks.csv\n"
     "  --scenes N   scenes per band (default 100; 5 with --quick)\n"
+    "  --dump DIR   write each silent failure of the default as DIR/<band>-<scene>.csv (the\n"
+    "               clicks, for `camproj fit`), -truth.json and -unseen.csv (X,Y,Z,u,v of the\n"
+    "               unseen points in the given world, as the true projector sees them)\n"
     "\n"
     "Exit codes: 0 ok; 1 usage, or with --quick: a silent failure of the default path or an\n"
     "exception other than SceneError from a camproj fit; 2 error.\n"
@@ -1204,6 +1241,10 @@ int Main(const ClicksOptions& options) {
       std::vector<Outcome> outcomes;
       for (MethodId m : kMethodIds) outcomes.push_back(Run(m, c, bands[b]));
       Accumulate(bands[b], c, outcomes, &stats[b]);
+      if (!options.dump_dir.empty() && Silent(outcomes[0], bands[b])) {
+        std::filesystem::create_directories(options.dump_dir);
+        DumpCase(options.dump_dir, bands[b], c);
+      }
       for (const Outcome& o : outcomes) {
         if (o.status != Status::kSkipped) WriteCsvRow(csv, bands[b], c, o);
       }
@@ -1314,6 +1355,8 @@ int ClicksMain(int argc, char** argv) {
       options.quick = true;
     } else if (arg == "--out") {
       options.out_dir = value();
+    } else if (arg == "--dump") {
+      options.dump_dir = value();
     } else if (arg == "--scenes") {
       const std::string text = value();
       char* end = nullptr;
