@@ -27,19 +27,27 @@ constexpr double kStep = 1e-6;
 // A rival's shift of a test point counts beyond this many of its own sigmas there.
 constexpr double kRivalSigmas = 3.0;
 
-enum Kind { kRotation, kEye, kFocal, kAspect, kCx, kCy, kSkew, kK1, kK2 };
+// kPerspective: an orthographic camera's perspective strength (module docs: ParametersOf).
+enum Kind { kRotation, kEye, kFocal, kAspect, kCx, kCy, kSkew, kK1, kK2, kPerspective };
 
 struct Parameter {
   Kind kind;
   int axis = 0;  // kRotation, kEye: the camera axis
 };
 
+// The parameters `model` frees at `camera`. An orthographic camera is the limit of perspective
+// cameras whose distance grows with their focal length; it answers for the scene only if the
+// points show that limit is reached, so its uncertainty has the perspective strength free too:
+// pixel = c + (u_ortho - c) / (1 + e z_cam), judged at e = 0. Where the points do not determine
+// e (too little depth spread against the distance for their noise), no orthographic camera is
+// determined either.
 std::vector<Parameter> ParametersOf(const Camera& camera, const FitOptions& model) {
   std::vector<Parameter> params;
   for (int a = 0; a < 3; ++a) params.push_back({kRotation, a});
   // An orthographic image does not change when the eye moves along the gaze.
-  const int eye_axes = camera.projection == Projection::kOrthographic ? 2 : 3;
-  for (int a = 0; a < eye_axes; ++a) params.push_back({kEye, a});
+  const bool orthographic = camera.projection == Projection::kOrthographic;
+  for (int a = 0; a < (orthographic ? 2 : 3); ++a) params.push_back({kEye, a});
+  if (orthographic) params.push_back({kPerspective});
   if (model.known_intrinsics) return params;
   if (model.focal.IsFree()) params.push_back({kFocal});
   if (model.aspect.IsFree()) params.push_back({kAspect});
@@ -82,8 +90,20 @@ Camera Moved(const Camera& camera, const Parameter& p, double amount, double len
     case kSkew: k.skew += amount * f; break;
     case kK1: k.k1 += amount; break;
     case kK2: k.k2 += amount; break;
+    case kPerspective: break;  // not a Camera: PixelJacobian differentiates it directly
   }
   return moved;
+}
+
+// d pixel / d e of the orthographic-to-perspective family (ParametersOf) at e = 0, per unit of
+// e * length_scale: -(pixel - principal point) * z_cam / length_scale.
+Eigen::Vector2d PerspectiveDerivative(const Camera& camera, const Eigen::Vector3d& point,
+                                      double length_scale) {
+  const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, point);
+  Require(u.has_value(), "the point is not in front of the camera");
+  const double z = (camera.cam_from_world * point).z();
+  const Eigen::Vector2d centre(camera.intrinsics.cx, camera.intrinsics.cy);
+  return -(*u - centre) * (z / length_scale);
 }
 
 // d pixel / d parameter (2 x params) at every point, by central differences; rows 2i, 2i+1 for
@@ -92,6 +112,12 @@ Eigen::MatrixXd PixelJacobian(const Camera& camera, const std::vector<Parameter>
                               const std::vector<Eigen::Vector3d>& points, double length_scale) {
   Eigen::MatrixXd jacobian(2 * points.size(), params.size());
   for (size_t j = 0; j < params.size(); ++j) {
+    if (params[j].kind == kPerspective) {
+      for (size_t i = 0; i < points.size(); ++i) {
+        jacobian.block<2, 1>(2 * i, j) = PerspectiveDerivative(camera, points[i], length_scale);
+      }
+      continue;
+    }
     const Camera plus = Moved(camera, params[j], kStep, length_scale);
     const Camera minus = Moved(camera, params[j], -kStep, length_scale);
     for (size_t i = 0; i < points.size(); ++i) {
