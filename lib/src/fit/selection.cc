@@ -241,14 +241,20 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       size_t best_index = 0;
       Evaluation best;
       FitOptions best_options;
+      auto included = [&](int g) {
+        return std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end();
+      };
       for (const int g : groups) {
-        if (std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end()) {
+        if (included(g)) continue;
+        if (g == kK2 && !included(kK1) && std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
+          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
           continue;
         }
-        if (g == kK2 &&
-            std::find(ladder.included.begin(), ladder.included.end(), kK1) == ladder.included.end() &&
-            std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
-          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
+        if (g == kSkew && !included(kPrincipalPoint) &&
+            std::find(groups.begin(), groups.end(), kPrincipalPoint) != groups.end()) {
+          // Skew only describes resampled or cropped pixels; before the principal point it
+          // stands in for a lens shift at a few points and bends the camera to match.
+          ladder.why_left_out[g] = "left out: not tried, the principal point is not in the model";
           continue;
         }
         FitOptions trial_options = ladder.final_options;
