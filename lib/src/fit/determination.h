@@ -19,9 +19,11 @@ namespace internal {
 
 // The points where the camera is judged: the corners and face centres of the box the fitted
 // points span along their principal axes (flat for a plane), and the points themselves, kept
-// where they are in front of `camera` and inside its image.
+// where they are in front of `camera` and inside its image. With min_thickness > 0 the box is
+// first widened about its centre so that no side is shorter than min_thickness times its longest.
 std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
-                                             const std::vector<Eigen::Vector3d>& points_in_world);
+                                             const std::vector<Eigen::Vector3d>& points_in_world,
+                                             double min_thickness = 0.0);
 
 // For each test point, the 1-sigma length of its reprojection error, sqrt(trace(C)) with
 // C = sigma_px^2 J_x (J^T J)^-1 J_x^T, J the Jacobian of the fitted points' pixels and J_x the
@@ -36,8 +38,9 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
 
 // The assessment's check of a selection fitted on `kept_points` (model_select.h,
 // AutoFitOptions::max_uncertainty_px): the test points' uncertainty at the noise the selection's
-// sigmas use, and the largest shift of a test point by a rival that fits about as well. Pixels
-// in messages are in options.fit.pixel_origin.
+// sigmas use, and the largest shift of a test point by a rival that fits about as well, over the
+// box widened to kRivalBoxThickness (a rival that agrees on the clicked points can still put the
+// object behind them elsewhere). Pixels in messages are in options.fit.pixel_origin.
 DeterminationCheck CheckDetermination(const Selection& selection,
                                       const std::vector<Eigen::Vector3d>& kept_points,
                                       const AutoFitOptions& options);
