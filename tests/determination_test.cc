@@ -52,6 +52,29 @@ TEST(DeterminationTest, FittedPointsSumToTheNumberOfParameters) {
   }
 }
 
+// An orthographic camera is judged with its perspective strength free as well (it answers only
+// where the points show the perspective is gone): the hat matrix's trace is its 6 parameters
+// (rotation, two eye axes, scale) plus one. Same tolerance as above.
+TEST(DeterminationTest, OrthographicCountsItsPerspectiveStrength) {
+  constexpr double kTolerance = 1e-6;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    const SynthScene scene = Scene(seed, 0.0);
+    const std::vector<Eigen::Vector3d>& points = scene.correspondences.points_in_world;
+    Camera orthographic = scene.truth;  // the same pose, a parallel view: a valid camera
+    orthographic.projection = Projection::kOrthographic;
+    orthographic.intrinsics.fx = orthographic.intrinsics.fy = 100.0;
+    FitOptions model;
+    model.projection = Projection::kOrthographic;
+    model.aspect = ParameterMode::Default();
+    model.principal_point = ParameterMode::Default();  // it trades with the eye in a parallel view
+    const std::vector<double> sigmas =
+        internal::ReprojectionSigmaPx(orthographic, model, points, 1.0, points);
+    double sum = 0.0;
+    for (const double s : sigmas) sum += s * s;
+    EXPECT_NEAR(sum, 7.0, kTolerance * 7.0) << "seed " << seed;
+  }
+}
+
 // Calibration: fit 400 noisy copies of one scene with the true model; the mean of
 // |pixel(fit) - pixel(truth)|^2 / sigma_predicted^2 at a box corner is 1 up to linearization
 // (noise 0.3 px: negligible). |d|^2 / sigma^2 has variance at most 2 (two correlated unit
