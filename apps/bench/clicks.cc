@@ -712,6 +712,20 @@ Camera CvCalibrate(const std::vector<Eigen::Vector3d>& points,
   return camera;
 }
 
+// The points a refusal tells the user to fix first ("Fix or drop point 5 (98 px from where the
+// camera puts it)"), as input indices; FitCameraAuto names unnamed points "point <row>".
+std::vector<int> NamedByRefusal(const std::string& message) {
+  std::vector<int> named;
+  static const std::regex kFix("Fix or drop point ([0-9]+) \\(");
+  for (auto it = std::sregex_iterator(message.begin(), message.end(), kFix);
+       it != std::sregex_iterator(); ++it) {
+    named.push_back(std::stoi((*it)[1].str()) - 1);
+  }
+  std::sort(named.begin(), named.end());
+  named.erase(std::unique(named.begin(), named.end()), named.end());
+  return named;
+}
+
 // One method on one case; the clock covers the library call only. Nothing but a refusal
 // (SceneError) is expected from camproj; anything else is recorded as an error, never rethrown.
 Outcome Run(MethodId method, const Case& c, const Band& band) {
@@ -759,6 +773,7 @@ Outcome Run(MethodId method, const Case& c, const Band& band) {
     outcome.status = Status::kRefused;
     outcome.reason = ReasonName(e.reason());
     outcome.message = e.what();
+    outcome.named = NamedByRefusal(outcome.message);
   } catch (const std::exception& e) {
     outcome.time_ms = MillisecondsBetween(start, Clock::now());
     outcome.status = Status::kError;
@@ -832,24 +847,24 @@ void Accumulate(const Band& band, const Case& c, const std::vector<Outcome>& out
   s->bad_total += bad;
   if (bad > 0) ++s->scenes_with_bad;
   s->default_time_ms.push_back(def.time_ms);
+  int bad_named = 0;
+  int good_named = 0;
+  for (int i : def.named) {
+    if (i >= 0 && i < c.n && c.bad[i]) {
+      ++bad_named;
+    } else {
+      ++good_named;
+    }
+  }
+  s->bad_named += bad_named;
+  if (bad > 0 && bad_named == bad) ++s->scenes_bad_named;
+  s->good_named += good_named;
+  if (good_named > 0) ++s->scenes_good_named;
   if (def.status == Status::kAnswered) {
     ++s->answered;
     ++s->models[def.model];
     s->default_error.push_back(def.unseen_max_px);
     if (Silent(def, band)) ++s->silent;
-    int bad_named = 0;
-    int good_named = 0;
-    for (int i : def.named) {
-      if (i >= 0 && i < c.n && c.bad[i]) {
-        ++bad_named;
-      } else {
-        ++good_named;
-      }
-    }
-    s->bad_named += bad_named;
-    if (bad > 0 && bad_named == bad) ++s->scenes_bad_named;
-    s->good_named += good_named;
-    if (good_named > 0) ++s->scenes_good_named;
     if (oracle.status == Status::kAnswered) s->oracle_error_same.push_back(oracle.unseen_max_px);
   } else if (def.status == Status::kRefused) {
     ++s->refused;
@@ -1133,9 +1148,10 @@ would see).
   m)" when the oracle answered only k of the default's m answered scenes (at mis-click N=6 it has
   5 points for 9 unknowns and mostly refuses).
 - **bad named**: mis-click band: scenes whose mis-click the default named (FitResult::outliers or
-  left_out) / scenes; outlier bands: replaced points named / replaced points, over all scenes (a
-  refusal names none). **good named**: good points the default named, summed over its answers (and
-  in how many scenes).
+  left_out, or a refusal's "Fix or drop point K" when the other points do not determine the
+  camera) / scenes; outlier bands: replaced points named / replaced points, over all scenes.
+  **good named**: good points the default named, summed over its answers and refusals (and in how
+  many scenes).
 - **SILENT**: silent failures = answers with unseen error > 10 px; in the mirrored band every
   answer (no proper camera is right in a mirrored world).
 - **t default / t oracle**: median wall time per call (refusals included), one core; other work
