@@ -3,6 +3,7 @@
 //
 //   bench [--quick] [--out DIR] [--scenes-scale X] [--mapamok-literal-focal]
 //   bench --clicks [--quick] [--out DIR] [--scenes N]     (the click benchmark: clicks.h)
+//   bench --stage-cost [--n N,N,...] [--seeds K]          (the default path's cost: stage_cost.h)
 //
 // Writes DIR/results.csv, DIR/results.json and DIR/table.md. Single-threaded (OpenCV is set to
 // one thread, Ceres runs with one), so 1 / median time is fits per second per core.
@@ -34,6 +35,7 @@
 #include "camproj/synth.h"
 #include "common.h"
 #include "clicks.h"
+#include "stage_cost.h"
 
 #ifndef CAMPROJ_CERES_VERSION
 #define CAMPROJ_CERES_VERSION "unknown"
@@ -94,7 +96,8 @@ const char* kUsage =
     "results are still written).\n"
     "\n"
     "bench --clicks [...] runs the click benchmark of the default fitting path instead\n"
-    "(bench --clicks --help).\n"
+    "(bench --clicks --help); bench --stage-cost [...] what the default path costs on clean\n"
+    "scenes (bench --stage-cost --help).\n"
     "\n"
     "Example:\n"
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
@@ -964,6 +967,7 @@ int Main(const BenchOptions& options) {
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--clicks") return camproj::bench::ClicksMain(argc, argv);
+    if (std::string(argv[i]) == "--stage-cost") return camproj::bench::StageCostMain(argc, argv);
   }
   camproj::bench::BenchOptions options;
   options.command = "bench";

@@ -20,10 +20,17 @@ std::string Concat(const Args&... args) {
   return out.str();
 }
 
+// Require's throw, out of line: Require itself then inlines to one test, which matters where
+// every projection checks its inputs (PixelFromCam, CamRayFromPixel).
+template <typename... Args>
+[[noreturn, gnu::cold, gnu::noinline]] void ThrowInvalidArgument(const Args&... message) {
+  throw std::invalid_argument(Concat(message...));
+}
+
 // Throws std::invalid_argument with the concatenated message unless `condition`.
 template <typename... Args>
 void Require(bool condition, const Args&... message) {
-  if (!condition) throw std::invalid_argument(Concat(message...));
+  if (!condition) ThrowInvalidArgument(message...);
 }
 
 // Throws unless `value` is finite; the message names it: "<name> must be finite, got nan".

@@ -16,6 +16,9 @@ using internal::Require;
 using internal::RequireFinite;
 
 void Intrinsics::Check() const {
+  // Every projection checks its intrinsics: one test for the valid case first (a sum is finite
+  // only if every term is), the named refusals below otherwise.
+  if (std::isfinite(fx + fy + cx + cy + skew + k1 + k2) && fx > 0.0 && fy > 0.0) return;
   RequireFinite(fx, "fx");
   RequireFinite(fy, "fy");
   RequireFinite(cx, "cx");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <stdexcept>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -34,7 +36,7 @@ constexpr double kRivalSigmas = 3.0;
 // same widening for the uncertainty bound as well costs 16 answers more and removes none.
 constexpr double kRivalBoxThickness = 0.25;
 
-// kPerspective: an orthographic camera's perspective strength (module docs: ParametersOf).
+// kPerspective: an orthographic camera's perspective strength (ParametersOf).
 enum Kind { kRotation, kEye, kFocal, kAspect, kCx, kCy, kSkew, kK1, kK2, kPerspective };
 
 struct Parameter {
@@ -102,40 +104,119 @@ Camera Moved(const Camera& camera, const Parameter& p, double amount, double len
   return moved;
 }
 
-// d pixel / d e of the orthographic-to-perspective family (ParametersOf) at e = 0, per unit of
-// e * length_scale: -(pixel - principal point) * z_cam / length_scale.
-Eigen::Vector2d PerspectiveDerivative(const Camera& camera, const Eigen::Vector3d& point,
-                                      double length_scale) {
-  const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, point);
-  Require(u.has_value(), "the point is not in front of the camera");
-  const double z = (camera.cam_from_world * point).z();
-  const Eigen::Vector2d centre(camera.intrinsics.cx, camera.intrinsics.cy);
-  return -(*u - centre) * (z / length_scale);
+// `camera` moved by +kStep and -kStep along each parameter: the central differences' cameras,
+// made once per camera and read for every point.
+// A kPerspective parameter's entries are copies of the camera, unread: its column is
+// -(pixel - principal point) * z_cam / length_scale, the derivative at e = 0 per unit of
+// e * length_scale.
+struct MovedCameras {
+  Camera camera;
+  double length_scale = 1.0;
+  std::vector<bool> perspective;
+  std::vector<Camera> plus;
+  std::vector<Camera> minus;
+};
+
+MovedCameras MovedAlong(const Camera& camera, const std::vector<Parameter>& params,
+                        double length_scale) {
+  MovedCameras moved;
+  moved.camera = camera;
+  moved.length_scale = length_scale;
+  for (const Parameter& p : params) {
+    moved.perspective.push_back(p.kind == kPerspective);
+    moved.plus.push_back(Moved(camera, p, kStep, length_scale));
+    moved.minus.push_back(Moved(camera, p, -kStep, length_scale));
+  }
+  return moved;
 }
 
 // d pixel / d parameter (2 x params) at every point, by central differences; rows 2i, 2i+1 for
-// point i. Throws if a point is not in front of a moved camera.
-Eigen::MatrixXd PixelJacobian(const Camera& camera, const std::vector<Parameter>& params,
-                              const std::vector<Eigen::Vector3d>& points, double length_scale) {
-  Eigen::MatrixXd jacobian(2 * points.size(), params.size());
-  for (size_t j = 0; j < params.size(); ++j) {
-    if (params[j].kind == kPerspective) {
+// point i. Returns the index of the first point (parameter by parameter) not in front of a moved
+// camera, if any; the Jacobian is then incomplete.
+std::optional<size_t> PixelJacobian(const MovedCameras& moved,
+                                    const std::vector<Eigen::Vector3d>& points,
+                                    Eigen::MatrixXd* jacobian) {
+  jacobian->resize(2 * points.size(), moved.plus.size());
+  for (size_t j = 0; j < moved.plus.size(); ++j) {
+    if (moved.perspective[j]) {
+      const Eigen::Vector2d centre(moved.camera.intrinsics.cx, moved.camera.intrinsics.cy);
       for (size_t i = 0; i < points.size(); ++i) {
-        jacobian.block<2, 1>(2 * i, j) = PerspectiveDerivative(camera, points[i], length_scale);
+        const std::optional<Eigen::Vector2d> u = PixelFromWorld(moved.camera, points[i]);
+        if (!u) return i;
+        const double z = (moved.camera.cam_from_world * points[i]).z();
+        jacobian->block<2, 1>(2 * i, j) = -(*u - centre) * (z / moved.length_scale);
       }
       continue;
     }
-    const Camera plus = Moved(camera, params[j], kStep, length_scale);
-    const Camera minus = Moved(camera, params[j], -kStep, length_scale);
     for (size_t i = 0; i < points.size(); ++i) {
-      const std::optional<Eigen::Vector2d> a = PixelFromWorld(plus, points[i]);
-      const std::optional<Eigen::Vector2d> b = PixelFromWorld(minus, points[i]);
-      Require(a && b, "point ", i, " is not in front of the camera");
-      jacobian.block<2, 1>(2 * i, j) = (*a - *b) / (2.0 * kStep);
+      const std::optional<Eigen::Vector2d> a = PixelFromWorld(moved.plus[j], points[i]);
+      const std::optional<Eigen::Vector2d> b = PixelFromWorld(moved.minus[j], points[i]);
+      if (!a || !b) return i;
+      jacobian->block<2, 1>(2 * i, j) = (*a - *b) / (2.0 * kStep);
     }
   }
-  return jacobian;
+  return std::nullopt;
 }
+
+// ReprojectionSigmaPx's linearization of one camera, prepared once: the moved cameras and the
+// Jacobi-scaled inverse of J^T J; SigmaAt then costs one point's Jacobian.
+class PixelUncertainty {
+ public:
+  // Throws std::invalid_argument if a fitted point is not in front of the camera.
+  PixelUncertainty(const Camera& camera, const FitOptions& model,
+                   const std::vector<Eigen::Vector3d>& fitted_points, double sigma_px)
+      : sigma_px_(sigma_px) {
+    Require(!fitted_points.empty(), "no fitted points");
+    const std::vector<Parameter> params = ParametersOf(camera, model);
+    // The eye's step scale: the median distance from the eye to the fitted points.
+    const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
+    std::vector<double> distances;
+    for (const Eigen::Vector3d& x : fitted_points) distances.push_back((x - eye).norm());
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
+    moved_ = MovedAlong(camera, params, length_scale);
+
+    Eigen::MatrixXd jacobian;
+    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &jacobian);
+    Require(!behind, "point ", behind.value_or(0), " is not in front of the camera");
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
+    // through the eigen-decomposition, refusing near-singular directions.
+    const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseMax(1e-300);
+    d_inverse_ = d.cwiseInverse();
+    const Eigen::MatrixXd scaled = d_inverse_.asDiagonal() * normal * d_inverse_.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+    const Eigen::VectorXd values = eigen.eigenvalues();
+    singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));
+    if (!singular_) {
+      scaled_inverse_ = eigen.eigenvectors() * values.cwiseInverse().asDiagonal() *
+                        eigen.eigenvectors().transpose();
+    }
+  }
+
+  // The 1-sigma length of the reprojection error of `x`; +inf where J^T J is singular or `x` is
+  // at the camera's plane (no pixel to be sure of).
+  double SigmaAt(const Eigen::Vector3d& x) const {
+    const double infinity = std::numeric_limits<double>::infinity();
+    if (singular_) return infinity;
+    Eigen::MatrixXd jacobian;
+    try {
+      if (PixelJacobian(moved_, {x}, &jacobian)) return infinity;
+    } catch (const std::invalid_argument&) {
+      return infinity;
+    }
+    const Eigen::MatrixXd jx = jacobian * d_inverse_.asDiagonal();
+    const double variance = (jx * scaled_inverse_ * jx.transpose()).trace();
+    return sigma_px_ * std::sqrt(std::max(0.0, variance));
+  }
+
+ private:
+  double sigma_px_;
+  MovedCameras moved_;
+  Eigen::VectorXd d_inverse_;
+  Eigen::MatrixXd scaled_inverse_;
+  bool singular_ = false;
+};
 
 }  // namespace
 
@@ -189,43 +270,10 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
                                         const std::vector<Eigen::Vector3d>& fitted_points,
                                         double sigma_px,
                                         const std::vector<Eigen::Vector3d>& test_points) {
-  Require(!fitted_points.empty(), "no fitted points");
-  const std::vector<Parameter> params = ParametersOf(camera, model);
-  // The eye's step scale: the median distance from the eye to the fitted points.
-  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
-  std::vector<double> distances;
-  for (const Eigen::Vector3d& x : fitted_points) distances.push_back((x - eye).norm());
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
-
-  const Eigen::MatrixXd jacobian = PixelJacobian(camera, params, fitted_points, length_scale);
-  const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
-  // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
-  // through the eigen-decomposition, refusing near-singular directions.
-  const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseMax(1e-300);
-  const Eigen::MatrixXd scaled = d.cwiseInverse().asDiagonal() * normal * d.cwiseInverse().asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
-  const Eigen::VectorXd values = eigen.eigenvalues();
-  const double infinity = std::numeric_limits<double>::infinity();
-  if (!(values(0) > kSingularRcond * values(values.size() - 1))) {
-    return std::vector<double>(test_points.size(), infinity);
-  }
-  const Eigen::MatrixXd scaled_inverse =
-      eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
-
+  const PixelUncertainty uncertainty(camera, model, fitted_points, sigma_px);
   std::vector<double> sigmas;
   sigmas.reserve(test_points.size());
-  for (const Eigen::Vector3d& x : test_points) {
-    Eigen::MatrixXd jx;
-    try {
-      jx = PixelJacobian(camera, params, {x}, length_scale) * d.cwiseInverse().asDiagonal();
-    } catch (const std::invalid_argument&) {
-      sigmas.push_back(infinity);  // at the camera's plane: no pixel to be sure of
-      continue;
-    }
-    const double variance = (jx * scaled_inverse * jx.transpose()).trace();
-    sigmas.push_back(sigma_px * std::sqrt(std::max(0.0, variance)));
-  }
+  for (const Eigen::Vector3d& x : test_points) sigmas.push_back(uncertainty.SigmaAt(x));
   return sigmas;
 }
 
