@@ -9,15 +9,7 @@ build="$root/build/release"
 cd "$root"
 
 # Release build of the bench alone (scripts/build.sh's configuration).
-if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-fi
-build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt")
-if [[ "$build_type" != "Release" ]]; then
-  echo "bench_clicks.sh: $build is configured as '$build_type', not Release; times would mislead" >&2
-  exit 1
-fi
-cmake --build "$build" --target camproj_bench
+bash "$root/scripts/build_release.sh" "$build" bench_clicks.sh camproj_bench
 
 bench="${build#"$root"/}/apps/bench"
 echo "\$ $bench --clicks --out docs/bench/clicks $*"

@@ -45,15 +45,7 @@ CMAKE
   bench=("$work/build/apps/stage_cost_baseline")
 else
   build="$root/build/release"
-  if [[ ! -f "$build/build.ninja" ]]; then
-    cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-  fi
-  build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt")
-  if [[ "$build_type" != "Release" ]]; then
-    echo "bench_stage_cost.sh: $build is configured as '$build_type', not Release" >&2
-    exit 1
-  fi
-  cmake --build "$build" --target camproj_bench
+  bash "$root/scripts/build_release.sh" "$build" bench_stage_cost.sh camproj_bench
   bench=("$build/apps/bench" --stage-cost)
 fi
 

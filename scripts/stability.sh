@@ -13,15 +13,7 @@ build="${CAMPROJ_BUILD_DIR:-$root/build/release}"
 out="${1:-$root/docs/stability.md}"
 cd "$root"
 
-if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-fi
-build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt")
-if [[ "$build_type" != "Release" ]]; then
-  echo "stability.sh: $build is configured as '$build_type', not Release; times would mislead" >&2
-  exit 1
-fi
-cmake --build "$build" --target stability_test
+bash "$root/scripts/build_release.sh" "$build" stability.sh stability_test
 
 rows=$(mktemp)
 log=$(mktemp)
