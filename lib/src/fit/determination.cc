@@ -105,14 +105,13 @@ Camera Moved(const Camera& camera, const Parameter& p, double amount, double len
 }
 
 // `camera` moved by +kStep and -kStep along each parameter: the central differences' cameras,
-// made once per camera and read for every point.
-// A kPerspective parameter's entries are copies of the camera, unread: its column is
-// -(pixel - principal point) * z_cam / length_scale, the derivative at e = 0 per unit of
-// e * length_scale.
+// made once per camera and read for every point. A kPerspective parameter's entries are copies
+// of the camera, unread: its column is -(pixel - principal point) * z_cam / length_scale, the
+// derivative at e = 0 per unit of e * length_scale.
 struct MovedCameras {
   Camera camera;
   double length_scale = 1.0;
-  std::vector<bool> perspective;
+  std::vector<Parameter> params;
   std::vector<Camera> plus;
   std::vector<Camera> minus;
 };
@@ -122,8 +121,8 @@ MovedCameras MovedAlong(const Camera& camera, const std::vector<Parameter>& para
   MovedCameras moved;
   moved.camera = camera;
   moved.length_scale = length_scale;
+  moved.params = params;
   for (const Parameter& p : params) {
-    moved.perspective.push_back(p.kind == kPerspective);
     moved.plus.push_back(Moved(camera, p, kStep, length_scale));
     moved.minus.push_back(Moved(camera, p, -kStep, length_scale));
   }
@@ -138,7 +137,7 @@ std::optional<size_t> PixelJacobian(const MovedCameras& moved,
                                     Eigen::MatrixXd* jacobian) {
   jacobian->resize(2 * points.size(), moved.plus.size());
   for (size_t j = 0; j < moved.plus.size(); ++j) {
-    if (moved.perspective[j]) {
+    if (moved.params[j].kind == kPerspective) {
       const Eigen::Vector2d centre(moved.camera.intrinsics.cx, moved.camera.intrinsics.cy);
       for (size_t i = 0; i < points.size(); ++i) {
         const std::optional<Eigen::Vector2d> u = PixelFromWorld(moved.camera, points[i]);
