@@ -197,12 +197,16 @@ Gated Gate(internal::Selection selection, const std::vector<int>& left_out,
   return gated;
 }
 
-// The model selection on the points not in `left_out`, gated.
+// The model selection on the points not in `left_out`, gated. `screen`: the screen's fit, read
+// by the selection when no point is left out (the same points), or nullptr.
 Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
                const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& left_out,
                const ImageSize& size, const AutoFitOptions& options,
-               const internal::NoiseReference& noise) {
-  return Gate(internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options),
+               const internal::NoiseReference& noise, const internal::Screen* screen = nullptr) {
+  const internal::Prefit* prefit =
+      screen != nullptr && screen->fit && left_out.empty() ? &*screen->fit : nullptr;
+  return Gate(internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options,
+                                    prefit),
               left_out, points, pixels, options, noise);
 }
 
@@ -347,7 +351,7 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
         guarded.min_redundancy = std::max(options.min_redundancy, static_cast<int>(points.size()));
       }
       try {
-        gated = SelectOn(points, pixels, left_out, size, guarded, noise);
+        gated = SelectOn(points, pixels, left_out, size, guarded, noise, &screen);
       } catch (const SceneError& e) {
         if (Final(e.reason())) throw;
         refusal = e;
