@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -141,10 +142,9 @@ class PixelUncertainty {
     const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
     moved_ = MovedAlong(camera, params, length_scale);
 
-    Eigen::MatrixXd jacobian;
-    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &jacobian);
+    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &fitted_jacobian_);
     Require(!behind, "point ", behind.value_or(0), " is not in front of the camera");
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    const Eigen::MatrixXd normal = fitted_jacobian_.transpose() * fitted_jacobian_;
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the eigen-decomposition, refusing near-singular directions.
     const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseMax(1e-300);
@@ -170,23 +170,39 @@ class PixelUncertainty {
     } catch (const std::invalid_argument&) {
       return infinity;
     }
+    return SigmaOf(jacobian);
+  }
+
+  // SigmaAt of fitted point i, whose Jacobian (J's rows 2i, 2i+1) is known: the same numbers.
+  double SigmaAtFitted(size_t i) const {
+    if (singular_) return std::numeric_limits<double>::infinity();
+    return SigmaOf(fitted_jacobian_.middleRows(2 * i, 2));
+  }
+
+ private:
+  // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
+  double SigmaOf(const Eigen::MatrixXd& jacobian) const {
     const Eigen::MatrixXd jx = jacobian * d_inverse_.asDiagonal();
     const double variance = (jx * scaled_inverse_ * jx.transpose()).trace();
     return sigma_px_ * std::sqrt(std::max(0.0, variance));
   }
 
- private:
   double sigma_px_;
   MovedCameras moved_;
+  Eigen::MatrixXd fitted_jacobian_;
   Eigen::VectorXd d_inverse_;
   Eigen::MatrixXd scaled_inverse_;
   bool singular_ = false;
 };
 
-}  // namespace
+// SceneTestPoints with, for each, the index of the fitted point it is (-1: a corner or face
+// centre of the box), whose Jacobian the uncertainty already has.
+struct TestPoints {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> fitted;
+};
 
-std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
-                                             const std::vector<Eigen::Vector3d>& points) {
+TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points) {
   std::vector<Eigen::Vector3d> candidates = points;
   if (!points.empty()) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -216,15 +232,34 @@ std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
       }
     }
   }
-  std::vector<Eigen::Vector3d> inside;
-  for (const Eigen::Vector3d& x : candidates) {
-    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, x);
+  TestPoints inside;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, candidates[k]);
     if (u && u->x() >= -0.5 && u->x() <= camera.image_size.width - 0.5 && u->y() >= -0.5 &&
         u->y() <= camera.image_size.height - 0.5) {
-      inside.push_back(x);
+      inside.points.push_back(candidates[k]);
+      inside.fitted.push_back(k < points.size() ? static_cast<int>(k) : -1);
     }
   }
   return inside;
+}
+
+// The sigmas at the test points.
+std::vector<double> SigmasAt(const PixelUncertainty& uncertainty, const TestPoints& test) {
+  std::vector<double> sigmas;
+  sigmas.reserve(test.points.size());
+  for (size_t i = 0; i < test.points.size(); ++i) {
+    sigmas.push_back(test.fitted[i] >= 0 ? uncertainty.SigmaAtFitted(test.fitted[i])
+                                         : uncertainty.SigmaAt(test.points[i]));
+  }
+  return sigmas;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
+                                             const std::vector<Eigen::Vector3d>& points) {
+  return TestPointsOf(camera, points).points;
 }
 
 std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& model,
@@ -245,11 +280,16 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   check.checked = true;
   check.bound_px = options.max_uncertainty_px;
   const Camera& camera = selection.fit.camera;
-  std::vector<Eigen::Vector3d> test = SceneTestPoints(camera, kept_points);
-  if (test.empty()) test = kept_points;  // none in the image: judge the points themselves
+  TestPoints test_points = TestPointsOf(camera, kept_points);
+  if (test_points.points.empty()) {  // none in the image: judge the points themselves
+    test_points.points = kept_points;
+    test_points.fitted.resize(kept_points.size());
+    std::iota(test_points.fitted.begin(), test_points.fitted.end(), 0);
+  }
+  const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
   const std::vector<double> sigmas =
-      ReprojectionSigmaPx(camera, selection.options, kept_points, sigma, test);
+      SigmasAt(PixelUncertainty(camera, selection.options, kept_points, sigma), test_points);
   for (size_t i = 0; i < test.size(); ++i) {
     if (!(sigmas[i] <= check.max_sigma_px)) {
       check.max_sigma_px = sigmas[i];
@@ -262,7 +302,8 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     // is a different reading of the data rather than the rival's noise.
     std::vector<double> rival_sigmas;
     try {
-      rival_sigmas = ReprojectionSigmaPx(rival.camera, rival.options, kept_points, sigma, test);
+      rival_sigmas =
+          SigmasAt(PixelUncertainty(rival.camera, rival.options, kept_points, sigma), test_points);
     } catch (const std::invalid_argument&) {
       continue;  // a kept point behind the rival: not a reading of these points
     }
