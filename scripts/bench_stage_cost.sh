@@ -70,7 +70,8 @@ if [[ -n "$baseline" ]]; then
   exit 0
 fi
 commit=$(git -C "$root" rev-parse --short HEAD)
-dirty=$(git -C "$root" status --porcelain --untracked-files=no | grep -q . && echo " with local changes" || true)
+dirty=$(git -C "$root" status --porcelain --untracked-files=no -- lib apps | grep -q . &&
+  echo " with local changes to lib/ or apps/" || true)
 cat >"$work/meta.txt" <<META
 Commit $commit$dirty, $(date -u +%Y-%m-%d), $(valgrind --version), $(c++ --version | head -1), $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg). Command: \`bash scripts/bench_stage_cost.sh --n $counts\`.
 META
