@@ -26,7 +26,9 @@ done
 command -v valgrind >/dev/null || { echo "bench_stage_cost.sh: needs valgrind" >&2; exit 1; }
 work=$(mktemp -d)
 cleanup() {
-  if [[ -n "$baseline" && -d "$work/tree" ]]; then git -C "$root" worktree remove --force "$work/tree"; fi
+  if [[ -n "$baseline" && -d "$work/tree" ]]; then
+    git -C "$root" worktree remove --force "$work/tree"
+  fi
   rm -rf "$work"
 }
 trap cleanup EXIT

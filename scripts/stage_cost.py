@@ -70,7 +70,8 @@ def parse(path):
 
 
 def short(name):
-    """camproj::internal::SelectModel(std::vector<...> const&, ...) -> camproj::internal::SelectModel()"""
+    """A function's name without its arguments: camproj::internal::SelectModel(std::vector<...>
+    const&, ...) -> camproj::internal::SelectModel()."""
     name = name.replace("(anonymous namespace)", "anon")
     out = []
     depth = 0
@@ -117,7 +118,8 @@ PARTS = [
      lambda a, b: b == "camproj::internal::FocalSweepStart()"),
     ("second", "every fit below 20 points: the second start's SQPnP (refine.cc, as at "
      + BASELINE_REV + ")",
-     lambda a, b: a == "camproj::internal::RefineCamera()" and b == "camproj::internal::PnpStart()"),
+     lambda a, b: (a == "camproj::internal::RefineCamera()"
+                   and b == "camproj::internal::PnpStart()")),
 ]
 
 
