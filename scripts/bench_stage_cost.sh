@@ -26,7 +26,9 @@ done
 command -v valgrind >/dev/null || { echo "bench_stage_cost.sh: needs valgrind" >&2; exit 1; }
 work=$(mktemp -d)
 cleanup() {
-  if [[ -n "$baseline" && -d "$work/tree" ]]; then git -C "$root" worktree remove --force "$work/tree"; fi
+  if [[ -n "$baseline" && -d "$work/tree" ]]; then
+    git -C "$root" worktree remove --force "$work/tree"
+  fi
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -62,7 +64,8 @@ if [[ -n "$baseline" ]]; then
   exit 0
 fi
 commit=$(git -C "$root" rev-parse --short HEAD)
-dirty=$(git -C "$root" status --porcelain --untracked-files=no | grep -q . && echo " with local changes" || true)
+dirty=$(git -C "$root" status --porcelain --untracked-files=no -- lib apps | grep -q . &&
+  echo " with local changes to lib/ or apps/" || true)
 cat >"$work/meta.txt" <<META
 Commit $commit$dirty, $(date -u +%Y-%m-%d), $(valgrind --version), $(c++ --version | head -1), $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg). Command: \`bash scripts/bench_stage_cost.sh --n $counts\`.
 META

@@ -88,7 +88,8 @@ Row Measure(int n, int seeds) {
         for (const double v : {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2, fit.rms_px}) {
           MixDouble(&row.digest, v);
         }
-        for (int i = 0; i < 3; ++i) MixDouble(&row.digest, fit.camera.cam_from_world.translation(i));
+        const Eigen::Vector3d& t = fit.camera.cam_from_world.translation;
+        for (int i = 0; i < 3; ++i) MixDouble(&row.digest, t(i));
       } catch (const std::exception& e) {
         times_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
         ++row.refused;

@@ -6,9 +6,9 @@
 // running it under callgrind (scripts/bench_stage_cost.sh, docs/bench/stage_cost.md): the
 // machines are shared, wall time is the secondary number.
 //
-// Uses only the public API that FitCameraAuto had before the default path's rewrite (model_select.h,
-// synth.h), so the same scenes can be fitted by an older library: compiled with
-// -DCAMPROJ_STAGE_COST_MAIN this file is a program of its own (scripts/bench_stage_cost.sh
+// Uses only the public API that FitCameraAuto had before the default path's rewrite
+// (model_select.h, synth.h), so the same scenes can be fitted by an older library: compiled with
+// -DCAMPROJ_STAGE_COST_MAIN, stage_cost.cc is a program of its own (scripts/bench_stage_cost.sh
 // --baseline REV).
 #ifndef CAMPROJ_APPS_BENCH_STAGE_COST_H_
 #define CAMPROJ_APPS_BENCH_STAGE_COST_H_

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -175,10 +176,9 @@ class PixelUncertainty {
     const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
     moved_ = MovedAlong(camera, params, length_scale);
 
-    Eigen::MatrixXd jacobian;
-    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &jacobian);
+    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &fitted_jacobian_);
     Require(!behind, "point ", behind.value_or(0), " is not in front of the camera");
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    const Eigen::MatrixXd normal = fitted_jacobian_.transpose() * fitted_jacobian_;
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the eigen-decomposition, refusing near-singular directions.
     const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseMax(1e-300);
@@ -204,24 +204,40 @@ class PixelUncertainty {
     } catch (const std::invalid_argument&) {
       return infinity;
     }
+    return SigmaOf(jacobian);
+  }
+
+  // SigmaAt of fitted point i, whose Jacobian (J's rows 2i, 2i+1) is known: the same numbers.
+  double SigmaAtFitted(size_t i) const {
+    if (singular_) return std::numeric_limits<double>::infinity();
+    return SigmaOf(fitted_jacobian_.middleRows(2 * i, 2));
+  }
+
+ private:
+  // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
+  double SigmaOf(const Eigen::MatrixXd& jacobian) const {
     const Eigen::MatrixXd jx = jacobian * d_inverse_.asDiagonal();
     const double variance = (jx * scaled_inverse_ * jx.transpose()).trace();
     return sigma_px_ * std::sqrt(std::max(0.0, variance));
   }
 
- private:
   double sigma_px_;
   MovedCameras moved_;
+  Eigen::MatrixXd fitted_jacobian_;
   Eigen::VectorXd d_inverse_;
   Eigen::MatrixXd scaled_inverse_;
   bool singular_ = false;
 };
 
-}  // namespace
+// SceneTestPoints with, for each, the index of the fitted point it is (-1: a corner or face
+// centre of the box), whose Jacobian the uncertainty already has.
+struct TestPoints {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> fitted;
+};
 
-std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
-                                             const std::vector<Eigen::Vector3d>& points,
-                                             double min_thickness) {
+TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
+                        double min_thickness) {
   std::vector<Eigen::Vector3d> candidates = points;
   if (!points.empty()) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -254,15 +270,47 @@ std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
       }
     }
   }
-  std::vector<Eigen::Vector3d> inside;
-  for (const Eigen::Vector3d& x : candidates) {
-    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, x);
+  TestPoints inside;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, candidates[k]);
     if (u && u->x() >= -0.5 && u->x() <= camera.image_size.width - 0.5 && u->y() >= -0.5 &&
         u->y() <= camera.image_size.height - 0.5) {
-      inside.push_back(x);
+      inside.points.push_back(candidates[k]);
+      inside.fitted.push_back(k < points.size() ? static_cast<int>(k) : -1);
     }
   }
   return inside;
+}
+
+// TestPointsOf, or the fitted points themselves when none of the box is in the image.
+TestPoints TestPointsOrFitted(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
+                              double min_thickness) {
+  TestPoints test = TestPointsOf(camera, points, min_thickness);
+  if (test.points.empty()) {
+    test.points = points;
+    test.fitted.resize(points.size());
+    std::iota(test.fitted.begin(), test.fitted.end(), 0);
+  }
+  return test;
+}
+
+// The sigmas at the test points.
+std::vector<double> SigmasAt(const PixelUncertainty& uncertainty, const TestPoints& test) {
+  std::vector<double> sigmas;
+  sigmas.reserve(test.points.size());
+  for (size_t i = 0; i < test.points.size(); ++i) {
+    sigmas.push_back(test.fitted[i] >= 0 ? uncertainty.SigmaAtFitted(test.fitted[i])
+                                         : uncertainty.SigmaAt(test.points[i]));
+  }
+  return sigmas;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
+                                             const std::vector<Eigen::Vector3d>& points,
+                                             double min_thickness) {
+  return TestPointsOf(camera, points, min_thickness).points;
 }
 
 std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& model,
@@ -283,37 +331,35 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   check.checked = true;
   check.bound_px = options.max_uncertainty_px;
   const Camera& camera = selection.fit.camera;
-  std::vector<Eigen::Vector3d> test = SceneTestPoints(camera, kept_points);
-  if (test.empty()) test = kept_points;  // none in the image: judge the points themselves
+  const TestPoints test_points = TestPointsOrFitted(camera, kept_points, 0.0);
+  const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
   const std::vector<double> sigmas =
-      ReprojectionSigmaPx(camera, selection.options, kept_points, sigma, test);
+      SigmasAt(PixelUncertainty(camera, selection.options, kept_points, sigma), test_points);
   for (size_t i = 0; i < test.size(); ++i) {
     if (!(sigmas[i] <= check.max_sigma_px)) {
       check.max_sigma_px = sigmas[i];
       check.worst_pixel = *PixelFromWorld(camera, test[i]);
     }
   }
-  std::vector<Eigen::Vector3d> rival_test;  // computed for the first rival that counts
+  std::optional<TestPoints> rival_test;  // computed for the first rival that counts
   for (const Rival& rival : selection.rivals) {
     if (!(std::abs(rival.criterion - selection.criterion) <= kEqualFitCriterion)) continue;
-    if (rival_test.empty()) {
-      rival_test = SceneTestPoints(camera, kept_points, kRivalBoxThickness);
-      if (rival_test.empty()) rival_test = kept_points;
-    }
+    if (!rival_test) rival_test = TestPointsOrFitted(camera, kept_points, kRivalBoxThickness);
     // A richer rival scatters by its own uncertainty: only a shift beyond kRivalSigmas of it
     // is a different reading of the data rather than the rival's noise.
     std::vector<double> rival_sigmas;
     try {
       rival_sigmas =
-          ReprojectionSigmaPx(rival.camera, rival.options, kept_points, sigma, rival_test);
+          SigmasAt(PixelUncertainty(rival.camera, rival.options, kept_points, sigma), *rival_test);
     } catch (const std::invalid_argument&) {
       continue;  // a kept point behind the rival: not a reading of these points
     }
     double shift = 0.0;
-    for (size_t i = 0; i < rival_test.size(); ++i) {
-      const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, rival_test[i]);
-      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival.camera, rival_test[i]);
+    for (size_t i = 0; i < rival_test->points.size(); ++i) {
+      const Eigen::Vector3d& x = rival_test->points[i];
+      const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, x);
+      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival.camera, x);
       const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
       if (d > kRivalSigmas * rival_sigmas[i]) shift = std::max(shift, d);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "fit/selection.h"
 #include "fit/statistics.h"
@@ -53,12 +54,13 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
     const int p = NumParameters(model);
     if (2 * static_cast<int>(x.size()) - p < options.min_redundancy) continue;
     try {
-      const FitResult fit = FitCamera(x, u, size, model);
+      FitResult fit = FitCamera(x, u, size, model);
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
       const ConsistencyCheck check = CheckConsistency(lengths, p, noise, options);
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
+      subset.fit = Prefit{model, std::move(fit)};
       return subset;
     } catch (const std::exception& e) {
       // Not determined by this subset (or a numerical failure): try the next model.

@@ -7,6 +7,7 @@
 #ifndef CAMPROJ_SRC_FIT_OUTLIERS_H_
 #define CAMPROJ_SRC_FIT_OUTLIERS_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
 #include "fit/gate.h"
+#include "fit/selection.h"
 
 namespace camproj {
 namespace internal {
@@ -34,6 +36,7 @@ struct OutlierSearch {
 struct Screen {
   bool consistent = false;
   std::string summary;  // the gate's verdict, or the last refusal
+  std::optional<Prefit> fit;  // the model fitted and its fit, unless every model was refused
 };
 
 Screen ScreenPoints(const std::vector<Eigen::Vector3d>& points_in_world,

@@ -60,6 +60,19 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
   return e;
 }
 
+// Whether two options, made from the same caller's options, fit the same model: the projection
+// and every intrinsic's mode (the noise and the covariance do not change a fit). Known
+// intrinsics are not compared: never the same.
+bool SameModel(const FitOptions& a, const FitOptions& b) {
+  auto same = [](const ParameterMode& x, const ParameterMode& y) {
+    return x.kind == y.kind && x.value == y.value && x.value2 == y.value2;
+  };
+  return !a.known_intrinsics && !b.known_intrinsics && a.projection == b.projection &&
+         a.ransac == b.ransac && same(a.focal, b.focal) && same(a.aspect, b.aspect) &&
+         same(a.principal_point, b.principal_point) && same(a.skew, b.skew) &&
+         same(a.k1, b.k1) && same(a.k2, b.k2);
+}
+
 // Whether the caller's options allow an orthographic camera: nothing only a perspective camera
 // has is forced or given (principal point free, distortion), no RANSAC, no known intrinsics.
 bool OrthographicIsPossible(const FitOptions& options) {
@@ -111,7 +124,19 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
 
 Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
                       const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
-                      const AutoFitOptions& options) {
+                      const AutoFitOptions& options, const Prefit* prefit) {
+  // One model fitted: the prefit's fit where it is that model.
+  auto evaluate = [&](const FitOptions& model) {
+    if (prefit == nullptr || !SameModel(prefit->model, model)) {
+      return Evaluate(points, pixels, image_size, model);
+    }
+    Evaluation e;
+    e.options = model;
+    e.fit = prefit->fit;
+    e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
+    e.num_params = static_cast<int>(e.fit->free_parameters.size());
+    return e;
+  };
   FitOptions base = options.fit;
   base.ransac = false;
   if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
@@ -133,7 +158,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // mirrored world from a proper one), never where it was refused as mirrored, behind the
   // points, or short of points.
   base.compute_uncertainty = false;
-  const Evaluation base_fit = Evaluate(points, pixels, image_size, base);
+  const Evaluation base_fit = evaluate(base);
   const bool orthographic_allowed =
       options.allow_orthographic && OrthographicIsPossible(base) &&
       (base_fit.fit || base_fit.reason == SceneError::Reason::kDegenerate ||
@@ -151,7 +176,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
           ModeOf(affine_options, g) = ParameterMode::Free();
         }
       }
-      affine = Evaluate(points, pixels, image_size, affine_options);
+      affine = evaluate(affine_options);
     }
     return *affine;
   };
@@ -166,7 +191,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       FitOptions richest = base;
       for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
       if (num_equations - NumParameters(richest) < 1) continue;
-      const Evaluation e = top == 0 ? base_fit : Evaluate(points, pixels, image_size, richest);
+      const Evaluation e = top == 0 ? base_fit : evaluate(richest);
       if (e.fit && num_equations > e.num_params) {
         sigma = CombinedNoise(options, e.sum_squares, num_equations - e.num_params);
         found = true;
@@ -230,8 +255,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     ladder.final_options = base_options;
     // The base fitted before the noise was known has the same camera and residuals (the noise
     // only scales its sigmas, which the ladder does not read for the base).
-    ladder.final = evaluated_base != nullptr ? *evaluated_base
-                                             : Evaluate(points, pixels, image_size, base_options);
+    ladder.final = evaluated_base != nullptr ? *evaluated_base : evaluate(base_options);
     ladder.final_index = record(ladder.final, base_name,
                                 ladder.final.fit ? "simplest model"
                                                  : "not determined: " + ladder.final.refusal);
@@ -271,7 +295,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
           tried.push_back(c);
           continue;
         }
-        Evaluation trial = Evaluate(points, pixels, image_size, trial_options);
+        Evaluation trial = evaluate(trial_options);
         if (!trial.fit) {
           ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
                                    trial.refusal + ")";

@@ -41,12 +41,22 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
 // The number of parameters of `options`' model: pose (6; orthographic 5) + free intrinsics.
 int NumParameters(const FitOptions& options);
 
+// A model already fitted to the same points (the screen's, ScreenPoints): the selection reads
+// its fit where the ladder reaches that model instead of fitting it again. Its noise and
+// covariance settings may differ from the selection's (they do not change the camera).
+struct Prefit {
+  FitOptions model;
+  FitResult fit;
+};
+
 // Selects and fits the model for these points (the caller's, in options.fit.pixel_origin;
-// options.fit.ransac must be off). Throws SceneError when no model fits (the simplest model's
-// refusal), or kMirroredWorld when only a mirrored perspective camera beats an orthographic one.
+// options.fit.ransac must be off). `prefit`: a fit of these same points, or nullptr. Throws
+// SceneError when no model fits (the simplest model's refusal), or kMirroredWorld when only a
+// mirrored perspective camera beats an orthographic one.
 Selection SelectModel(const std::vector<Eigen::Vector3d>& points_in_world,
                       const std::vector<Eigen::Vector2d>& observed_pixels,
-                      const ImageSize& image_size, const AutoFitOptions& options);
+                      const ImageSize& image_size, const AutoFitOptions& options,
+                      const Prefit* prefit = nullptr);
 
 }  // namespace internal
 }  // namespace camproj
