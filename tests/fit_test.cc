@@ -289,6 +289,44 @@ TEST(FitTest, InvariantToWorldUnitsAndOffsets) {
   }
 }
 
+// Beyond ~1e154 the squares of the coordinates overflow, below ~1e-154 they underflow, so the
+// fitter's normalization must not square them. Times 2^k the input is exact, and so are its
+// centroid and RMS distance: the normalized world is the same bit for bit, and so is every
+// number of the fit (the translation and an orthographic scale in world units times 2^k, 2^-k).
+// (Before: the small scales were refused as collinear, the large ones ended in "K must be
+// finite".)
+TEST(FitTest, ExtremeWorldScalesGiveTheSameCameraBitForBit) {
+  std::mt19937_64 rng(78);
+  const RandomCamera camera = ProjectorLikeCamera(rng);
+  SceneOptions scene_options;
+  scene_options.num_points = 30;
+  scene_options.pixel_noise = 0.5;
+  const Scene scene = MakeScene(rng, camera, scene_options);
+  for (const Projection projection : {Projection::kPerspective, Projection::kOrthographic}) {
+    FitOptions options;
+    options.projection = projection;
+    if (projection == Projection::kOrthographic) options.principal_point = ParameterMode::Default();
+    const FitResult unit = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+    const double scale_power = projection == Projection::kOrthographic ? -1.0 : 0.0;
+    for (const int k : {-1000, -500, 500, 1000}) {
+      std::vector<Eigen::Vector3d> points = scene.points_in_world;
+      for (auto& x : points) x = std::ldexp(1.0, k) * x;
+      const FitResult scaled = FitCamera(points, scene.observed_pixels, camera.size, options);
+      const Intrinsics& a = unit.camera.intrinsics;
+      const Intrinsics& b = scaled.camera.intrinsics;
+      EXPECT_EQ(b.fx, std::ldexp(a.fx, static_cast<int>(scale_power * k))) << k;
+      EXPECT_EQ(b.fy, std::ldexp(a.fy, static_cast<int>(scale_power * k))) << k;
+      EXPECT_EQ(b.skew, std::ldexp(a.skew, static_cast<int>(scale_power * k))) << k;
+      EXPECT_EQ(b.cx, a.cx) << k;
+      EXPECT_EQ(b.cy, a.cy) << k;
+      EXPECT_EQ(scaled.camera.cam_from_world.rotation, unit.camera.cam_from_world.rotation) << k;
+      EXPECT_EQ(scaled.camera.cam_from_world.translation,
+                std::ldexp(1.0, k) * unit.camera.cam_from_world.translation) << k;
+      EXPECT_EQ(scaled.rms_px, unit.rms_px) << k;
+    }
+  }
+}
+
 SceneError::Reason RefusalOf(const std::vector<Eigen::Vector3d>& points,
                              const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                              const FitOptions& options, std::string* message) {
@@ -357,6 +395,25 @@ TEST_F(RefusalTest, NonFiniteInputNamesThePoint) {
   EXPECT_EQ(RefusalOf(points, scene_.observed_pixels, camera_.size, {}, &message_),
             SceneError::Reason::kNonFiniteInput);
   EXPECT_NE(message_.find("point 7"), std::string::npos) << message_;
+}
+
+// Finite coordinates whose sum overflows (|X| ~ 1e308) cannot be centred: refused as input a
+// double cannot hold, with the advice to change units -- not a NaN camera.
+TEST_F(RefusalTest, CoordinatesWhoseSumOverflowsAreRefused) {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 12; ++i) {
+    points.push_back(1e308 * Eigen::Vector3d(i < 6 ? 1 : -1, (i / 2) % 2 ? 1 : -1, i % 2 ? 1 : -1));
+  }
+  const std::vector<Eigen::Vector2d> pixels(scene_.observed_pixels.begin(),
+                                            scene_.observed_pixels.begin() + 12);
+  for (const Projection projection : {Projection::kPerspective, Projection::kOrthographic}) {
+    FitOptions options;
+    options.projection = projection;
+    options.principal_point = ParameterMode::Default();
+    EXPECT_EQ(RefusalOf(points, pixels, camera_.size, options, &message_),
+              SceneError::Reason::kNonFiniteInput);
+    EXPECT_NE(message_.find("change units"), std::string::npos) << message_;
+  }
 }
 
 TEST_F(RefusalTest, PointsBehindTheCamera) {

@@ -14,6 +14,7 @@
 
 #include "check.h"
 #include "fit/common.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
@@ -91,9 +92,19 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& x : points_in_world) centroid += x;
   centroid /= n;
+  Eigen::MatrixXd centred(n, 3);
+  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
+  const double scale = RmsRowLength(centred);
+  if (!std::isfinite(scale)) throw TooLargeForDouble();
+  std::vector<Eigen::Vector3d> points(n);
+  std::vector<Eigen::Vector2d> pixels(n);
+  // The shape from the normalized points (the scatter of the raw ones overflows above ~1e154).
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& x : points_in_world) scatter += (x - centroid) * (x - centroid).transpose();
-  const double scale = std::sqrt(scatter.trace() / n);
+  for (int i = 0; i < n; ++i) {
+    points[i] = centred.row(i).transpose() / scale;
+    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
+    scatter += points[i] * points[i].transpose();
+  }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(scatter);
   const Eigen::Vector3d extents = shape.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
   if (!(scale > 0.0) || extents(1) <= kOrthoCollinearRatio * extents(2)) {
@@ -105,12 +116,6 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                      "the points are coplanar: a plane seen orthographically has two mirror-image "
                      "poses (the sign of its tilt is not in the image); add points off the plane "
                      "or fit a perspective camera");
-  }
-  std::vector<Eigen::Vector3d> points(n);
-  std::vector<Eigen::Vector2d> pixels(n);
-  for (int i = 0; i < n; ++i) {
-    points[i] = (points_in_world[i] - centroid) / scale;
-    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
   }
 
   // Affine start: [X 1] a_row = u, v by least squares (4 x 4 normal equations).

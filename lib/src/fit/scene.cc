@@ -9,6 +9,7 @@
 
 #include "camproj/conventions.h"
 #include "check.h"
+#include "fit/common.h"
 
 namespace camproj {
 namespace internal {
@@ -25,6 +26,13 @@ constexpr double kPlanarRatio = 1e-9;
 constexpr double kPlanarStartRatio = 1e-2;
 
 }  // namespace
+
+SceneError TooLargeForDouble() {
+  return SceneError(SceneError::Reason::kNonFiniteInput,
+                    "the 3D points' coordinates are too large for double precision (their sum or "
+                    "differences overflow): divide every coordinate by a common factor (change "
+                    "units) and refit");
+}
 
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels) {
@@ -68,7 +76,9 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   centroid /= n;
   Eigen::MatrixXd centred(n, 3);
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
-  const double scale = std::sqrt(centred.squaredNorm() / n);
+  const double scale = RmsRowLength(centred);
+  if (!std::isfinite(scale)) throw TooLargeForDouble();
+  // (JacobiSVD scales the matrix to its largest entry itself.)
   const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
   const Eigen::Vector3d extents = shape.singularValues();
   if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {

@@ -45,11 +45,15 @@ struct Scene {
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels);
 
+// The refusal of finite coordinates whose centroid or spread overflows a double (|X| near
+// 1e308): kNonFiniteInput, with the advice to change units.
+SceneError TooLargeForDouble();
+
 // The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
 // `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when
 // 2N < 6 + free intrinsics or N < 4, kCollinearPoints when the points are collinear or coincide,
 // kPlanarUnderdetermined when coplanar points must determine more than 2 of focal, aspect,
-// principal point and skew.
+// principal point and skew, and TooLargeForDouble() when the coordinates overflow.
 Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options);
