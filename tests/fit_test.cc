@@ -416,6 +416,23 @@ TEST_F(RefusalTest, CoordinatesWhoseSumOverflowsAreRefused) {
   }
 }
 
+// 1e12 times farther from the origin than from each other, the points keep ~4 digits of their
+// positions relative to each other: a camera written in these coordinates moves their pixels by
+// ~0.04 px against the fit's (the refusal's own estimate). Refused, naming the fix; 4e6 mm (a
+// site in projected map coordinates) is fitted (InvariantToWorldUnitsAndOffsets).
+TEST_F(RefusalTest, OffsetsBeyondDoublePrecisionAreRefused) {
+  std::vector<Eigen::Vector3d> points = scene_.points_in_world;
+  for (auto& x : points) x += Eigen::Vector3d(1e12, -1e12, 1e12);
+  for (const Projection projection : {Projection::kPerspective, Projection::kOrthographic}) {
+    FitOptions options;
+    options.projection = projection;
+    options.principal_point = ParameterMode::Default();
+    EXPECT_EQ(RefusalOf(points, scene_.observed_pixels, camera_.size, options, &message_),
+              SceneError::Reason::kNonFiniteInput);
+    EXPECT_NE(message_.find("Subtract a common offset"), std::string::npos) << message_;
+  }
+}
+
 TEST_F(RefusalTest, PointsBehindTheCamera) {
   // Reflecting half the points through the camera centre keeps their pixels (the projective
   // camera cannot tell) but puts them behind it: no real camera sees all of them.

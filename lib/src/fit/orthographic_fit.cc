@@ -117,6 +117,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                      "poses (the sign of its tilt is not in the image); add points off the plane "
                      "or fit a perspective camera");
   }
+  CheckOffset(points_in_world, scale, pixels);
 
   // Affine start: [X 1] a_row = u, v by least squares (4 x 4 normal equations).
   Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();

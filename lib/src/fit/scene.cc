@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "camproj/conventions.h"
+#include "camproj/model_select.h"
 #include "check.h"
 #include "fit/common.h"
 
@@ -25,6 +28,13 @@ constexpr double kCollinearRatio = 1e-9;
 constexpr double kPlanarRatio = 1e-9;
 constexpr double kPlanarStartRatio = 1e-2;
 
+// Double precision's unit roundoff (2^-53): the relative rounding of every coordinate.
+constexpr double kUnitRoundoff = 0.5 * std::numeric_limits<double>::epsilon();
+// The most the rounding of the coordinates may move the pixels: a tenth of the smallest pixel
+// noise the model selection believes (kMinNoisePx), so that an offset never changes its
+// decisions, even on noise-free data.
+constexpr double kMaxOffsetRoundingPx = 0.1 * kMinNoisePx;
+
 }  // namespace
 
 SceneError TooLargeForDouble() {
@@ -32,6 +42,29 @@ SceneError TooLargeForDouble() {
                     "the 3D points' coordinates are too large for double precision (their sum or "
                     "differences overflow): divide every coordinate by a common factor (change "
                     "units) and refit");
+}
+
+void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
+                 const std::vector<Eigen::Vector2d>& pixels) {
+  double largest = 0.0;
+  for (const auto& x : points_in_world) largest = std::max(largest, x.cwiseAbs().maxCoeff());
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : pixels) mean += p / static_cast<double>(pixels.size());
+  Eigen::MatrixXd centred(pixels.size(), 2);
+  for (size_t i = 0; i < pixels.size(); ++i) centred.row(i) = (pixels[i] - mean).transpose();
+  const double offset = largest / scale;  // in units of the points' spread
+  const double rounding = kUnitRoundoff * offset;
+  const double rounding_px = rounding * RmsRowLength(centred);
+  if (rounding_px > kMaxOffsetRoundingPx) {
+    throw SceneError(
+        SceneError::Reason::kNonFiniteInput,
+        Concat(std::setprecision(2), "the 3D points are ", offset,
+               " times as far from the origin as from each other: double precision rounds their "
+               "positions relative to each other by ", rounding, " of their spread, which moves "
+               "their pixels by about ", rounding_px, " px, and so would the camera written with "
+               "these coordinates. Subtract a common offset from every point (e.g. the first "
+               "point), refit, and use the camera with the offset subtracted"));
+  }
 }
 
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
@@ -86,6 +119,7 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                      "the 3D points are collinear (or coincide): a line does not determine a "
                      "camera's rotation about it; add points off the line");
   }
+  CheckOffset(points_in_world, scale, scene.pixels);
   scene.centroid = centroid;
   scene.scale = scale;
   scene.points.resize(n);

@@ -49,11 +49,20 @@ void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
 // 1e308): kNonFiniteInput, with the advice to change units.
 SceneError TooLargeForDouble();
 
+// Refuses (kNonFiniteInput) points so far from the origin against their spread (`scale`, their
+// RMS distance from their centroid) that double precision's rounding of their coordinates moves
+// their pixels (kCenter) by more than a tenth of kMinNoisePx: the camera, written in these
+// coordinates, could not reproduce the fit. (Pixels spread over a 4000 px square: offsets
+// above ~5e7 times the points' spread.) The message says to subtract an offset.
+void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
+                 const std::vector<Eigen::Vector2d>& pixels);
+
 // The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
 // `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when
 // 2N < 6 + free intrinsics or N < 4, kCollinearPoints when the points are collinear or coincide,
 // kPlanarUnderdetermined when coplanar points must determine more than 2 of focal, aspect,
-// principal point and skew, and TooLargeForDouble() when the coordinates overflow.
+// principal point and skew, TooLargeForDouble() when the coordinates overflow, and as
+// CheckOffset when they are too far from the origin.
 Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options);
