@@ -199,6 +199,18 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   } else {
     result.termination = "not refined (closed-form start only)";
   }
+  // The refinement may cross to a negative scale or fy: the same image as positive ones with
+  // the camera's x and/or y axis turned over (and z with them, keeping the rotation proper).
+  const double sign_x = k[0] < 0.0 ? -1.0 : 1.0;
+  const double sign_y = k[1] * k[0] < 0.0 ? -1.0 : 1.0;
+  if (sign_y < 0.0 && !skew_free && k[2] != 0.0) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the orthographic camera that fits these points has its image's y axis "
+                     "turned over, which the given skew does not allow: free the skew or check "
+                     "the correspondences");
+  }
+  rotation = Eigen::Vector3d(sign_x, sign_y, sign_x * sign_y).asDiagonal() * rotation;
+  k = {sign_x * k[0], sign_x * sign_y * k[1], sign_y * k[2]};
 
   // Residuals, and the Jacobian at the solution (omega = 0) for the uncertainty.
   ceres::Problem problem;
