@@ -407,6 +407,29 @@ TEST_F(RefusalTest, TooFewPointsForTheFreeParameters) {
   EXPECT_NE(message_.find("6 non-coplanar"), std::string::npos) << message_;
 }
 
+// A point given more than once adds no equation: 4 distinct points, each three times, determine
+// pose + focal (8 equations for 7 unknowns; the focal sweep, as the DLT needs 6 distinct
+// points) but not the 10 unknowns of the default model. (Before, the 12 rows counted as 12
+// points: the DLT ran on 4 distinct ones and refused the scene as points behind the camera.)
+TEST_F(RefusalTest, RepeatedPointsCountOnce) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  for (int copy = 0; copy < 3; ++copy) {
+    for (int i = 0; i < 4; ++i) {
+      points.push_back(scene_.points_in_world[i]);
+      pixels.push_back(scene_.true_pixels[i]);
+    }
+  }
+  const Intrinsics& k = camera_.intrinsics;
+  FitOptions focal_only;
+  focal_only.aspect = ParameterMode::Fixed(k.fy / k.fx);
+  focal_only.principal_point = ParameterMode::Fixed(k.cx, k.cy);
+  const FitResult fit = FitCamera(points, pixels, camera_.size, focal_only);
+  EXPECT_NEAR(fit.camera.intrinsics.fx, k.fx, kRecoveryRelative * k.fx);
+  EXPECT_EQ(RefusalOf(points, pixels, camera_.size, {}, &message_), SceneError::Reason::kTooFewPoints);
+  EXPECT_NE(message_.find("12 points (4 distinct) give 8 equations"), std::string::npos) << message_;
+}
+
 TEST_F(RefusalTest, CollinearPoints) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;

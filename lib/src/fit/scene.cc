@@ -91,13 +91,17 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   const int n = static_cast<int>(points_in_world.size());
   const int num_params = 6 + scene.model.NumFree();
   // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
-  if (2 * n < num_params || n < 4) {
+  // `count`: the distinct points, as a point given twice adds no equation.
+  auto require_points = [&](int count) {
+    if (2 * count >= num_params && count >= 4) return;
     throw SceneError(SceneError::Reason::kTooFewPoints,
-                     Concat(n, " points give ", 2 * n, " equations, but the model has ",
+                     Concat(n, " points", count < n ? Concat(" (", count, " distinct)") : "",
+                            " give ", 2 * count, " equations, but the model has ",
                             num_params, " unknowns (pose 6 + ", scene.model.NumFree(),
                             " free intrinsics) and a unique pose needs 4 points: add points (at "
                             "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
-  }
+  };
+  require_points(n);
 
   // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
   // offsets reach the numerics.
@@ -119,6 +123,14 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                      "the 3D points are collinear (or coincide): a line does not determine a "
                      "camera's rotation about it; add points off the line");
   }
+  std::vector<Eigen::Vector3d> sorted = points_in_world;
+  auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  std::sort(sorted.begin(), sorted.end(), less);
+  scene.num_distinct_points =
+      static_cast<int>(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
+  require_points(scene.num_distinct_points);
   CheckOffset(points_in_world, scale, scene.pixels);
   scene.centroid = centroid;
   scene.scale = scale;
