@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/fit.h"
+#include "camproj/model_select.h"
 #include "camproj/synth.h"
 
 namespace camproj {
@@ -106,6 +107,51 @@ TEST(DeterminationTest, PredictsTheScatterOfRepeatedFits) {
     }
   }
   for (size_t i = 0; i < test.size(); ++i) EXPECT_NEAR(mean_ratio[i], 1.0, 0.28) << "point " << i;
+}
+
+// The check works in the points' centred, unit-RMS world, so the same scene in other units or
+// far from the origin is judged the same. Times 2^k everything is exact: the same numbers bit
+// for bit. Moved by 1e7 scene sizes, the points and the camera are rounded by ~1e-9 of the
+// scene (u * 1e7), which moves the sigmas by ~1e-9 relative times the normal equations'
+// condition (below 1e3 here): 1e-6 relative. (Before, central differences in world units: at
+// 2^-600 the squared distances underflowed to an infinite sigma, at 2^600 they overflowed to
+// std::invalid_argument, and at 1e7 the steps, 1e-6 of the distance, met the rounding: 1e-3.)
+TEST(DeterminationTest, TheSameInAnyUnitsAndFarFromTheOrigin) {
+  constexpr double kMovedRelative = 1e-6;
+  const SynthScene scene = Scene(5, 0.5);
+  const std::vector<Eigen::Vector3d>& points = scene.correspondences.points_in_world;
+  const FitOptions model = Model(true, false);
+  internal::Selection selection;
+  selection.fit = FitCamera(points, scene.correspondences.pixels, scene.truth.image_size, model);
+  selection.options = model;
+  selection.options.pixel_sigma = 0.5;
+  selection.sigma_px = 0.5;
+  const AutoFitOptions options;
+  const DeterminationCheck reference = internal::CheckDetermination(selection, points, options);
+  ASSERT_TRUE(std::isfinite(reference.max_sigma_px));
+
+  for (const int k : {-600, 600}) {
+    const double unit = std::ldexp(1.0, k);
+    std::vector<Eigen::Vector3d> scaled = points;
+    for (auto& x : scaled) x *= unit;
+    internal::Selection moved = selection;
+    Camera& camera = moved.fit.camera;
+    camera.cam_from_world.translation *= unit;
+    camera.z_near *= unit;
+    camera.z_far *= unit;
+    const DeterminationCheck check = internal::CheckDetermination(moved, scaled, options);
+    EXPECT_EQ(check.max_sigma_px, reference.max_sigma_px) << k;
+    EXPECT_EQ(check.worst_pixel, reference.worst_pixel) << k;
+  }
+
+  const Eigen::Vector3d offset = 1e7 * Eigen::Vector3d(0.6, -0.48, 0.64);  // scene size ~1
+  std::vector<Eigen::Vector3d> far = points;
+  for (auto& x : far) x += offset;
+  internal::Selection moved = selection;
+  Rigid3& cam_from_world = moved.fit.camera.cam_from_world;
+  cam_from_world.translation -= cam_from_world.rotation * offset;
+  const DeterminationCheck check = internal::CheckDetermination(moved, far, options);
+  EXPECT_NEAR(check.max_sigma_px, reference.max_sigma_px, kMovedRelative * reference.max_sigma_px);
 }
 
 }  // namespace

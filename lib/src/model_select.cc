@@ -192,7 +192,9 @@ Gated Gate(internal::Selection selection, const std::vector<int>& left_out,
   gated.residuals_px = internal::ResidualsAgainst(selection.fit.camera, points, pixels,
                                                   options.fit.pixel_origin);
   gated.check = internal::CheckConsistency(
-      KeptLengths(gated.residuals_px, left_out), static_cast<int>(selection.fit.free_parameters.size()), noise, options);
+      KeptLengths(gated.residuals_px, left_out),
+      internal::Repeats(Kept(points, left_out), Kept(pixels, left_out)),
+      static_cast<int>(selection.fit.free_parameters.size()), noise, options);
   gated.selection = std::move(selection);
   return gated;
 }

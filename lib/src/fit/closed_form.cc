@@ -191,7 +191,10 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
   start.rotation = r;
   start.center = -m.inverse() * p.col(3);
   start.intrinsics = IntrinsicsFromK(k);
-  if (m.determinant() < 0.0) {
+  // det R has the sign of det M, but read from R: where M is nearly singular (the DLT does not
+  // determine the camera, e.g. a plane and one point off it) det M's rounding can disagree with
+  // the factor used.
+  if (r.determinant() < 0.0) {
     // K R (X - C) = K (R F) (F X - F C) with F = diag(1, 1, -1): a proper rotation R F in the
     // world with z negated. Under noise a nearly degenerate scene can flip the sign, so the
     // fitter decides (start.cc) whether the world is really mirrored.

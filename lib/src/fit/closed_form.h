@@ -17,9 +17,9 @@ struct StartCamera {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Intrinsics intrinsics;  // kCenter, k1 = k2 = 0
-  // DltStart only: the DLT's 3x3 part has det < 0, i.e. the points are seen as through a
-  // mirror. rotation and center are then those of the world with z negated (z -> -z), where
-  // the same linear camera has a proper rotation.
+  // DltStart only: the DLT's 3x3 part has det < 0 (its rotation factor does), i.e. the points
+  // are seen as through a mirror. rotation and center are then those of the world with z
+  // negated (z -> -z), where the same linear camera has a proper rotation.
   bool mirrored = false;
 };
 

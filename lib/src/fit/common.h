@@ -27,6 +27,17 @@ inline double MicrosecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+// The RMS length of the rows of `centred` (points minus their centroid): the normalized world's
+// scale. The squares are summed on the coordinates times a power of two (exact), so that they
+// neither overflow above ~1e154 nor underflow below ~1e-154; elsewhere the result is bit for bit
+// sqrt(squaredNorm / rows). 0 when every row is 0; not finite when a coordinate is not.
+inline double RmsRowLength(const Eigen::MatrixXd& centred) {
+  const double largest = centred.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0 && std::isfinite(largest))) return largest;
+  const double unit = std::ldexp(1.0, -std::ilogb(largest));  // largest * unit in [1, 2)
+  return std::sqrt((unit * centred).squaredNorm() / static_cast<double>(centred.rows())) / unit;
+}
+
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest
 // eigenvalue is the reciprocal condition the fitters refuse on (kDegenerate), and its inverse
 // gives the covariance. `Matrix` is Eigen::MatrixXd or a fixed-capacity type.

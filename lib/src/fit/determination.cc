@@ -14,6 +14,7 @@
 #include "camproj/conventions.h"
 #include "camproj/pose.h"
 #include "check.h"
+#include "fit/common.h"
 #include "fit/gate.h"
 
 namespace camproj {
@@ -156,6 +157,22 @@ std::optional<size_t> PixelJacobian(const MovedCameras& moved,
     }
   }
   return std::nullopt;
+}
+
+// `camera` for the world point_in_world = origin + unit * y: the same pixel for y as `camera`
+// gives for the point. (Perspective: the cam-frame point scales by unit, which a pinhole does not
+// see; orthographic: fx, fy and skew are px per world unit.)
+Camera InUnitWorld(const Camera& camera, const Eigen::Vector3d& origin, double unit) {
+  Camera moved = camera;
+  moved.cam_from_world.translation = (camera.cam_from_world * origin) / unit;
+  moved.z_near /= unit;
+  moved.z_far /= unit;
+  if (camera.projection == Projection::kOrthographic) {
+    moved.intrinsics.fx *= unit;
+    moved.intrinsics.fy *= unit;
+    moved.intrinsics.skew *= unit;
+  }
+  return moved;
 }
 
 // ReprojectionSigmaPx's linearization of one camera, prepared once: the moved cameras and the
@@ -330,12 +347,25 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   DeterminationCheck check;
   check.checked = true;
   check.bound_px = options.max_uncertainty_px;
-  const Camera& camera = selection.fit.camera;
-  const TestPoints test_points = TestPointsOrFitted(camera, kept_points, 0.0);
+  // Everything below in the points' centred, unit-RMS world (as the fitter's): in world units
+  // the squared lengths overflow or underflow beyond ~1e+-154, and at an offset of 1e10 scene
+  // sizes the finite-difference steps (1e-6 of the scene) fall below the coordinates' rounding.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& x : kept_points) origin += x;
+  origin /= static_cast<double>(kept_points.size());
+  Eigen::MatrixXd centred(kept_points.size(), 3);
+  for (size_t i = 0; i < kept_points.size(); ++i) {
+    centred.row(i) = (kept_points[i] - origin).transpose();
+  }
+  const double unit = RmsRowLength(centred);
+  std::vector<Eigen::Vector3d> points(kept_points.size());
+  for (size_t i = 0; i < kept_points.size(); ++i) points[i] = centred.row(i).transpose() / unit;
+  const Camera camera = InUnitWorld(selection.fit.camera, origin, unit);
+  const TestPoints test_points = TestPointsOrFitted(camera, points, 0.0);
   const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
   const std::vector<double> sigmas =
-      SigmasAt(PixelUncertainty(camera, selection.options, kept_points, sigma), test_points);
+      SigmasAt(PixelUncertainty(camera, selection.options, points, sigma), test_points);
   for (size_t i = 0; i < test.size(); ++i) {
     if (!(sigmas[i] <= check.max_sigma_px)) {
       check.max_sigma_px = sigmas[i];
@@ -345,13 +375,14 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   std::optional<TestPoints> rival_test;  // computed for the first rival that counts
   for (const Rival& rival : selection.rivals) {
     if (!(std::abs(rival.criterion - selection.criterion) <= kEqualFitCriterion)) continue;
-    if (!rival_test) rival_test = TestPointsOrFitted(camera, kept_points, kRivalBoxThickness);
+    if (!rival_test) rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness);
     // A richer rival scatters by its own uncertainty: only a shift beyond kRivalSigmas of it
     // is a different reading of the data rather than the rival's noise.
+    const Camera rival_camera = InUnitWorld(rival.camera, origin, unit);
     std::vector<double> rival_sigmas;
     try {
       rival_sigmas =
-          SigmasAt(PixelUncertainty(rival.camera, rival.options, kept_points, sigma), *rival_test);
+          SigmasAt(PixelUncertainty(rival_camera, rival.options, points, sigma), *rival_test);
     } catch (const std::invalid_argument&) {
       continue;  // a kept point behind the rival: not a reading of these points
     }
@@ -359,7 +390,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     for (size_t i = 0; i < rival_test->points.size(); ++i) {
       const Eigen::Vector3d& x = rival_test->points[i];
       const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, x);
-      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival.camera, x);
+      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival_camera, x);
       const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
       if (d > kRivalSigmas * rival_sigmas[i]) shift = std::max(shift, d);
     }

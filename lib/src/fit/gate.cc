@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
+#include <tuple>
 
 #include "fit/statistics.h"
 
@@ -26,20 +28,42 @@ NoiseReference NoiseReferenceOf(const AutoFitOptions& options) {
   return noise;
 }
 
-ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px, int num_params,
+std::vector<bool> Repeats(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<Eigen::Vector2d>& pixels) {
+  auto key = [&](int i) {
+    return std::make_tuple(points[i].x(), points[i].y(), points[i].z(), pixels[i].x(),
+                           pixels[i].y());
+  };
+  std::vector<int> order(points.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  std::vector<bool> repeats(points.size(), false);
+  for (size_t k = 1; k < order.size(); ++k) repeats[order[k]] = key(order[k]) == key(order[k - 1]);
+  return repeats;
+}
+
+ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px,
+                                  const std::vector<bool>& repeats, int num_params,
                                   const NoiseReference& noise, const AutoFitOptions& options) {
   ConsistencyCheck check;
   check.checked = true;
   check.noise_px = noise.sigma_px;
   check.noise_source = noise.Source();
   check.significance = options.significance;
-  const int n = static_cast<int>(residual_lengths_px.size());
-  double sum_squares = 0.0;
-  for (const double r : residual_lengths_px) {
-    sum_squares += r * r;
+  double sum_squares_all = 0.0;
+  std::vector<double> observed;  // one residual per observation
+  for (size_t i = 0; i < residual_lengths_px.size(); ++i) {
+    const double r = residual_lengths_px[i];
+    sum_squares_all += r * r;
     check.max_residual_px = std::max(check.max_residual_px, r);
+    if (repeats.empty() || !repeats[i]) observed.push_back(r);
   }
-  check.rms_px = n > 0 ? std::sqrt(sum_squares / n) : 0.0;
+  if (!residual_lengths_px.empty()) {
+    check.rms_px = std::sqrt(sum_squares_all / static_cast<double>(residual_lengths_px.size()));
+  }
+  const int n = static_cast<int>(observed.size());
+  double sum_squares = 0.0;
+  for (const double r : observed) sum_squares += r * r;
   const int dof = 2 * n - num_params;
   if (dof <= 0) {
     check.passed = std::isfinite(sum_squares);
@@ -50,8 +74,7 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
   const double tolerance = options.noise_tolerance * noise.sigma_px;
   const double chi2_bound = ChiSquareQuantile(dof, 1.0 - options.significance);
   check.noise_bound_px = tolerance * std::sqrt(chi2_bound / dof);
-  check.robust_noise_px =
-      Median(residual_lengths_px) / kRayleighMedian * std::sqrt(2.0 * n / dof);
+  check.robust_noise_px = Median(observed) / kRayleighMedian * std::sqrt(2.0 * n / dof);
   check.max_residual_bound_px = MaxResidualBound(n, options.significance) *
                                 std::max(check.robust_noise_px, noise.sigma_px);
   const bool noise_ok = check.noise_estimate_px <= check.noise_bound_px;

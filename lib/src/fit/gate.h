@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
 
@@ -28,12 +30,21 @@ struct NoiseReference {
 
 NoiseReference NoiseReferenceOf(const AutoFitOptions& options);
 
+// Which correspondences repeat an earlier one exactly (the same point with the same pixel): one
+// observation written twice, which adds no redundancy.
+std::vector<bool> Repeats(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<Eigen::Vector2d>& pixels);
+
 // Tests the residual lengths (px) of the points a fit kept, for a model of num_params
-// parameters: (1) chi-square: sum r^2 <= (tolerance * noise)^2 * chi2_{2N-p}(1 - alpha);
-// (2) largest residual <= sqrt(2 ln(N / alpha)) * max(robust noise, noise), the robust noise
-// being median |r| / sqrt(2 ln 2), scaled by sqrt(2N / (2N - p)) for the fit's leverage. With no
-// redundant equation (2N <= p) nothing can be tested and the check passes, saying so.
-ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px, int num_params,
+// parameters, counting each observation once (`repeats`: Repeats of those points, the copies
+// to leave out; empty: none), N observations: (1) chi-square: sum r^2 <= (tolerance *
+// noise)^2 * chi2_{2N-p}(1 - alpha); (2) largest residual <= sqrt(2 ln(N / alpha)) *
+// max(robust noise, noise), the robust noise being median |r| / sqrt(2 ln 2), scaled by
+// sqrt(2N / (2N - p)) for the fit's leverage. With no redundant equation (2N <= p) nothing can
+// be tested and the check passes, saying so. rms_px and max_residual_px are over every point
+// kept.
+ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px,
+                                  const std::vector<bool>& repeats, int num_params,
                                   const NoiseReference& noise, const AutoFitOptions& options);
 
 }  // namespace internal

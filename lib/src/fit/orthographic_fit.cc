@@ -14,6 +14,7 @@
 
 #include "check.h"
 #include "fit/common.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
@@ -91,9 +92,19 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& x : points_in_world) centroid += x;
   centroid /= n;
+  Eigen::MatrixXd centred(n, 3);
+  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
+  const double scale = RmsRowLength(centred);
+  if (!std::isfinite(scale)) throw TooLargeForDouble();
+  std::vector<Eigen::Vector3d> points(n);
+  std::vector<Eigen::Vector2d> pixels(n);
+  // The shape from the normalized points (the scatter of the raw ones overflows above ~1e154).
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& x : points_in_world) scatter += (x - centroid) * (x - centroid).transpose();
-  const double scale = std::sqrt(scatter.trace() / n);
+  for (int i = 0; i < n; ++i) {
+    points[i] = centred.row(i).transpose() / scale;
+    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
+    scatter += points[i] * points[i].transpose();
+  }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(scatter);
   const Eigen::Vector3d extents = shape.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
   if (!(scale > 0.0) || extents(1) <= kOrthoCollinearRatio * extents(2)) {
@@ -106,12 +117,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                      "poses (the sign of its tilt is not in the image); add points off the plane "
                      "or fit a perspective camera");
   }
-  std::vector<Eigen::Vector3d> points(n);
-  std::vector<Eigen::Vector2d> pixels(n);
-  for (int i = 0; i < n; ++i) {
-    points[i] = (points_in_world[i] - centroid) / scale;
-    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
-  }
+  CheckOffset(points_in_world, scale, pixels);
 
   // Affine start: [X 1] a_row = u, v by least squares (4 x 4 normal equations).
   Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
@@ -193,6 +199,18 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   } else {
     result.termination = "not refined (closed-form start only)";
   }
+  // The refinement may cross to a negative scale or fy: the same image as positive ones with
+  // the camera's x and/or y axis turned over (and z with them, keeping the rotation proper).
+  const double sign_x = k[0] < 0.0 ? -1.0 : 1.0;
+  const double sign_y = k[1] * k[0] < 0.0 ? -1.0 : 1.0;
+  if (sign_y < 0.0 && !skew_free && k[2] != 0.0) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the orthographic camera that fits these points has its image's y axis "
+                     "turned over, which the given skew does not allow: free the skew or check "
+                     "the correspondences");
+  }
+  rotation = Eigen::Vector3d(sign_x, sign_y, sign_x * sign_y).asDiagonal() * rotation;
+  k = {sign_x * k[0], sign_x * sign_y * k[1], sign_y * k[2]};
 
   // Residuals, and the Jacobian at the solution (omega = 0) for the uncertainty.
   ceres::Problem problem;

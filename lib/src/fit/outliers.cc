@@ -57,7 +57,7 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
       FitResult fit = FitCamera(x, u, size, model);
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
-      const ConsistencyCheck check = CheckConsistency(lengths, p, noise, options);
+      const ConsistencyCheck check = CheckConsistency(lengths, Repeats(x, u), p, noise, options);
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
       subset.fit = Prefit{model, std::move(fit)};

@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "camproj/conventions.h"
+#include "camproj/model_select.h"
 #include "check.h"
+#include "fit/common.h"
 
 namespace camproj {
 namespace internal {
@@ -24,7 +28,44 @@ constexpr double kCollinearRatio = 1e-9;
 constexpr double kPlanarRatio = 1e-9;
 constexpr double kPlanarStartRatio = 1e-2;
 
+// Double precision's unit roundoff (2^-53): the relative rounding of every coordinate.
+constexpr double kUnitRoundoff = 0.5 * std::numeric_limits<double>::epsilon();
+// The most the rounding of the coordinates may move the pixels: a tenth of the smallest pixel
+// noise the model selection believes (kMinNoisePx), so that an offset never changes its
+// decisions, even on noise-free data.
+constexpr double kMaxOffsetRoundingPx = 0.1 * kMinNoisePx;
+
 }  // namespace
+
+SceneError TooLargeForDouble() {
+  return SceneError(SceneError::Reason::kNonFiniteInput,
+                    "the 3D points' coordinates are too large for double precision (their sum or "
+                    "differences overflow): divide every coordinate by a common factor (change "
+                    "units) and refit");
+}
+
+void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
+                 const std::vector<Eigen::Vector2d>& pixels) {
+  double largest = 0.0;
+  for (const auto& x : points_in_world) largest = std::max(largest, x.cwiseAbs().maxCoeff());
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : pixels) mean += p / static_cast<double>(pixels.size());
+  Eigen::MatrixXd centred(pixels.size(), 2);
+  for (size_t i = 0; i < pixels.size(); ++i) centred.row(i) = (pixels[i] - mean).transpose();
+  const double offset = largest / scale;  // in units of the points' spread
+  const double rounding = kUnitRoundoff * offset;
+  const double rounding_px = rounding * RmsRowLength(centred);
+  if (rounding_px > kMaxOffsetRoundingPx) {
+    throw SceneError(
+        SceneError::Reason::kNonFiniteInput,
+        Concat(std::setprecision(2), "the 3D points are ", offset,
+               " times as far from the origin as from each other: double precision rounds their "
+               "positions relative to each other by ", rounding, " of their spread, which moves "
+               "their pixels by about ", rounding_px, " px, and so would the camera written with "
+               "these coordinates. Subtract a common offset from every point (e.g. the first "
+               "point), refit, and use the camera with the offset subtracted"));
+  }
+}
 
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels) {
@@ -50,13 +91,17 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   const int n = static_cast<int>(points_in_world.size());
   const int num_params = 6 + scene.model.NumFree();
   // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
-  if (2 * n < num_params || n < 4) {
+  // `count`: the distinct points, as a point given twice adds no equation.
+  auto require_points = [&](int count) {
+    if (2 * count >= num_params && count >= 4) return;
     throw SceneError(SceneError::Reason::kTooFewPoints,
-                     Concat(n, " points give ", 2 * n, " equations, but the model has ",
+                     Concat(n, " points", count < n ? Concat(" (", count, " distinct)") : "",
+                            " give ", 2 * count, " equations, but the model has ",
                             num_params, " unknowns (pose 6 + ", scene.model.NumFree(),
                             " free intrinsics) and a unique pose needs 4 points: add points (at "
                             "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
-  }
+  };
+  require_points(n);
 
   // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
   // offsets reach the numerics.
@@ -68,7 +113,9 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   centroid /= n;
   Eigen::MatrixXd centred(n, 3);
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
-  const double scale = std::sqrt(centred.squaredNorm() / n);
+  const double scale = RmsRowLength(centred);
+  if (!std::isfinite(scale)) throw TooLargeForDouble();
+  // (JacobiSVD scales the matrix to its largest entry itself.)
   const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
   const Eigen::Vector3d extents = shape.singularValues();
   if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
@@ -76,6 +123,15 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                      "the 3D points are collinear (or coincide): a line does not determine a "
                      "camera's rotation about it; add points off the line");
   }
+  std::vector<Eigen::Vector3d> sorted = points_in_world;
+  auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  };
+  std::sort(sorted.begin(), sorted.end(), less);
+  scene.num_distinct_points =
+      static_cast<int>(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
+  require_points(scene.num_distinct_points);
+  CheckOffset(points_in_world, scale, scene.pixels);
   scene.centroid = centroid;
   scene.scale = scale;
   scene.points.resize(n);

@@ -33,6 +33,9 @@ struct Scene {
   bool planar_start = false;
   // The cloud's principal axes as a rotation: for a plane, its in-plane axes, then its normal.
   Eigen::Matrix3d plane_basis = Eigen::Matrix3d::Identity();
+  // Points given more than once count once: the equations they add (the closed-form starts
+  // need 4 or 6 distinct points).
+  int num_distinct_points = 0;
   // The model the options ask for, before the closed-form start sets its free values.
   Model model;
   ImageSize image_size;
@@ -45,11 +48,24 @@ struct Scene {
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels);
 
+// The refusal of finite coordinates whose centroid or spread overflows a double (|X| near
+// 1e308): kNonFiniteInput, with the advice to change units.
+SceneError TooLargeForDouble();
+
+// Refuses (kNonFiniteInput) points so far from the origin against their spread (`scale`, their
+// RMS distance from their centroid) that double precision's rounding of their coordinates moves
+// their pixels (kCenter) by more than a tenth of kMinNoisePx: the camera, written in these
+// coordinates, could not reproduce the fit. (Pixels spread over a 4000 px square: offsets
+// above ~5e7 times the points' spread.) The message says to subtract an offset.
+void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
+                 const std::vector<Eigen::Vector2d>& pixels);
+
 // The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
 // `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when
-// 2N < 6 + free intrinsics or N < 4, kCollinearPoints when the points are collinear or coincide,
-// kPlanarUnderdetermined when coplanar points must determine more than 2 of focal, aspect,
-// principal point and skew.
+// 2N < 6 + free intrinsics or N < 4 (N: distinct points), kCollinearPoints when the points are
+// collinear or coincide, kPlanarUnderdetermined when coplanar points must determine more than 2
+// of focal, aspect, principal point and skew, TooLargeForDouble() when the coordinates overflow,
+// and as CheckOffset when they are too far from the origin.
 Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options);

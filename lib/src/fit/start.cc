@@ -91,7 +91,7 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
   const std::vector<Eigen::Vector3d>& points = scene.points;
   const std::vector<Eigen::Vector2d>& pixels = scene.pixels;
   const Model& start_model = scene.model;
-  const int n = scene.NumPoints();
+  const int n = scene.num_distinct_points;  // a repeated point adds no equation
   StartCamera start;
   const Intrinsics guess = start_model.ToIntrinsics();
   if (options.known_intrinsics) {
