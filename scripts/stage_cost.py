@@ -106,16 +106,14 @@ STAGES = [
     ("gate", "consistency gate on the selection (residuals, chi-square, largest residual)", True,
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::CheckConsistency()",
                                            "camproj::internal::ResidualsAgainst()")),
-    ("mirror", "mirror test: the chosen model fitted to the mirrored world (where n rms² / σ² "
-     "> 10.83: below, no mirrored fit could refuse)", True,
-     lambda a, b: is_pipeline(a) and b == "camproj::FitCamera()"),
+    ("mirror", "mirror test: the chosen model refined on the mirrored world from the camera's "
+     "depth reversal (where n rms² / σ² > 10.83: below, no mirrored fit could refuse)", True,
+     lambda a, b: is_pipeline(a) and b == "camproj::internal::MirroredReadingRmsPx()"),
     ("determination", "determination check: sigmas at the test points, rivals' shifts", True,
      lambda a, b: b == "camproj::internal::CheckDetermination()"),
 ]
 # Parts of the stages above, shown separately: (key, label, predicate).
 PARTS = [
-    ("sweep", "mirror test: its focal sweep (48 SQPnP solves, start.cc)",
-     lambda a, b: b == "camproj::internal::FocalSweepStart()"),
     ("second", "every fit below 20 points: the second start's SQPnP (refine.cc, as at "
      + BASELINE_REV + ")",
      lambda a, b: (a == "camproj::internal::RefineCamera()"
@@ -132,7 +130,7 @@ def measure(path):
         a, b = short(caller), short(callee)
         if a == b:
             continue
-        if is_pipeline(a) and b == "camproj::FitCamera()":
+        if is_pipeline(a) and b == "camproj::internal::MirroredReadingRmsPx()":
             stages["mirror_calls"] += calls  # the mirror test's fits (clean scenes: no refits)
         if b == "camproj::FitCameraAuto()":
             total += cost  # from the bench

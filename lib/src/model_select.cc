@@ -14,6 +14,7 @@
 #include "fit/common.h"
 #include "fit/determination.h"
 #include "fit/gate.h"
+#include "fit/mirror.h"
 #include "fit/outliers.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
@@ -107,34 +108,27 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
 
 // A right-handed world fits its proper camera better than the same model fits the world with z
 // negated; where the perspective is weak (a Necker-cube reading) the two fit about equally well
-// and either may win by noise. Refuses as mirrored when the mirrored reading fits significantly
-// better: by more than the chi-square 99.9 % quantile of one degree of freedom (10.83) in units
-// of the noise.
-void RefuseIfMirrorFitsBetter(double rms_px, const FitOptions& model,
+// and either may win by noise. Refuses as mirrored when the mirrored reading (fit/mirror.h: the
+// camera's depth reversal, refined) fits significantly better: by more than the chi-square
+// 99.9 % quantile of one degree of freedom (10.83) in units of the noise.
+void RefuseIfMirrorFitsBetter(const Camera& camera, double rms_px, const FitOptions& model,
                               const std::vector<Eigen::Vector3d>& kept_points,
                               const std::vector<Eigen::Vector2d>& kept_pixels,
-                              const ImageSize& size, const internal::NoiseReference& noise) {
+                              const internal::NoiseReference& noise) {
   constexpr double kSignificantChi2 = 10.83;
   if (model.projection != Projection::kPerspective) return;
   const double n = static_cast<double>(kept_points.size());
   const double sigma2 = noise.sigma_px * noise.sigma_px;
   // Even a mirrored reading that fits exactly (rms 0) beats this fit by n rms^2 / sigma^2 at
-  // most: when that is not more than kSignificantChi2 no mirrored fit can refuse, so it is not
-  // made (with its focal sweep it costs more than the rest of the default path; at 6-20 clicked
-  // points at 1 px it is never needed).
+  // most: when that is not more than kSignificantChi2 no mirrored fit can refuse.
   if (!(n * rms_px * rms_px / sigma2 > kSignificantChi2)) return;
-  FitOptions quick = model;
-  quick.compute_uncertainty = false;
-  double mirrored_rms = 0.0;
-  try {
-    mirrored_rms = FitCamera(Mirrored(kept_points), kept_pixels, size, quick).rms_px;
-  } catch (const std::exception&) {
-    return;  // no camera of the mirrored world
-  }
-  if (n * mirrored_rms * mirrored_rms / sigma2 + kSignificantChi2 < n * rms_px * rms_px / sigma2) {
+  const std::optional<double> mirrored_rms =
+      internal::MirroredReadingRmsPx(camera, model, kept_points, kept_pixels);
+  if (!mirrored_rms) return;  // no camera of the mirrored world
+  if (n * *mirrored_rms * *mirrored_rms / sigma2 + kSignificantChi2 < n * rms_px * rms_px / sigma2) {
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "the points fit a camera better with one world axis flipped (rms " +
-                         Px(mirrored_rms) + " against " + Px(rms_px) +
+                         Px(*mirrored_rms) + " against " + Px(rms_px) +
                          "): they are seen as through a mirror, i.e. the world frame is "
                          "left-handed. Flip one world axis (e.g. negate Z of every point, and "
                          "again in anything you render) and refit");
@@ -222,8 +216,8 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   // The refusals first, in order (mirror, gate, determination), on the selection as gated.
   const std::vector<Eigen::Vector3d> kept_points = Kept(points, left_out);
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
-  RefuseIfMirrorFitsBetter(gated.check.rms_px, gated.selection.options, kept_points,
-                           Kept(pixels, left_out), size, noise);
+  RefuseIfMirrorFitsBetter(gated.selection.fit.camera, gated.check.rms_px,
+                           gated.selection.options, kept_points, Kept(pixels, left_out), noise);
   if (!gated.check.passed) {
     throw SceneError(SceneError::Reason::kInconsistent,
                      "no camera explains these points: " + gated.check.summary +

@@ -345,18 +345,14 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const std::vector<Eigen::Vector2d>& pixels,
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
-                                       const FitOptions& options, Clock::time_point start_time) {
+                                       const FitOptions& options, Clock::time_point start_time,
+                                       int max_rounds) {
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
   outcome.center = start_center;
   outcome.model = model;
-  // LM's stopping rules can fire while it crawls along a curved, nearly flat valley (a nearly
-  // planar scene with the full model: 100 iterations left it 6 sigma from the optimum; at
-  // thickness 1e-4 it needs 700). The polish then does not converge, and LM resumes from where it
-  // stopped; after kMaxRounds the caller refuses rather than return a camera short of the minimum.
-  constexpr int kMaxRounds = 20;
   bool have_normal = false;
-  for (int round = 0; round < kMaxRounds && !outcome.converged; ++round) {
+  for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
     const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
     ParamVector u = problem.Pack(outcome.center);
     const LmSummary summary =
