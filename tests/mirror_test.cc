@@ -67,7 +67,8 @@ TEST(MirrorTest, RefinementFromTheReversalOfTheReversalFindsTheTruth) {
     synth.aspect = 1.01;
     const SynthScene scene = SynthesizeScene(synth);
     const std::vector<Eigen::Vector3d> mirrored = MirroredZ(scene.correspondences.points_in_world);
-    const Camera fitted_to_mirrored = internal::NeckerReversal(scene.truth, scene.correspondences.points_in_world);
+    const Camera fitted_to_mirrored =
+        internal::NeckerReversal(scene.truth, scene.correspondences.points_in_world);
     const std::optional<double> rms = internal::MirroredReadingRmsPx(
         fitted_to_mirrored, model, mirrored, scene.correspondences.pixels);
     ASSERT_TRUE(rms.has_value()) << "seed " << seed;

@@ -125,7 +125,8 @@ void RefuseIfMirrorFitsBetter(const Camera& camera, double rms_px, const FitOpti
   const std::optional<double> mirrored_rms =
       internal::MirroredReadingRmsPx(camera, model, kept_points, kept_pixels);
   if (!mirrored_rms) return;  // no camera of the mirrored world
-  if (n * *mirrored_rms * *mirrored_rms / sigma2 + kSignificantChi2 < n * rms_px * rms_px / sigma2) {
+  const double mirrored_chi2 = n * *mirrored_rms * *mirrored_rms / sigma2;
+  if (mirrored_chi2 + kSignificantChi2 < n * rms_px * rms_px / sigma2) {
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "the points fit a camera better with one world axis flipped (rms " +
                          Px(*mirrored_rms) + " against " + Px(rms_px) +

@@ -198,16 +198,17 @@ class PixelUncertainty {
     const Eigen::MatrixXd normal = fitted_jacobian_.transpose() * fitted_jacobian_;
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the eigen-decomposition, refusing near-singular directions.
-    const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseMax(1e-300);
-    d_inverse_ = d.cwiseInverse();
-    const Eigen::MatrixXd scaled = d_inverse_.asDiagonal() * normal * d_inverse_.asDiagonal();
+    const Eigen::VectorXd d_inverse = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+    const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
     const Eigen::VectorXd values = eigen.eigenvalues();
     singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));
-    if (!singular_) {
-      scaled_inverse_ = eigen.eigenvectors() * values.cwiseInverse().asDiagonal() *
-                        eigen.eigenvectors().transpose();
-    }
+    if (singular_) return;
+    // (J^T J)^-1 = W W^T with W = D^-1 V L^-1/2 (scaled = V L V^T): a point's variance is the
+    // squared norm of J_x W, and every fitted point's comes from one product J W.
+    whitening_ = d_inverse.asDiagonal() * eigen.eigenvectors() *
+                 values.cwiseSqrt().cwiseInverse().asDiagonal();
+    fitted_whitened_ = fitted_jacobian_ * whitening_;
   }
 
   // The 1-sigma length of the reprojection error of `x`; +inf where J^T J is singular or `x` is
@@ -227,22 +228,20 @@ class PixelUncertainty {
   // SigmaAt of fitted point i, whose Jacobian (J's rows 2i, 2i+1) is known: the same numbers.
   double SigmaAtFitted(size_t i) const {
     if (singular_) return std::numeric_limits<double>::infinity();
-    return SigmaOf(fitted_jacobian_.middleRows(2 * i, 2));
+    return sigma_px_ * std::sqrt(fitted_whitened_.middleRows(2 * i, 2).squaredNorm());
   }
 
  private:
   // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
   double SigmaOf(const Eigen::MatrixXd& jacobian) const {
-    const Eigen::MatrixXd jx = jacobian * d_inverse_.asDiagonal();
-    const double variance = (jx * scaled_inverse_ * jx.transpose()).trace();
-    return sigma_px_ * std::sqrt(std::max(0.0, variance));
+    return sigma_px_ * std::sqrt((jacobian * whitening_).squaredNorm());
   }
 
   double sigma_px_;
   MovedCameras moved_;
   Eigen::MatrixXd fitted_jacobian_;
-  Eigen::VectorXd d_inverse_;
-  Eigen::MatrixXd scaled_inverse_;
+  Eigen::MatrixXd whitening_;        // W: (J^T J)^-1 = W W^T
+  Eigen::MatrixXd fitted_whitened_;  // J W, two rows per fitted point
   bool singular_ = false;
 };
 
@@ -262,7 +261,8 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
     mean /= static_cast<double>(points.size());
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (const Eigen::Vector3d& x : points) scatter += (x - mean) * (x - mean).transpose();
-    const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
+    const Eigen::Matrix3d axes =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d hi = -lo;
     for (const Eigen::Vector3d& x : points) {

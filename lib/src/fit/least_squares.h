@@ -44,10 +44,10 @@ struct LeastSquaresOutcome {
 // Refines the camera point_in_cam = start_rotation * (point - start_center) with `model`'s free
 // slots over `points` (normalized world) and `pixels` (kCenter), under options' stopping rules
 // (max_iterations, function, gradient and parameter tolerances). Where the polish does not
-// settle, LM resumes from where it stopped, up to max_rounds rounds. `ok` is false when a point ends
-// behind the camera or the focal length or aspect is not positive (normal is then empty if the
-// normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one settling
-// step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
+// settle, LM resumes from where it stopped, up to max_rounds rounds. `ok` is false when a point
+// ends behind the camera or the focal length or aspect is not positive (normal is then empty if
+// the normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one
+// settling step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,
                                        const Eigen::Matrix3d& start_rotation,
