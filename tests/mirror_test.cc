@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/synth.h"
+#include "fit/common.h"
 
 namespace camproj {
 namespace {
@@ -15,10 +16,7 @@ namespace {
 // Exact algebra on O(1) numbers: a few ulps of the cam-frame coordinates (~1-10 units).
 constexpr double kAlgebraTolerance = 1e-12;
 
-std::vector<Eigen::Vector3d> MirroredZ(std::vector<Eigen::Vector3d> points) {
-  for (Eigen::Vector3d& x : points) x.z() = -x.z();
-  return points;
-}
+using internal::MirroredZ;
 
 // For every point x, the reversal sees the mirrored point at the same x, y and at the depth
 // reflected about the centroid's: 2 z_c - z. Its rotation is proper, and reversing twice gives

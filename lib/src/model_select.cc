@@ -83,12 +83,6 @@ bool Final(SceneError::Reason reason) {
          reason == SceneError::Reason::kPlanarUnderdetermined;
 }
 
-// The points with the world's z negated: the same scene seen through a mirror.
-std::vector<Eigen::Vector3d> Mirrored(std::vector<Eigen::Vector3d> points) {
-  for (auto& x : points) x.z() = -x.z();
-  return points;
-}
-
 // A scene that no camera explains may be a mirrored world whose reading the fit could not
 // tell: if the screen's model fits every point consistently once the world's z is negated,
 // throws kMirroredWorld with the advice to flip an axis.
@@ -96,7 +90,8 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                      const AutoFitOptions& options, const internal::NoiseReference& noise) {
   if (options.fit.projection != Projection::kPerspective) return;
-  const internal::Screen screen = internal::ScreenPoints(Mirrored(points), pixels, size, options, noise);
+  const internal::Screen screen =
+      internal::ScreenPoints(internal::MirroredZ(points), pixels, size, options, noise);
   if (screen.consistent) {
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "no camera explains these points, but with one world axis flipped they fit "

@@ -27,6 +27,19 @@ inline double MicrosecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
+// The mean of `points` (not empty): the normalized world's origin.
+inline Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& x : points) centroid += x;
+  return centroid / static_cast<double>(points.size());
+}
+
+// The points with the world's z negated: the same scene seen through a mirror.
+inline std::vector<Eigen::Vector3d> MirroredZ(std::vector<Eigen::Vector3d> points) {
+  for (Eigen::Vector3d& x : points) x.z() = -x.z();
+  return points;
+}
+
 // The RMS length of the rows of `centred` (points minus their centroid): the normalized world's
 // scale. The squares are summed on the coordinates times a power of two (exact), so that they
 // neither overflow above ~1e154 nor underflow below ~1e-154; elsewhere the result is bit for bit

@@ -256,9 +256,7 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
                         double min_thickness) {
   std::vector<Eigen::Vector3d> candidates = points;
   if (!points.empty()) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& x : points) mean += x;
-    mean /= static_cast<double>(points.size());
+    const Eigen::Vector3d mean = Centroid(points);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (const Eigen::Vector3d& x : points) scatter += (x - mean) * (x - mean).transpose();
     const Eigen::Matrix3d axes =
@@ -350,9 +348,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   // Everything below in the points' centred, unit-RMS world (as the fitter's): in world units
   // the squared lengths overflow or underflow beyond ~1e+-154, and at an offset of 1e10 scene
   // sizes the finite-difference steps (1e-6 of the scene) fall below the coordinates' rounding.
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& x : kept_points) origin += x;
-  origin /= static_cast<double>(kept_points.size());
+  const Eigen::Vector3d origin = Centroid(kept_points);
   Eigen::MatrixXd centred(kept_points.size(), 3);
   for (size_t i = 0; i < kept_points.size(); ++i) {
     centred.row(i) = (kept_points[i] - origin).transpose();

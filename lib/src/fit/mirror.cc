@@ -1,21 +1,18 @@
 #include "fit/mirror.h"
 
 #include <cmath>
-#include <exception>
 
 #include "camproj/pose.h"
-#include "fit/model.h"
+#include "fit/common.h"
 #include "fit/least_squares.h"
+#include "fit/model.h"
 #include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
 
 Camera NeckerReversal(const Camera& camera, const std::vector<Eigen::Vector3d>& points_in_world) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& x : points_in_world) centroid += x;
-  centroid /= static_cast<double>(points_in_world.size());
-  const double centroid_depth = (camera.cam_from_world * centroid).z();
+  const double centroid_depth = (camera.cam_from_world * Centroid(points_in_world)).z();
   const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
   Camera reversed = camera;
   reversed.cam_from_world.rotation = flip * camera.cam_from_world.rotation * flip;
@@ -34,8 +31,7 @@ std::optional<double> MirroredReadingRmsPx(const Camera& camera, const FitOption
   // bring near ours. Stopping early only raises the cost found -- a camera with that cost
   // exists -- so it can miss a refusal but never make a wrong one.
   constexpr int kMirrorIterations = 20;
-  std::vector<Eigen::Vector3d> mirrored = points_in_world;
-  for (Eigen::Vector3d& x : mirrored) x.z() = -x.z();
+  const std::vector<Eigen::Vector3d> mirrored = MirroredZ(points_in_world);
   const Camera reversed = NeckerReversal(camera, points_in_world);
   FitOptions options = model;
   options.max_iterations = kMirrorIterations;

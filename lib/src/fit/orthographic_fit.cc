@@ -89,9 +89,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
 
   // The normalized world (centred, unit RMS distance) and kCenter pixels, as in FitCamera.
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& x : points_in_world) centroid += x;
-  centroid /= n;
+  const Eigen::Vector3d centroid = Centroid(points_in_world);
   Eigen::MatrixXd centred(n, 3);
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
   const double scale = RmsRowLength(centred);

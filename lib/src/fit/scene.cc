@@ -108,9 +108,7 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
   scene.pixels = observed_pixels;
   for (auto& p : scene.pixels) p += Eigen::Vector2d(shift, shift);
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& x : points_in_world) centroid += x;
-  centroid /= n;
+  const Eigen::Vector3d centroid = Centroid(points_in_world);
   Eigen::MatrixXd centred(n, 3);
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
   const double scale = RmsRowLength(centred);

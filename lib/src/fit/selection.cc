@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "fit/common.h"
+
 namespace camproj {
 namespace internal {
 
@@ -381,11 +383,9 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     // An orthographic image cannot show a mirrored world (its depth order is a choice), but a
     // perspective camera can: if the mirrored world fits a perspective camera better than any
     // orthographic one, the world frame is left-handed.
-    std::vector<Eigen::Vector3d> flipped(points);
-    for (auto& x : flipped) x.z() = -x.z();
     FitOptions mirrored = base;
     mirrored.compute_uncertainty = false;
-    const Evaluation e = Evaluate(flipped, pixels, image_size, mirrored);
+    const Evaluation e = Evaluate(MirroredZ(points), pixels, image_size, mirrored);
     if (e.fit && criterion_of(e) < criterion_of(chosen.final)) {
       throw SceneError(SceneError::Reason::kMirroredWorld,
                        "the points fit a perspective camera only with one world axis flipped "

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "check.h"
+#include "fit/common.h"
 #include "fit/least_squares.h"
 
 namespace camproj {
@@ -54,9 +55,7 @@ StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& points,
     }
     return outcome.normal.cost;
   };
-  std::vector<Eigen::Vector3d> flipped(points);
-  for (auto& x : flipped) x.z() = -x.z();
-  const double mirrored_cost = refine(flipped, dlt, dlt_model, nullptr);
+  const double mirrored_cost = refine(MirroredZ(points), dlt, dlt_model, nullptr);
   StartCamera start;
   if (PnpStart(points, pixels, dlt_model.ToIntrinsics(), &start)) {
     refine(points, start, dlt_model, &proper);
