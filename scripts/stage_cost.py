@@ -107,8 +107,9 @@ STAGES = [
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::CheckConsistency()",
                                            "camproj::internal::ResidualsAgainst()")),
     ("mirror", "mirror test: the chosen model refined on the mirrored world from the camera's "
-     "depth reversal (where n rms² / σ² > 10.83: below, no mirrored fit could refuse)", True,
-     lambda a, b: is_pipeline(a) and b == "camproj::internal::MirroredReadingRmsPx()"),
+     "depth reversal (every perspective answer)", True,
+     lambda a, b: is_pipeline(a) and b in ("camproj::internal::FitMirroredReading()",
+                                           "camproj::internal::FitMirroredWorld()")),
     ("determination", "determination check: sigmas at the test points, rivals' shifts", True,
      lambda a, b: b == "camproj::internal::CheckDetermination()"),
 ]
@@ -130,7 +131,7 @@ def measure(path):
         a, b = short(caller), short(callee)
         if a == b:
             continue
-        if is_pipeline(a) and b == "camproj::internal::MirroredReadingRmsPx()":
+        if is_pipeline(a) and b == "camproj::internal::FitMirroredReading()":
             stages["mirror_calls"] += calls  # the mirror test's fits (clean scenes: no refits)
         if b == "camproj::FitCameraAuto()":
             total += cost  # from the bench

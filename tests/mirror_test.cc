@@ -67,10 +67,19 @@ TEST(MirrorTest, RefinementFromTheReversalOfTheReversalFindsTheTruth) {
     const std::vector<Eigen::Vector3d> mirrored = MirroredZ(scene.correspondences.points_in_world);
     const Camera fitted_to_mirrored =
         internal::NeckerReversal(scene.truth, scene.correspondences.points_in_world);
-    const std::optional<double> rms = internal::MirroredReadingRmsPx(
+    const std::optional<internal::MirroredReading> reading = internal::FitMirroredReading(
         fitted_to_mirrored, model, mirrored, scene.correspondences.pixels);
-    ASSERT_TRUE(rms.has_value()) << "seed " << seed;
-    EXPECT_LE(*rms, kConvergedRmsPx) << "seed " << seed;
+    ASSERT_TRUE(reading.has_value()) << "seed " << seed;
+    EXPECT_LE(reading->rms_px, kConvergedRmsPx) << "seed " << seed;
+    // The reading's camera sees the mirrored world of `mirrored`, the scene's own points.
+    const std::vector<Eigen::Vector2d>& pixels = scene.correspondences.pixels;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const std::optional<Eigen::Vector2d> pixel =
+          PixelFromWorld(reading->camera, scene.correspondences.points_in_world[i]);
+      ASSERT_TRUE(pixel.has_value()) << "seed " << seed << ", point " << i;
+      EXPECT_LE((*pixel - pixels[i]).norm(), kConvergedRmsPx * std::sqrt(pixels.size()))
+          << "seed " << seed << ", point " << i;
+    }
   }
 }
 

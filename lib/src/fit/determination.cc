@@ -368,25 +368,42 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.worst_pixel = *PixelFromWorld(camera, test[i]);
     }
   }
-  std::optional<TestPoints> rival_test;  // computed for the first rival that counts
+  std::optional<TestPoints> rival_test;  // computed for the first (unmirrored) rival that counts
   for (const Rival& rival : selection.rivals) {
-    if (!(std::abs(rival.criterion - selection.criterion) <= kEqualFitCriterion)) continue;
-    if (!rival_test) rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness);
+    const double excess = rival.criterion - selection.criterion;
+    if (!(rival.mirrored_world ? excess <= kEqualFitCriterion
+                               : std::abs(excess) <= kEqualFitCriterion)) {
+      continue;
+    }
+    if (!rival_test && !rival.mirrored_world) {
+      rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness);
+    }
+    // A mirrored reading sees every point, test points included, with z negated: in the unit
+    // world about the centroid, whose mirror image is the mirrored points' centroid.
+    const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
+    const Camera rival_camera = InUnitWorld(rival.camera, flip.asDiagonal() * origin, unit);
+    // The mirrored reading is judged over the points' own box: off a plane (or a nearly flat
+    // scene) the two readings always part, and no data on it can tell them apart.
+    const TestPoints& our_test = rival.mirrored_world ? test_points : *rival_test;
+    TestPoints their_test = our_test;
+    for (Eigen::Vector3d& x : their_test.points) x = flip.asDiagonal() * x;
     // A richer rival scatters by its own uncertainty: only a shift beyond kRivalSigmas of it
     // is a different reading of the data rather than the rival's noise.
-    const Camera rival_camera = InUnitWorld(rival.camera, origin, unit);
     std::vector<double> rival_sigmas;
     try {
-      rival_sigmas =
-          SigmasAt(PixelUncertainty(rival_camera, rival.options, points, sigma), *rival_test);
+      rival_sigmas = SigmasAt(PixelUncertainty(rival_camera, rival.options,
+                                               rival.mirrored_world ? MirroredZ(points) : points,
+                                               sigma),
+                              their_test);
     } catch (const std::invalid_argument&) {
       continue;  // a kept point behind the rival: not a reading of these points
     }
     double shift = 0.0;
-    for (size_t i = 0; i < rival_test->points.size(); ++i) {
-      const Eigen::Vector3d& x = rival_test->points[i];
+    for (size_t i = 0; i < our_test.points.size(); ++i) {
+      const Eigen::Vector3d& x = our_test.points[i];
       const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, x);
-      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival_camera, x);
+      const std::optional<Eigen::Vector2d> theirs =
+          PixelFromWorld(rival_camera, their_test.points[i]);
       const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
       if (d > kRivalSigmas * rival_sigmas[i]) shift = std::max(shift, d);
     }

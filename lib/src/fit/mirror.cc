@@ -3,10 +3,12 @@
 #include <cmath>
 
 #include "camproj/pose.h"
+#include "fit/closed_form.h"
 #include "fit/common.h"
 #include "fit/least_squares.h"
 #include "fit/model.h"
 #include "fit/scene.h"
+#include "fit/start.h"
 
 namespace camproj {
 namespace internal {
@@ -21,34 +23,92 @@ Camera NeckerReversal(const Camera& camera, const std::vector<Eigen::Vector3d>& 
   return reversed;
 }
 
-std::optional<double> MirroredReadingRmsPx(const Camera& camera, const FitOptions& model,
-                                           const std::vector<Eigen::Vector3d>& points_in_world,
-                                           const std::vector<Eigen::Vector2d>& observed_pixels) {
-  // The readings a weak perspective cannot tell apart differ from the reversal at second order
-  // in depth / distance: LM from there settles in a few iterations. A strong perspective leaves
-  // the reversal far from any camera that fits, and LM would crawl for hundreds of iterations
-  // (at 100 points that cost 10 times the rest of the default path) towards a cost it cannot
-  // bring near ours. Stopping early only raises the cost found -- a camera with that cost
-  // exists -- so it can miss a refusal but never make a wrong one.
-  constexpr int kMirrorIterations = 20;
-  const std::vector<Eigen::Vector3d> mirrored = MirroredZ(points_in_world);
+namespace {
+
+// The mirrored readings' LM iterations (one round). The readings a weak perspective cannot tell
+// apart differ from the depth reversal at second order in depth / distance, and a mirrored
+// world's proper camera is near its closed form: LM settles in a few iterations. Where no proper
+// camera fits, LM would crawl for hundreds of iterations (at 100 points that cost 10 times the
+// rest of the default path) towards a cost it cannot bring near ours. Stopping early only raises
+// the cost found -- a camera with that cost exists.
+constexpr int kMirrorIterations = 20;
+
+// `model` with its free slots at `intrinsics`, distortion included.
+Model ModelAt(const Model& model, const Intrinsics& intrinsics) {
+  Model at = ProjectOntoModel(model, intrinsics);
+  if (at.free[5]) at.value[5] = intrinsics.k1;
+  if (at.free[6]) at.value[6] = intrinsics.k2;
+  return at;
+}
+
+// LM (one round of options.max_iterations) in `scene`'s normalized world from `start`: the
+// camera as `like` (projection, image size, depth range) with the refined pose and intrinsics,
+// and its RMS; nothing if a point ends behind it or its focal length or aspect is not positive.
+std::optional<MirroredReading> Refine(const Scene& scene, const StartCamera& start,
+                                      const Model& start_model, const FitOptions& options,
+                                      const Camera& like) {
+  const LeastSquaresOutcome outcome =
+      RefineLeastSquares(scene.points, scene.pixels, start.rotation, start.center, start_model,
+                         options, Clock::now(), /*max_rounds=*/1);
+  if (!outcome.ok) return std::nullopt;
+  MirroredReading reading;
+  reading.camera = like;
+  reading.camera.intrinsics = outcome.model.ToIntrinsics();
+  reading.camera.intrinsics.skew += 0.0;  // no -0
+  reading.camera.cam_from_world =
+      CamFromWorldFromCenter(outcome.rotation, scene.centroid + scene.scale * outcome.center);
+  reading.rms_px = std::sqrt(outcome.normal.cost / static_cast<double>(scene.NumPoints()));
+  return reading;
+}
+
+}  // namespace
+
+std::optional<MirroredReading> FitMirroredReading(
+    const Camera& camera, const FitOptions& model,
+    const std::vector<Eigen::Vector3d>& points_in_world,
+    const std::vector<Eigen::Vector2d>& observed_pixels) {
   const Camera reversed = NeckerReversal(camera, points_in_world);
   FitOptions options = model;
   options.max_iterations = kMirrorIterations;
   try {
-    const Scene scene = ValidateScene(mirrored, observed_pixels, camera.image_size, options);
-    const Eigen::Vector3d start_center =
-        (CameraCenterInWorld(reversed.cam_from_world) - scene.centroid) / scene.scale;
-    Model start_model = ProjectOntoModel(scene.model, camera.intrinsics);
-    if (start_model.free[5]) start_model.value[5] = camera.intrinsics.k1;
-    if (start_model.free[6]) start_model.value[6] = camera.intrinsics.k2;
-    const LeastSquaresOutcome outcome =
-        RefineLeastSquares(scene.points, scene.pixels, reversed.cam_from_world.rotation,
-                           start_center, start_model, options, Clock::now(), /*max_rounds=*/1);
-    if (!outcome.ok) return std::nullopt;  // a point behind it, or a mirror image of its own
-    return std::sqrt(outcome.normal.cost / static_cast<double>(mirrored.size()));
+    const Scene scene =
+        ValidateScene(MirroredZ(points_in_world), observed_pixels, camera.image_size, options);
+    StartCamera start;
+    start.rotation = reversed.cam_from_world.rotation;
+    start.center = (CameraCenterInWorld(reversed.cam_from_world) - scene.centroid) / scene.scale;
+    return Refine(scene, start, ModelAt(scene.model, camera.intrinsics), options, camera);
   } catch (const SceneError&) {
     return std::nullopt;  // the mirrored scene has no valid start (ValidateScene's refusals)
+  }
+}
+
+std::optional<MirroredReading> FitMirroredWorld(
+    const std::vector<Eigen::Vector3d>& points_in_world,
+    const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
+    const FitOptions& model, const Intrinsics& intrinsics) {
+  FitOptions options = model;
+  options.max_iterations = kMirrorIterations;
+  try {
+    const Scene scene =
+        ValidateScene(MirroredZ(points_in_world), observed_pixels, image_size, options);
+    StartCamera start;
+    Model start_model;
+    // The DLT reads the mirrored world as mirrored where it reads the given one as proper:
+    // SQPnP then, from the intrinsics the given world was fitted with.
+    if (model.known_intrinsics || scene.planar_start || scene.num_distinct_points < 6 ||
+        !DltStart(scene.points, scene.pixels).mirrored) {
+      const Start closed_form = ClosedFormStart(scene, options, Clock::now());
+      start = closed_form.camera;
+      start_model = closed_form.model;
+    } else {
+      if (!PnpStart(scene.points, scene.pixels, intrinsics, &start)) return std::nullopt;
+      start_model = ModelAt(scene.model, intrinsics);
+    }
+    Camera like;
+    like.image_size = image_size;
+    return Refine(scene, start, start_model, options, like);
+  } catch (const SceneError&) {
+    return std::nullopt;  // no start, or no valid scene
   }
 }
 

@@ -1,8 +1,9 @@
-// The mirrored reading of a fitted camera (private), for the default path's mirror test: the
-// same model fitted to the points with the world's z negated, started from the fitted camera's
-// depth reversal (the Necker reading). Where the perspective is weak the two readings explain
-// the image about equally well and either may win the closed form by noise; where it is strong
-// the reversal fits far worse and no other start could make a mirrored camera fit better.
+// The mirrored readings of a fitted camera (private), for the default path's mirror test: the
+// same data read as a left-handed world (the points with z negated). Where the perspective is
+// weak the two readings explain the image about equally well and either may win the closed form
+// by noise: the camera's depth reversal (the Necker reading) refined finds the mirrored one.
+// Where it is strong, only a few points let a mirrored world fit a proper camera at all, far
+// from the reversal: a start of that world's own finds it.
 #ifndef CAMPROJ_SRC_FIT_MIRROR_H_
 #define CAMPROJ_SRC_FIT_MIRROR_H_
 
@@ -23,13 +24,34 @@ namespace internal {
 // give the same pixels; under perspective they differ at second order in depth / distance.
 Camera NeckerReversal(const Camera& camera, const std::vector<Eigen::Vector3d>& points_in_world);
 
-// The RMS (px) of `model` fitted by least squares (at most 20 LM iterations) to the points with
-// z negated, from NeckerReversal(camera, points): the RMS of a proper camera of the mirrored
-// world, at or above the best one near the reversal. Nothing when that refinement ends with a
-// point behind the camera or a non-positive focal length or aspect.
-std::optional<double> MirroredReadingRmsPx(const Camera& camera, const FitOptions& model,
-                                           const std::vector<Eigen::Vector3d>& points_in_world,
-                                           const std::vector<Eigen::Vector2d>& observed_pixels);
+// The model name of a mirrored reading where it is a rival (DeterminationCheck::rival).
+inline constexpr char kMirroredReadingName[] = "the same model with one world axis flipped";
+
+// A proper camera of the mirrored world (the points with z negated, MirroredZ) and its RMS.
+struct MirroredReading {
+  Camera camera;  // sees MirroredZ(points_in_world): pixel of x is PixelFromWorld(camera, M x)
+  double rms_px = 0.0;
+};
+
+// `model` fitted by least squares (at most 20 LM iterations) to the points with z negated, from
+// NeckerReversal(camera, points): a proper camera of the mirrored world whose RMS is at or above
+// the best one near the reversal. Nothing when that refinement ends with a point behind the
+// camera or a non-positive focal length or aspect.
+std::optional<MirroredReading> FitMirroredReading(
+    const Camera& camera, const FitOptions& model,
+    const std::vector<Eigen::Vector3d>& points_in_world,
+    const std::vector<Eigen::Vector2d>& observed_pixels);
+
+// `model` fitted to the points with z negated from a start of that world's own, by LM (one round
+// of at most 20 iterations): at few points a mirrored world can fit a proper camera within the
+// noise far from any depth reversal. The start is the mirrored world's closed form where that
+// reads it as proper (the DLT's det > 0, or a plane's homography), else SQPnP with `intrinsics`
+// (the fitted camera's: the closed form would refine both readings and refuse, start.cc).
+// Nothing where no start or no proper camera with every point in front is found.
+std::optional<MirroredReading> FitMirroredWorld(
+    const std::vector<Eigen::Vector3d>& points_in_world,
+    const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
+    const FitOptions& model, const Intrinsics& intrinsics);
 
 }  // namespace internal
 }  // namespace camproj

@@ -418,6 +418,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     }
   }
   selection.criterion = tried[chosen.final_index].criterion;
+  selection.penalty = penalty;
   for (Rival& r : rivals) {
     if (r.model != selection.fit.model) selection.rivals.push_back(std::move(r));
   }

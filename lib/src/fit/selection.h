@@ -21,6 +21,10 @@ struct Rival {
   FitOptions options;
   Camera camera;
   double criterion = 0.0;
+  // The camera sees the world with z negated (fit/mirror.h): the same data read as a mirrored
+  // world. It counts when it fits about as well or better (a better one by more than the
+  // mirror test's margin is refused before).
+  bool mirrored_world = false;
 };
 
 struct Selection {
@@ -30,6 +34,7 @@ struct Selection {
   FitOptions options;             // the chosen model (pixel_sigma: the noise its sigmas use)
   double sigma_px = 0.0;          // the noise the criterion used
   double criterion = 0.0;         // the chosen model's
+  double penalty = 0.0;  // the criterion's per parameter: sum_squares / sigma_px^2 + penalty * k
   std::vector<Rival> rivals;      // every other model fitted, either family
 };
 
