@@ -411,6 +411,20 @@ TEST_F(RefusalTest, TooFewPointsForTheFreeParameters) {
 // pose + focal (8 equations for 7 unknowns; the focal sweep, as the DLT needs 6 distinct
 // points) but not the 10 unknowns of the default model. (Before, the 12 rows counted as 12
 // points: the DLT ran on 4 distinct ones and refused the scene as points behind the camera.)
+// RANSAC's samples are 6 distinct rows without known intrinsics (4 with them, or on a plane,
+// where fewer points are refused before): 5 points with the focal length alone free are a
+// valid scene, refused for RANSAC by name instead of searching forever for a sample.
+TEST_F(RefusalTest, RansacWithFewerPointsThanASample) {
+  std::vector<Eigen::Vector3d> points(scene_.points_in_world.begin(), scene_.points_in_world.begin() + 5);
+  std::vector<Eigen::Vector2d> pixels(scene_.observed_pixels.begin(), scene_.observed_pixels.begin() + 5);
+  FitOptions options;
+  options.aspect = options.principal_point = ParameterMode::Default();
+  options.ransac = true;
+  EXPECT_EQ(RefusalOf(points, pixels, camera_.size, options, &message_),
+            SceneError::Reason::kTooFewPoints);
+  EXPECT_NE(message_.find("RANSAC draws samples of 6 points; got 5"), std::string::npos) << message_;
+}
+
 TEST_F(RefusalTest, RepeatedPointsCountOnce) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;

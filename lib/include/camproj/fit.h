@@ -129,10 +129,14 @@ class SceneError : public std::runtime_error {
     kPointsBehindCamera,
     kMirroredWorld,          // left-handed world frame
     kDegenerate,             // no unique solution (e.g. a plane seen head-on with free focal)
-    // FitCameraAuto (model_select.h) only:
+    // FitCameraAuto (model_select.h) only, but kAmbiguous:
     kContaminated,  // some points disagree with the rest and the rest cannot say which
     kInconsistent,  // the best camera's residuals are larger than the pixel noise allows
-    kAmbiguous,     // two different cameras explain the points about equally well
+    // Two different cameras explain the points about equally well: FitCameraAuto's
+    // determination check (a rival model, or the world read mirrored, puts the scene
+    // elsewhere), and FitCamera's start (a mirrored reading fits somewhat better than any
+    // proper camera, by too little to call the world left-handed).
+    kAmbiguous,
     kNumerical,     // a numerical failure on these values (a bug: please report it)
   };
   SceneError(Reason reason, const std::string& message)

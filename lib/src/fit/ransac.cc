@@ -68,6 +68,9 @@ bool SolveSubset(const std::vector<Eigen::Vector3d>& points,
          fitted_model->value[0] > 0.0 && fitted_model->value[1] > 0.0;
 }
 
+// Points per minimal sample: 4 for known intrinsics or a plane, 6 for the DLT.
+int SampleSize(bool known, bool planar) { return known || planar ? 4 : 6; }
+
 // RANSAC on minimal closed-form samples (4 points for known intrinsics or a plane, 6 for the
 // DLT), with a local optimization (the closed form on all inliers) whenever the best consensus
 // grows, and the adaptive stopping rule k = log(1 - confidence) / log(1 - w^s).
@@ -76,7 +79,7 @@ std::vector<int> RansacInliers(const std::vector<Eigen::Vector3d>& points,
                                bool known, bool planar, const Eigen::Matrix3d& plane_basis,
                                const FitOptions& options) {
   const int n = static_cast<int>(points.size());
-  const int sample_size = known || planar ? 4 : 6;
+  const int sample_size = SampleSize(known, planar);
   std::mt19937_64 rng(options.ransac_seed);
   std::vector<int> best;
   long iterations_needed = options.ransac_max_iterations;
@@ -125,10 +128,18 @@ std::vector<int> RansacInliers(const std::vector<Eigen::Vector3d>& points,
 
 std::vector<int> RansacConsensus(const Scene& scene, const FitOptions& options) {
   const bool known = options.known_intrinsics.has_value();
+  // A sample draws distinct rows: with fewer rows than a sample there is none to draw.
+  const int sample_size = SampleSize(known, scene.planar_start);
+  if (scene.NumPoints() < sample_size) {
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     Concat("RANSAC draws samples of ", sample_size, " points",
+                            known ? " (known intrinsics)" : scene.planar_start ? " (a plane)" : "",
+                            "; got ", scene.NumPoints(), ": drop --ransac, or add points"));
+  }
   const std::vector<int> inliers = RansacInliers(scene.points, scene.pixels, scene.model, known,
                                                  scene.planar_start, scene.plane_basis, options);
   const int num_params = 6 + scene.model.NumFree();
-  const int minimum = std::max(known || scene.planar_start ? 4 : 6, (num_params + 1) / 2);
+  const int minimum = std::max(sample_size, (num_params + 1) / 2);
   if (static_cast<int>(inliers.size()) < minimum) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("RANSAC found no camera that ", minimum,
