@@ -25,9 +25,6 @@ namespace {
 // Reciprocal condition of the Jacobi-scaled J^T J below which a direction is taken as not
 // determined (the fitter refuses at 1e-12; this only guards the inverse).
 constexpr double kSingularRcond = 1e-14;
-// Central-difference steps, relative to each parameter's natural scale: the truncation error is
-// O(step^2), far below what an uncertainty needs.
-constexpr double kStep = 1e-6;
 // A rival's shift of a test point counts beyond this many of its own sigmas there.
 constexpr double kRivalSigmas = 3.0;
 // The rivals are compared over the points' box widened so that no side is shorter than this
@@ -72,88 +69,80 @@ std::vector<Parameter> ParametersOf(const Camera& camera, const FitOptions& mode
   return params;
 }
 
-// `camera` moved by `amount` (in the parameter's step units) along one parameter; the eye and the
-// rotation move about and along the camera's own axes.
-Camera Moved(const Camera& camera, const Parameter& p, double amount, double length_scale) {
-  Camera moved = camera;
-  const Eigen::Matrix3d& r = camera.cam_from_world.rotation;
-  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
-  Intrinsics& k = moved.intrinsics;
-  const double f = camera.intrinsics.fx;
-  switch (p.kind) {
-    case kRotation: {
-      const Eigen::Matrix3d turn =
-          Eigen::AngleAxisd(amount, Eigen::Vector3d::Unit(p.axis)).toRotationMatrix();
-      moved.cam_from_world = CamFromWorldFromCenter(turn * r, eye);
-      break;
-    }
-    case kEye:
-      moved.cam_from_world = CamFromWorldFromCenter(
-          r, eye + r.transpose() * (amount * length_scale * Eigen::Vector3d::Unit(p.axis)));
-      break;
-    case kFocal:
-      k.fx *= 1.0 + amount;
-      k.fy *= 1.0 + amount;
-      break;
-    case kAspect: k.fy *= 1.0 + amount; break;
-    case kCx: k.cx += amount * f; break;
-    case kCy: k.cy += amount * f; break;
-    case kSkew: k.skew += amount * f; break;
-    case kK1: k.k1 += amount; break;
-    case kK2: k.k2 += amount; break;
-    case kPerspective: break;  // not a Camera: PixelJacobian differentiates it directly
-  }
-  return moved;
-}
-
-// `camera` moved by +kStep and -kStep along each parameter: the central differences' cameras,
-// made once per camera and read for every point. A kPerspective parameter's entries are copies
-// of the camera, unread: its column is -(pixel - principal point) * z_cam / length_scale, the
-// derivative at e = 0 per unit of e * length_scale.
-struct MovedCameras {
+// The camera linearized along `params` (ParametersOf): the rotation turns about the camera's
+// own axes (R -> exp([a e]x) R), the eye moves along them in units of length_scale, the focal
+// length and aspect scale (fx, fy by 1 + a; fy by 1 + a), the principal point and skew move by
+// a * fx, k1 and k2 by a.
+struct Linearization {
   Camera camera;
   double length_scale = 1.0;
   std::vector<Parameter> params;
-  std::vector<Camera> plus;
-  std::vector<Camera> minus;
 };
 
-MovedCameras MovedAlong(const Camera& camera, const std::vector<Parameter>& params,
-                        double length_scale) {
-  MovedCameras moved;
-  moved.camera = camera;
-  moved.length_scale = length_scale;
-  moved.params = params;
-  for (const Parameter& p : params) {
-    moved.plus.push_back(Moved(camera, p, kStep, length_scale));
-    moved.minus.push_back(Moved(camera, p, -kStep, length_scale));
-  }
-  return moved;
-}
-
-// d pixel / d parameter (2 x params) at every point, by central differences; rows 2i, 2i+1 for
-// point i. Returns the index of the first point (parameter by parameter) not in front of a moved
-// camera, if any; the Jacobian is then incomplete.
-std::optional<size_t> PixelJacobian(const MovedCameras& moved,
+// d pixel / d parameter (2 x params) at every point, analytic; rows 2i, 2i+1 for point i.
+// Returns the index of the first point not in front of the camera, if any; the Jacobian is then
+// incomplete. A kPerspective column (orthographic) is -(pixel - principal point) * z_cam /
+// length_scale: the derivative at e = 0 of pixel = c + (u_ortho - c) / (1 + e z_cam) per unit of
+// e * length_scale.
+std::optional<size_t> PixelJacobian(const Linearization& at,
                                     const std::vector<Eigen::Vector3d>& points,
                                     Eigen::MatrixXd* jacobian) {
-  jacobian->resize(2 * points.size(), moved.plus.size());
-  for (size_t j = 0; j < moved.plus.size(); ++j) {
-    if (moved.params[j].kind == kPerspective) {
-      const Eigen::Vector2d centre(moved.camera.intrinsics.cx, moved.camera.intrinsics.cy);
-      for (size_t i = 0; i < points.size(); ++i) {
-        const std::optional<Eigen::Vector2d> u = PixelFromWorld(moved.camera, points[i]);
-        if (!u) return i;
-        const double z = (moved.camera.cam_from_world * points[i]).z();
-        jacobian->block<2, 1>(2 * i, j) = -(*u - centre) * (z / moved.length_scale);
-      }
-      continue;
+  const Intrinsics& k = at.camera.intrinsics;
+  const bool orthographic = at.camera.projection == Projection::kOrthographic;
+  jacobian->resize(2 * points.size(), at.params.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p = at.camera.cam_from_world * points[i];
+    if (!(p.z() > 0.0)) return i;
+    // d pixel / d point_in_cam, and the pixel's parts the intrinsics scale.
+    Eigen::Matrix<double, 2, 3> by_point;
+    Eigen::Vector2d scaled;  // (fx xd, fy yd): what fx and fy multiply
+    Eigen::Vector2d sheared;  // (yd, 0): what skew multiplies
+    Eigen::Vector2d by_k1 = Eigen::Vector2d::Zero();
+    Eigen::Vector2d by_k2 = Eigen::Vector2d::Zero();
+    if (orthographic) {
+      by_point << k.fx, k.skew, 0.0, 0.0, k.fy, 0.0;
+      scaled << k.fx * p.x(), k.fy * p.y();
+      sheared << p.y(), 0.0;
+    } else {
+      // pixel = (fx xd + skew yd + cx, fy yd + cy), (xd, yd) = d (x, y), d = 1 + k1 r2 + k2 r2^2.
+      const double x = p.x() / p.z();
+      const double y = p.y() / p.z();
+      const double r2 = x * x + y * y;
+      const double d = 1.0 + r2 * (k.k1 + r2 * k.k2);
+      const double g = 2.0 * (k.k1 + 2.0 * k.k2 * r2);  // d d / d r2, times 2
+      Eigen::Matrix2d distorted_by_normalized;  // d (xd, yd) / d (x, y)
+      distorted_by_normalized << d + g * x * x, g * x * y, g * x * y, d + g * y * y;
+      Eigen::Matrix2d pixel_by_distorted;
+      pixel_by_distorted << k.fx, k.skew, 0.0, k.fy;
+      Eigen::Matrix<double, 2, 3> normalized_by_point;
+      normalized_by_point << 1.0, 0.0, -x, 0.0, 1.0, -y;
+      by_point = pixel_by_distorted * distorted_by_normalized * normalized_by_point / p.z();
+      scaled << k.fx * d * x, k.fy * d * y;
+      sheared << d * y, 0.0;
+      by_k1 = pixel_by_distorted * Eigen::Vector2d(x, y) * r2;
+      by_k2 = by_k1 * r2;
     }
-    for (size_t i = 0; i < points.size(); ++i) {
-      const std::optional<Eigen::Vector2d> a = PixelFromWorld(moved.plus[j], points[i]);
-      const std::optional<Eigen::Vector2d> b = PixelFromWorld(moved.minus[j], points[i]);
-      if (!a || !b) return i;
-      jacobian->block<2, 1>(2 * i, j) = (*a - *b) / (2.0 * kStep);
+    for (size_t j = 0; j < at.params.size(); ++j) {
+      const Parameter& param = at.params[j];
+      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(param.axis);
+      Eigen::Vector2d column;
+      switch (param.kind) {
+        case kRotation: column = by_point * axis.cross(p); break;
+        case kEye: column = by_point * (-at.length_scale * axis); break;
+        case kFocal: column = scaled; break;
+        case kAspect: column << 0.0, scaled.y(); break;
+        case kCx: column << k.fx, 0.0; break;
+        case kCy: column << 0.0, k.fx; break;
+        case kSkew: column = k.fx * sheared; break;
+        case kK1: column = by_k1; break;
+        case kK2: column = by_k2; break;
+        case kPerspective: {
+          const Eigen::Vector2d pixel(k.fx * p.x() + k.skew * p.y() + k.cx, k.fy * p.y() + k.cy);
+          column = -(pixel - Eigen::Vector2d(k.cx, k.cy)) * (p.z() / at.length_scale);
+          break;
+        }
+      }
+      jacobian->block<2, 1>(2 * i, j) = column;
     }
   }
   return std::nullopt;
@@ -175,8 +164,8 @@ Camera InUnitWorld(const Camera& camera, const Eigen::Vector3d& origin, double u
   return moved;
 }
 
-// ReprojectionSigmaPx's linearization of one camera, prepared once: the moved cameras and the
-// Jacobi-scaled inverse of J^T J; SigmaAt then costs one point's Jacobian.
+// ReprojectionSigmaPx's linearization of one camera, prepared once: the Jacobi-scaled inverse
+// of J^T J; SigmaAt then costs one point's Jacobian.
 class PixelUncertainty {
  public:
   // Throws std::invalid_argument if a fitted point is not in front of the camera.
@@ -191,9 +180,9 @@ class PixelUncertainty {
     for (const Eigen::Vector3d& x : fitted_points) distances.push_back((x - eye).norm());
     std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
     const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
-    moved_ = MovedAlong(camera, params, length_scale);
+    at_ = Linearization{camera, length_scale, params};
 
-    const std::optional<size_t> behind = PixelJacobian(moved_, fitted_points, &fitted_jacobian_);
+    const std::optional<size_t> behind = PixelJacobian(at_, fitted_points, &fitted_jacobian_);
     Require(!behind, "point ", behind.value_or(0), " is not in front of the camera");
     const Eigen::MatrixXd normal = fitted_jacobian_.transpose() * fitted_jacobian_;
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
@@ -218,7 +207,7 @@ class PixelUncertainty {
     if (singular_) return infinity;
     Eigen::MatrixXd jacobian;
     try {
-      if (PixelJacobian(moved_, {x}, &jacobian)) return infinity;
+      if (PixelJacobian(at_, {x}, &jacobian)) return infinity;
     } catch (const std::invalid_argument&) {
       return infinity;
     }
@@ -238,7 +227,7 @@ class PixelUncertainty {
   }
 
   double sigma_px_;
-  MovedCameras moved_;
+  Linearization at_;
   Eigen::MatrixXd fitted_jacobian_;
   Eigen::MatrixXd whitening_;        // W: (J^T J)^-1 = W W^T
   Eigen::MatrixXd fitted_whitened_;  // J W, two rows per fitted point
