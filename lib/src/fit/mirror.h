@@ -33,7 +33,7 @@ struct MirroredReading {
   double rms_px = 0.0;
 };
 
-// `model` fitted by least squares (at most 20 LM iterations) to the points with z negated, from
+// `model` fitted by least squares (at most 10 LM iterations) to the points with z negated, from
 // NeckerReversal(camera, points): a proper camera of the mirrored world whose RMS is at or above
 // the best one near the reversal. Nothing when that refinement ends with a point behind the
 // camera or a non-positive focal length or aspect.
