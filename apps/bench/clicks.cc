@@ -584,14 +584,16 @@ Case MakeCase(const std::vector<Band>& bands, int band_index, int index) {
 // ---------------------------------------------------------------------------------------------
 // Methods
 
-enum class MethodId { kDefault, kOracle, kOpenCv };
-const std::vector<MethodId> kMethodIds = {MethodId::kDefault, MethodId::kOracle, MethodId::kOpenCv};
+enum class MethodId { kDefault, kOracle, kOpenCv, kWithModel };
+const std::vector<MethodId> kMethodIds = {MethodId::kDefault, MethodId::kOracle, MethodId::kOpenCv,
+                                          MethodId::kWithModel};
 
 const char* Name(MethodId m) {
   switch (m) {
     case MethodId::kDefault: return "default";
     case MethodId::kOracle: return "oracle";
     case MethodId::kOpenCv: return "opencv";
+    case MethodId::kWithModel: return "default+model";
   }
   return "?";
 }
@@ -726,6 +728,20 @@ std::vector<int> NamedByRefusal(const std::string& message) {
   return named;
 }
 
+// The corners of every box of the building, in the world the clicks are given in: what a user
+// who maps onto a model has (its vertices), for AutoFitOptions::object_points_in_world.
+std::vector<Eigen::Vector3d> ModelVertices(const Case& c) {
+  std::vector<Eigen::Vector3d> vertices;
+  for (const Box& box : c.scene.boxes) {
+    for (int bits = 0; bits < 8; ++bits) {
+      Eigen::Vector3d given = Corner(box, bits);
+      if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
+      vertices.push_back(given);
+    }
+  }
+  return vertices;
+}
+
 // One method on one case; the clock covers the library call only. Nothing but a refusal
 // (SceneError) is expected from camproj; anything else is recorded as an error, never rethrown.
 Outcome Run(MethodId method, const Case& c, const Band& band) {
@@ -748,6 +764,13 @@ Outcome Run(MethodId method, const Case& c, const Band& band) {
     if (method == MethodId::kDefault) {
       start = Clock::now();
       const FitResult fit = FitCameraAuto(points, pixels, kImageSize, AutoFitOptions{});
+      outcome.time_ms = MillisecondsBetween(start, Clock::now());
+      RecordFit(fit, c, &outcome);
+    } else if (method == MethodId::kWithModel) {
+      AutoFitOptions options;
+      options.object_points_in_world = ModelVertices(c);
+      start = Clock::now();
+      const FitResult fit = FitCameraAuto(points, pixels, kImageSize, options);
       outcome.time_ms = MillisecondsBetween(start, Clock::now());
       RecordFit(fit, c, &outcome);
     } else if (method == MethodId::kOracle) {
@@ -835,6 +858,9 @@ struct BandStats {
   std::vector<double> opencv_error;
   std::vector<double> opencv_time_ms;
   std::map<std::string, int> models;  // the default's chosen models
+  int with_model_answered = 0;        // default+model
+  int with_model_silent = 0;
+  std::vector<double> with_model_error;
 };
 
 void Accumulate(const Band& band, const Case& c, const std::vector<Outcome>& outcomes,
@@ -842,7 +868,15 @@ void Accumulate(const Band& band, const Case& c, const std::vector<Outcome>& out
   const Outcome& def = outcomes[0];
   const Outcome& oracle = outcomes[1];
   const Outcome& opencv = outcomes[2];
+  const Outcome& with_model = outcomes[3];
   ++s->scenes;
+  if (with_model.status == Status::kAnswered) {
+    ++s->with_model_answered;
+    s->with_model_error.push_back(with_model.unseen_max_px);
+    if (Silent(with_model, band)) ++s->with_model_silent;
+  } else if (with_model.status == Status::kError) {
+    ++s->error_messages["default+model: " + MessageKind(with_model.message)];
+  }
   const int bad = static_cast<int>(std::count(c.bad.begin(), c.bad.end(), true));
   s->bad_total += bad;
   if (bad > 0) ++s->scenes_with_bad;
@@ -1026,8 +1060,8 @@ std::string ContextTable(const std::vector<Band>& bands, const std::vector<BandS
   std::ostringstream out;
   out << "| band | oracle answered | oracle refused | oracle p50 px (all) | oracle p90 px (all) | "
          "oracle > 10 px | opencv answered | opencv p50 px | opencv p90 px | opencv silent | "
-         "t opencv | default models |\n"
-         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+         "t opencv | with model answered | with model p90 px | with model SILENT | default models |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
   for (size_t b = 0; b < bands.size(); ++b) {
     const BandStats& s = stats[b];
     const bool mirrored = bands[b].variant == Variant::kMirrored;
@@ -1043,7 +1077,9 @@ std::string ContextTable(const std::vector<Band>& bands, const std::vector<BandS
         << (mirrored ? "-" : std::to_string(s.oracle_over)) << " | "
         << Fraction(s.opencv_answered, s.scenes) << " | " << FormatPx(Median(s.opencv_error))
         << " | " << FormatPx(Percentile90(s.opencv_error)) << " | " << s.opencv_over << " | "
-        << FormatMs(Median(s.opencv_time_ms)) << " | " << (models.empty() ? "-" : models) << " |\n";
+        << FormatMs(Median(s.opencv_time_ms)) << " | " << s.with_model_answered << " | "
+        << FormatPx(Percentile90(s.with_model_error)) << " | **" << s.with_model_silent << "** | "
+        << (models.empty() ? "-" : models) << " |\n";
   }
   return out.str();
 }
@@ -1136,6 +1172,9 @@ would see).
 - **opencv**: `cv::calibrateCamera` on the same clicks as the default, from a 60° horizontal-fov
   guess with the principal point at the centre; CALIB_USE_INTRINSIC_GUESS | CALIB_FIX_ASPECT_RATIO
   | CALIB_ZERO_TANGENT_DIST | CALIB_FIX_K1..K3 (what mapamok-style tools run).
+- **default+model**: the default with the building's box corners (the model's vertices, in the
+  given world) as `AutoFitOptions::object_points_in_world` (`camproj fit --object-points`): the
+  camera must also be determined there.
 
 ## Columns
 
@@ -1158,7 +1197,8 @@ would see).
   on the machine inflates them (load average in the header).
 - Second table: the oracle over all scenes of the band (answers, refusals, unseen error, answers
   more than 10 px off), OpenCV's answers and errors (its exceptions count as not answered; its
-  'silent' uses the same rule), and the models the default chose.
+  'silent' uses the same rule), default+model's answers, p90 unseen error and silent failures, and
+  the models the default chose.
 )md";
 
 // A scene as files a user can fit by hand: the clicks as given (mirrored world included), the

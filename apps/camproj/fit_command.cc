@@ -50,6 +50,7 @@ struct FitArgs {
   double ransac_px = 0.0;
   double sigma = 0.0;
   double max_uncertainty = 0.0;  // 0: AutoFitOptions' default
+  std::string object_points_path;
   double z_near = 0.0;
   double z_far = 0.0;
   int max_iterations = 100;
@@ -213,6 +214,16 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   }
   request.auto_options.find_outliers = !args.keep_all;
   if (args.max_uncertainty > 0.0) request.auto_options.max_uncertainty_px = args.max_uncertainty;
+  if (!args.object_points_path.empty()) {
+    if (!request.automatic) {
+      throw UsageError("--object-points is for the default path's determination check, which a "
+                       "robust --loss does not run");
+    }
+    CorrespondencesLimits limits;
+    limits.require_pixels = false;
+    request.auto_options.object_points_in_world =
+        ReadCorrespondencesFile(args.object_points_path, limits).points_in_world;
+  }
   try {
     if (request.automatic) {
       request.auto_options.Check();
@@ -348,15 +359,16 @@ Command AddFitCommand(CLI::App& root) {
       "written only if its residuals are consistent with the pixel noise (--sigma; default: a\n"
       "1 px prior for clicked points); otherwise exit 3 names the worst points and what to do.\n"
       "It must also be determined to --max-uncertainty px (1 sigma, default 5) over the box the\n"
-      "points span, and no model that fits about as well may put the scene further away than\n"
-      "that; otherwise exit 3 says where points are missing.\n"
+      "points span (and the --object-points), and no model that fits about as well may put the\n"
+      "scene further away than that; otherwise exit 3 says where points are missing.\n"
       "Prints a summary (parameters +- 1 sigma, residuals, worst points, time); -o writes the\n"
       "camera file (docs/camera-file.md) atomically.\n\n"
       "Examples:\n"
       "  camproj fit points.csv --image-size 1920x1080 -o camera.json\n"
       "  camproj fit plane.csv --image-size 640x480 --model focal+k1\n"
       "  camproj fit points.csv --image-size 1920x1080 --model focal+aspect+principal-point --loss huber:2\n"
-      "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json");
+      "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json\n"
+      "  camproj fit clicks.csv --image-size 1920x1080 --object-points model_vertices.csv");
   app->add_option("POINTS", args->points_paths,
                   "correspondences CSV; several files or a folder of *.csv fit them all in "
                   "parallel (-o names the output folder)")->required();
@@ -407,6 +419,10 @@ Command AddFitCommand(CLI::App& root) {
   app->add_option("--max-uncertainty", args->max_uncertainty,
                   "refuse a camera the points determine more loosely than this (px, 1 sigma over "
                   "the box the points span; default 5)")->check(CLI::PositiveNumber);
+  app->add_option("--object-points", args->object_points_path,
+                  "CSV with X,Y,Z of the object's other points (e.g. the model's vertices): the "
+                  "camera must be determined to --max-uncertainty there too, where they are in "
+                  "the image (u,v columns are ignored)");
   app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")
       ->check(CLI::PositiveNumber);
   app->add_option("--far", args->z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);

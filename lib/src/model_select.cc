@@ -449,6 +449,10 @@ void AutoFitOptions::Check() const {
           "give the model explicitly to use a robust loss");
   Require(max_uncertainty_px > 0.0, "max_uncertainty_px must be positive, got ",
           max_uncertainty_px);
+  for (size_t i = 0; i < object_points_in_world.size(); ++i) {
+    Require(object_points_in_world[i].allFinite(), "object_points_in_world[", i,
+            "] must be finite");
+  }
   Require(exhaustive_max_points >= 0 && exhaustive_max_points <= 40,
           "exhaustive_max_points must be in [0, 40], got ", exhaustive_max_points);
   Require(std::isfinite(prior_sigma_px) && prior_sigma_px > 0.0,

@@ -242,7 +242,8 @@ struct TestPoints {
 };
 
 TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
-                        double min_thickness) {
+                        double min_thickness,
+                        const std::vector<Eigen::Vector3d>& object_points = {}) {
   std::vector<Eigen::Vector3d> candidates = points;
   if (!points.empty()) {
     const Eigen::Vector3d mean = Centroid(points);
@@ -274,6 +275,7 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
       }
     }
   }
+  candidates.insert(candidates.end(), object_points.begin(), object_points.end());
   TestPoints inside;
   for (size_t k = 0; k < candidates.size(); ++k) {
     const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, candidates[k]);
@@ -288,8 +290,9 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
 
 // TestPointsOf, or the fitted points themselves when none of the box is in the image.
 TestPoints TestPointsOrFitted(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
-                              double min_thickness) {
-  TestPoints test = TestPointsOf(camera, points, min_thickness);
+                              double min_thickness,
+                              const std::vector<Eigen::Vector3d>& object_points) {
+  TestPoints test = TestPointsOf(camera, points, min_thickness, object_points);
   if (test.points.empty()) {
     test.points = points;
     test.fitted.resize(points.size());
@@ -346,7 +349,11 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   std::vector<Eigen::Vector3d> points(kept_points.size());
   for (size_t i = 0; i < kept_points.size(); ++i) points[i] = centred.row(i).transpose() / unit;
   const Camera camera = InUnitWorld(selection.fit.camera, origin, unit);
-  const TestPoints test_points = TestPointsOrFitted(camera, points, 0.0);
+  std::vector<Eigen::Vector3d> object_points(options.object_points_in_world.size());
+  for (size_t i = 0; i < object_points.size(); ++i) {
+    object_points[i] = (options.object_points_in_world[i] - origin) / unit;
+  }
+  const TestPoints test_points = TestPointsOrFitted(camera, points, 0.0, object_points);
   const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
   const std::vector<double> sigmas =
@@ -365,7 +372,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       continue;
     }
     if (!rival_test && !rival.mirrored_world) {
-      rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness);
+      rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
     }
     // A mirrored reading sees every point, test points included, with z negated: in the unit
     // world about the centroid, whose mirror image is the mirrored points' centroid.
@@ -405,7 +412,8 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   const Eigen::Vector2d where =
       ConvertPixelOrigin(check.worst_pixel, PixelOrigin::kCenter, options.fit.pixel_origin);
   check.summary = "uncertain by up to " + Px(check.max_sigma_px) +
-                  " (1 sigma) over the box the points span, most near pixel (" +
+                  " (1 sigma) over the box the points span" +
+                  (object_points.empty() ? "" : " and the object points") + ", most near pixel (" +
                   std::to_string(static_cast<long>(std::lround(where.x()))) + ", " +
                   std::to_string(static_cast<long>(std::lround(where.y()))) + "); bound " +
                   Px(check.bound_px);
