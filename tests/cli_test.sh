@@ -172,6 +172,18 @@ EOF
       --model focal --loss huber:2
     expect_in err "object-points"
     ;;
+  fit_robust_loss)
+    # A robust loss runs with a forced model (Ceres, said in the summary); the automatic
+    # selection compares least-squares fits and refuses it with the reason.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --model focal+aspect+principal-point --loss huber:2 -o "$work/cam.json"
+    expect_in out "iterations of ceres, huber loss 2 px"
+    [[ -f "$work/cam.json" ]] || fail "no camera file"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080
+    expect_in out "iterations of levenberg-marquardt"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --loss huber:2
+    expect_in err "--loss needs an explicit --model"
+    ;;
   usage_errors)
     expect_exit 1 "$bin"
     expect_exit 1 "$bin" fit "$data/projector/points.csv"

@@ -619,6 +619,40 @@ TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
   EXPECT_LT(b.median_px, 1.5);
 }
 
+// The result names what refined it (docs say the least-squares path is the project's own LM and
+// Ceres runs only for a robust loss and the orthographic fit): one scene, every path.
+TEST(FitTest, NamesItsRefiner) {
+  std::mt19937_64 rng(33);
+  const RandomCamera camera = ProjectorLikeCamera(rng);
+  SceneOptions scene_options;
+  scene_options.num_points = 30;
+  scene_options.pixel_noise = 0.5;
+  const Scene scene = MakeScene(rng, camera, scene_options);
+  const auto refiner = [&](const FitOptions& options) {
+    return FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options).refiner;
+  };
+  EXPECT_EQ(refiner(FitOptions{}), "levenberg-marquardt");
+  FitOptions huber;
+  huber.loss = LossType::kHuber;
+  huber.loss_scale_px = 2.0;
+  EXPECT_EQ(refiner(huber), "ceres, huber loss 2 px");
+  FitOptions cauchy;
+  cauchy.loss = LossType::kCauchy;
+  cauchy.loss_scale_px = 0.5;
+  EXPECT_EQ(refiner(cauchy), "ceres, cauchy loss 0.5 px");
+  FitOptions start_only;
+  start_only.refine = false;
+  EXPECT_EQ(refiner(start_only), "none");
+  FitOptions orthographic;
+  orthographic.projection = Projection::kOrthographic;
+  orthographic.focal = ParameterMode::Free();
+  orthographic.aspect = ParameterMode::Default();
+  orthographic.principal_point = ParameterMode::Default();
+  EXPECT_EQ(refiner(orthographic), "ceres");
+  orthographic.refine = false;
+  EXPECT_EQ(refiner(orthographic), "none");
+}
+
 // A 3-degree field of view: focal length and distance trade off almost exactly (a telephoto
 // view is nearly affine), and the result says so.
 TEST(FitTest, ReportsTheFocalDistanceCorrelationOfANarrowView) {

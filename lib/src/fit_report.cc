@@ -186,8 +186,8 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
         << " (" << Format("%.2f", fit.residuals_px[index].norm()) << " px)";
   }
   out << "\n";
-  out << "time: " << Format("%.3f", fit.time_ms) << " ms, " << fit.iterations << " iterations ("
-      << fit.termination << "), Jacobian condition " << Format("%.3g", fit.jacobian_condition)
+  out << "time: " << Format("%.3f", fit.time_ms) << " ms, " << fit.iterations << " iterations of "
+      << fit.refiner << " (" << fit.termination << "), Jacobian condition " << Format("%.3g", fit.jacobian_condition)
       << "\n";
   return out.str();
 }

@@ -268,7 +268,12 @@ struct FitResult {
   double jacobian_condition = 0.0;
 
   int iterations = 0;
-  std::string termination;  // Ceres' termination type and message
+  // What refined the camera: "levenberg-marquardt" (the project's own LM on accumulated normal
+  // equations, then undamped Gauss-Newton steps: every least-squares fit), "ceres, huber loss
+  // 2 px" / "ceres, cauchy loss 2 px" (FitOptions::loss: a ceres::Problem), "ceres"
+  // (orthographic) or "none" (FitOptions::refine = false).
+  std::string refiner;
+  std::string termination;  // why it stopped, in the refiner's words
   double time_ms = 0.0;
   std::vector<TraceEntry> trace;
 

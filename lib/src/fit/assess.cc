@@ -144,6 +144,7 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const int num_params = 6 + model.NumFree();
   FitResult result;
   result.iterations = refined.iterations;
+  result.refiner = std::move(refined.refiner);
   result.termination = std::move(refined.termination);
   result.trace = std::move(refined.trace);
 

@@ -188,6 +188,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                        "the orthographic refinement failed: " + summary.message);
     }
     result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    result.refiner = "ceres";
     result.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
                          ": " + summary.message;
     Eigen::Matrix3d step;
@@ -195,6 +196,7 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
     rotation = step * rotation;
     omega = {0.0, 0.0, 0.0};
   } else {
+    result.refiner = "none";
     result.termination = "not refined (closed-form start only)";
   }
   // The refinement may cross to a negative scale or fy: the same image as positive ones with

@@ -121,6 +121,7 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
   refined.model = std::move(best.model);
   refined.normal = std::move(best.normal);
   refined.iterations = best.iterations;
+  refined.refiner = "levenberg-marquardt";
   refined.termination = std::move(best.termination);
   refined.trace = std::move(best.trace);
   return refined;
@@ -188,6 +189,8 @@ RefinedCamera RefineRobust(const Scene& scene, const Start& start, const FitOpti
   rotation.normalize();
   refined.rotation = rotation.toRotationMatrix();
   refined.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  refined.refiner = Concat("ceres, ", options.loss == LossType::kHuber ? "huber" : "cauchy",
+                           " loss ", options.loss_scale_px, " px");
   refined.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
                         ": " + summary.message;
   return refined;
@@ -207,6 +210,7 @@ RefinedCamera RefineCamera(const Scene& scene, const Start& start, const FitOpti
     refined.rotation = start.camera.rotation;
     refined.center = start.camera.center;
     refined.model = start.model;
+    refined.refiner = "none";
     refined.termination = "not refined (closed-form start only)";
   }
   // A point behind the camera leaves them empty: the assessment refuses it.

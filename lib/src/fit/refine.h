@@ -31,6 +31,7 @@ struct RefinedCamera {
   // empty when a point is behind the camera, which the assessment refuses.
   NormalEquations normal;
   int iterations = 0;
+  std::string refiner;      // FitResult::refiner
   std::string termination;  // FitResult::termination
   std::vector<TraceEntry> trace;
 };
