@@ -239,6 +239,7 @@ class PixelUncertainty {
 struct TestPoints {
   std::vector<Eigen::Vector3d> points;
   std::vector<int> fitted;
+  std::vector<bool> object;  // an object point (AutoFitOptions::object_points_in_world)
 };
 
 TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
@@ -283,6 +284,7 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
         u->y() <= camera.image_size.height - 0.5) {
       inside.points.push_back(candidates[k]);
       inside.fitted.push_back(k < points.size() ? static_cast<int>(k) : -1);
+      inside.object.push_back(k >= candidates.size() - object_points.size());
     }
   }
   return inside;
@@ -297,6 +299,7 @@ TestPoints TestPointsOrFitted(const Camera& camera, const std::vector<Eigen::Vec
     test.points = points;
     test.fitted.resize(points.size());
     std::iota(test.fitted.begin(), test.fitted.end(), 0);
+    test.object.assign(points.size(), false);
   }
   return test;
 }
@@ -384,7 +387,12 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     TestPoints their_test = our_test;
     for (Eigen::Vector3d& x : their_test.points) x = flip.asDiagonal() * x;
     // A richer rival scatters by its own uncertainty: only a shift beyond kRivalSigmas of it
-    // is a different reading of the data rather than the rival's noise.
+    // is a different reading of the data rather than the rival's noise -- except at an object
+    // point where the rival is itself undetermined (sigma above the bound): if it is the true
+    // model, the data that cannot tell it from the chosen one cannot pin that point either, and
+    // the user said the object is there. (Not at the box's corners: off a plane every rival
+    // with a free intrinsic is undetermined, and a plane would always be refused. Measured on
+    // the click benchmark with the model's vertices: docs/model-selection.md.)
     std::vector<double> rival_sigmas;
     try {
       rival_sigmas = SigmasAt(PixelUncertainty(rival_camera, rival.options,
@@ -401,7 +409,9 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       const std::optional<Eigen::Vector2d> theirs =
           PixelFromWorld(rival_camera, their_test.points[i]);
       const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
-      if (d > kRivalSigmas * rival_sigmas[i]) shift = std::max(shift, d);
+      const bool undetermined =
+          !rival.mirrored_world && our_test.object[i] && rival_sigmas[i] > check.bound_px;
+      if (d > kRivalSigmas * rival_sigmas[i] || undetermined) shift = std::max(shift, d);
     }
     if (!(shift <= check.rival_shift_px)) {
       check.rival_shift_px = shift;
