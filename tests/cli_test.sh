@@ -31,6 +31,11 @@ case $case in
     expect_in out "residuals: rms"
     expect_in out "worst points:"
     expect_in out "iteration  elapsed_us  rms_px"
+    # The fit's time and the command's wall time (reading and writing included) are both printed.
+    fit_ms=$(sed -n 's/^time: \([0-9.]*\) ms.*/\1/p' "$work/out")
+    wall_ms=$(sed -n 's/^wall time: \([0-9.]*\) ms (reading 20 points.*/\1/p' "$work/out")
+    [[ -n "$fit_ms" && -n "$wall_ms" ]] && py -c "import sys; sys.exit(not float(sys.argv[1]) <= float(sys.argv[2]))" "$fit_ms" "$wall_ms" \
+      || fail "fit time '$fit_ms' ms and wall time '$wall_ms' ms"
     [[ -f "$work/cam.json" ]] || fail "no camera file"
     grep -q '"fit"' "$work/cam.json" || fail "camera file lacks fit"
     # The fit is within a few sigma of the truth the data was made from.

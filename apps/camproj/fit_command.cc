@@ -487,6 +487,7 @@ Command AddFitCommand(CLI::App& root) {
             if (inputs.size() > 1 || std::filesystem::is_directory(args->points_paths.front())) {
               return FitBatch(inputs, size, request, *args);
             }
+            const auto begin = std::chrono::steady_clock::now();
             if (!args->output_path.empty()) {
               RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path});
             }
@@ -498,6 +499,11 @@ Command AddFitCommand(CLI::App& root) {
             } else {
               std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
               if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
+              // The summary's time is the fit's; reading and writing the files add to it.
+              const double wall_ms = std::chrono::duration<double, std::milli>(
+                                         std::chrono::steady_clock::now() - begin).count();
+              std::printf("wall time: %.3f ms (reading %zu points, fitting, writing)\n", wall_ms,
+                          data.pixels.size());
             }
             if (args->trace) std::cout << FitTraceText(fit);
             return kExitOk;
