@@ -189,6 +189,13 @@ case $case in
     py -c "n=174000; print('{\"image_size\": [640, 480], \"x\": ' + '{\"a\":'*n + '1' + '}'*n + '}')" >"$work/deep2.json"
     expect_exit 2 "$bin" export "$work/deep2.json"
     expect_in err "nest deeper"
+    # The reader's other bounds (docs/reliability.md): 1 MiB, and image_size up to 10^6.
+    { printf '{"image_size": [640, 480]'; head -c 1100000 /dev/zero | tr '\0' ' '; printf '}'; } >"$work/big.json"
+    expect_exit 2 "$bin" export "$work/big.json"
+    expect_in err "big.json: larger than 1048576 bytes"
+    printf '{"image_size": [1000001, 480]}' >"$work/wide.json"
+    expect_exit 2 "$bin" export "$work/wide.json"
+    expect_in err "wide.json: image_size: expected two positive integers"
     # Wrong values are described, not quoted back.
     printf '{"image_size": [640, [[1]]]}' >"$work/typed.json"
     expect_exit 2 "$bin" export "$work/typed.json"

@@ -18,9 +18,6 @@ namespace {
 // OpenCV draws with integer coordinates in 1/16 px (shift = 4); its pixel centres are at integers,
 // as in kCenter.
 constexpr int kShift = 4;
-
-// A PNG or JPEG of kMaxImagePixels is far smaller than this; a bigger file is not a photo.
-constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
 cv::Point Fixed(const Eigen::Vector2d& p) {
   return {static_cast<int>(std::lround(p.x() * 16.0)), static_cast<int>(std::lround(p.y() * 16.0))};
 }
@@ -34,11 +31,16 @@ void OverlayOptions::Check() const {
 
 namespace {
 
-// The background, decoded only after its header states the camera's size.
+// A PNG or JPEG of kMaxImagePixels is far smaller than this; a bigger file is not a photo.
+constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
+
+// The background, decoded only after its header states the camera's size (for a JPEG, either
+// way round: OpenCV turns it by its EXIF orientation while decoding).
 cv::Mat ReadBackground(const std::string& path, int w, int h) {
   const std::string bytes = ReadWholeFile(path, kMaxImageFileBytes);
   const ImageHeader header = ReadImageHeader(bytes, path);
-  if (header.width != w || header.height != h) {
+  const bool turned = header.format == ImageFormat::kJpeg && header.width == h && header.height == w;
+  if ((header.width != w || header.height != h) && !turned) {
     throw InputError(internal::Concat(path, ": image is ", header.width, "x", header.height,
                                       " but the camera's image size is ", w, "x", h));
   }
@@ -50,8 +52,11 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
   } catch (const cv::Exception& e) {
     throw InputError(path + ": cannot decode the image: " + e.what());
   }
-  if (image.empty() || image.cols != w || image.rows != h) {
-    throw InputError(path + ": cannot decode the image (corrupt or unsupported)");
+  if (image.empty()) throw InputError(path + ": cannot decode the image (corrupt or unsupported)");
+  if (image.cols != w || image.rows != h) {
+    throw InputError(internal::Concat(path, ": image is ", image.cols, "x", image.rows,
+                                      " after its EXIF orientation, but the camera's image size is ",
+                                      w, "x", h));
   }
   return image;
 }
