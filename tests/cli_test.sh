@@ -275,6 +275,13 @@ json.load(open(rows[1]["camera_file"]))
       done
     }
     for delay in 0 0.05 0.3; do kill_batch KILL "$delay"; done
+    # A temporary left by a kill over an hour ago is swept by the next write there; a recent one
+    # (maybe another camproj's write in progress) is left alone.
+    touch -d '2 hours ago' "$work/cams/.camproj-Stale1.tmp"
+    touch "$work/cams/.camproj-Fresh1.tmp"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cams/one.json"
+    [[ ! -e "$work/cams/.camproj-Stale1.tmp" ]] || fail "a stale temporary was not swept"
+    [[ -e "$work/cams/.camproj-Fresh1.tmp" ]] || fail "a recent temporary was removed"
     # Without O_TMPFILE (forced): the named temporary is removed on SIGTERM and SIGHUP (SIGINT has
     # the same handler, but a background job of a script ignores it).
     kill_batch TERM 0 CAMPROJ_TEST_NO_TMPFILE=1

@@ -1,5 +1,6 @@
 #include "camproj/file_io.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/random.h>
 #include <sys/stat.h>
@@ -12,7 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <optional>
+#include <ctime>
 
 #include "camproj/errors.h"
 
@@ -44,11 +45,18 @@ void AbandonIfDying(const std::string& name) {
   for (;;) pause();
 }
 
-// Registers `path` for removal on a signal until the destructor; silently does nothing if the
-// table is full or the path too long (the temporary then just is not removed on a signal).
+// Registers a temporary's path for removal on a signal, until cleared or destroyed; silently
+// does nothing if the table is full or the path too long (the temporary then just is not removed
+// on a signal).
 class SignalCleanup {
  public:
-  explicit SignalCleanup(const std::string& path) {
+  SignalCleanup() = default;
+  ~SignalCleanup() { Clear(); }
+  SignalCleanup(const SignalCleanup&) = delete;
+  SignalCleanup& operator=(const SignalCleanup&) = delete;
+
+  void Set(const std::string& path) {
+    Clear();
     if (path.size() >= PATH_MAX) return;
     for (PendingTemporary& slot : pending_temporaries) {
       bool expected = false;
@@ -60,13 +68,12 @@ class SignalCleanup {
       }
     }
   }
-  ~SignalCleanup() {
+  void Clear() {
     if (slot_ == nullptr) return;
     slot_->ready = false;
     slot_->used = false;
+    slot_ = nullptr;
   }
-  SignalCleanup(const SignalCleanup&) = delete;
-  SignalCleanup& operator=(const SignalCleanup&) = delete;
 
  private:
   PendingTemporary* slot_ = nullptr;
@@ -142,6 +149,34 @@ struct TemporaryGuard {
   }
 };
 
+// Removes this tool's temporaries in `folder` (".camproj-XXXXXX.tmp", regular files) last modified
+// over kStaleTemporarySeconds ago: left by a kill at the instant between linkat and rename, or
+// during a write on a file system without O_TMPFILE. A write in progress touches its temporary
+// within milliseconds, so an hour-old one belongs to no running camproj. Best effort: errors are
+// ignored.
+constexpr time_t kStaleTemporarySeconds = 3600;
+void SweepStaleTemporaries(const std::string& folder) {
+  DIR* dir = opendir(folder.c_str());
+  if (dir == nullptr) return;
+  const time_t now = time(nullptr);
+  static constexpr char kPrefix[] = ".camproj-";
+  static constexpr char kSuffix[] = ".tmp";
+  const size_t length = sizeof kPrefix - 1 + 6 + sizeof kSuffix - 1;
+  while (const dirent* entry = readdir(dir)) {
+    const std::string name = entry->d_name;
+    if (name.size() != length || name.compare(0, sizeof kPrefix - 1, kPrefix) != 0 ||
+        name.compare(length - (sizeof kSuffix - 1), std::string::npos, kSuffix) != 0) {
+      continue;
+    }
+    struct stat info {};
+    if (fstatat(dirfd(dir), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(info.st_mode) &&
+        info.st_mtime < now - kStaleTemporarySeconds) {
+      unlinkat(dirfd(dir), name.c_str(), 0);
+    }
+  }
+  closedir(dir);
+}
+
 const char* KindOf(mode_t mode) {
   if (S_ISDIR(mode)) return "a folder";
   if (S_ISFIFO(mode)) return "a FIFO";
@@ -183,15 +218,15 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   temporary.fd = try_unnamed ? open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666) : -1;
   const bool unnamed = temporary.fd >= 0;
   std::string name;
-  std::optional<SignalCleanup> cleanup;
+  SignalCleanup cleanup;
   if (!unnamed) {
     for (int attempt = 0; attempt < 100 && temporary.fd < 0; ++attempt) {
       name = TemporaryName(folder);
-      cleanup.emplace(name);
+      cleanup.Set(name);
       temporary.fd = open(name.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0666);
       if (temporary.fd < 0) {
         const int error = errno;
-        cleanup.reset();
+        cleanup.Clear();
         if (error != EEXIST) {
           throw InputError("cannot write " + path + ": cannot create a file in " + folder + ": " +
                            ErrnoText(error));
@@ -218,17 +253,17 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
     const std::string fd_path = "/proc/self/fd/" + std::to_string(temporary.fd);
     for (int attempt = 0; attempt < 100; ++attempt) {
       name = TemporaryName(folder);
-      cleanup.emplace(name);
+      cleanup.Set(name);
       if (linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
         AbandonIfDying(name);
         break;
       }
       if (errno != EEXIST) {
         const int error = errno;
-        cleanup.reset();
+        cleanup.Clear();
         throw InputError("cannot write " + path + ": link: " + ErrnoText(error));
       }
-      cleanup.reset();
+      cleanup.Clear();
       name.clear();
     }
     if (name.empty()) throw InputError("cannot write " + path + ": no free temporary name in " + folder);
@@ -241,6 +276,7 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
     throw InputError("cannot write " + path + ": rename: " + ErrnoText(errno));
   }
   temporary.name.clear();
+  SweepStaleTemporaries(folder);
 }
 
 InputFile::InputFile(const std::string& path) : path_(path) {

@@ -15,7 +15,9 @@ namespace camproj {
 //    file system has no O_TMPFILE, that short name is created directly (it fits NAME_MAX for any
 //    target name) and InstallTemporaryFileCleanup's handlers remove it on SIGINT/SIGTERM/SIGHUP;
 //  - a `path` that is a symbolic link is written through: its target is replaced, the link stays;
-//  - a replaced file keeps its permission bits; a new one gets 0666 minus the umask.
+//  - a replaced file keeps its permission bits; a new one gets 0666 minus the umask;
+//  - after the rename, temporaries of this function in the folder last modified over an hour ago
+//    (left by a kill in the instant before a rename) are removed.
 // Throws InputError naming `path` and the reason (e.g. "File too large" under `ulimit -f`, when
 // SIGXFSZ is ignored as InstallTemporaryFileCleanup arranges) and removes the temporary.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
