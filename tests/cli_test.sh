@@ -300,6 +300,35 @@ json.load(open(rows[1]["camera_file"]))
       [[ -z $(ls -A "$work" | grep -v '^out$\|^err$') ]] || fail "left behind: $(ls -A "$work")"
     done
     ;;
+  full_disk)
+    # A full file system (a 16 KiB tmpfs in a private mount namespace, filled to its last 4 KiB
+    # page): exit 2 naming the file and "No space left on device", the old file kept, nothing
+    # left. Needs the right to mount (root, or a user namespace): SKIPPED otherwise.
+    if ! unshare -rm true 2>/dev/null && ! unshare -m true 2>/dev/null; then
+      echo "SKIPPED [$case]: cannot create a mount namespace to mount a tmpfs"; exit 77
+    fi
+    cat >"$work/full.sh" <<'INNER'
+set -u
+bin=$1 data=$2 dir=$3
+mount -t tmpfs -o size=16k tmpfs "$dir" 2>/dev/null || exit 77
+printf '{"old": true}\n' >"$dir/cam.json"
+head -c 8192 /dev/zero >"$dir/filler" 2>/dev/null
+"$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$dir/cam.json" >/dev/null
+code=$?
+ls -A "$dir" >"$dir.list"
+cp "$dir/cam.json" "$dir.cam"
+exit $code
+INNER
+    mkdir -p "$work/mnt"
+    unshare -m bash "$work/full.sh" "$bin" "$data" "$work/mnt" >"$work/out" 2>"$work/err" ||
+      code=$?
+    code=${code:-0}
+    ((code == 77)) && { echo "SKIPPED [$case]: cannot mount a tmpfs"; exit 77; }
+    ((code == 2)) || fail "exit $code on a full file system:\n$(cat "$work/err")"
+    expect_in err "cannot write .*cam.json: .*No space left on device"
+    [[ $(cat "$work/mnt.list" | tr '\n' ' ') == "cam.json filler " ]] || fail "left: $(cat "$work/mnt.list")"
+    grep -q '"old"' "$work/mnt.cam" || fail "the old camera file was changed"
+    ;;
   file_modes_and_links)
     # A new file honours the umask; a replaced one keeps its mode (main: always 0644).
     ( umask 077; exec "$bin" synth --seed 1 --points 10 -o "$work/new.csv" --truth "$work/new.json" ) >/dev/null 2>&1 || fail "synth failed"
