@@ -252,10 +252,10 @@ json.load(open(rows[1]["camera_file"]))
   no_stray_temporary_after_kill)
     # A signal in the middle of a batch, at several moments after the first camera file appeared:
     # every camera file present is whole JSON and nothing else is in the folder (main left 1-2
-    # *.tmp.* files per SIGKILL). 30 fits of 5000 points take ~1 s on 2 threads.
-    "$bin" synth --seed 2 --points 5000 -o "$work/big.csv" --truth "$work/truth.json" >/dev/null || fail "synth"
+    # *.tmp.* files per SIGKILL). 20 fits of 3000 points take ~0.5 s on 2 threads in Release.
+    "$bin" synth --seed 2 --points 3000 -o "$work/big.csv" --truth "$work/truth.json" >/dev/null || fail "synth"
     mkdir -p "$work/in"
-    for i in $(seq 1 30); do cp "$work/big.csv" "$work/in/s$i.csv"; done
+    for i in $(seq 1 20); do cp "$work/big.csv" "$work/in/s$i.csv"; done
     # kill_batch SIGNAL DELAY [ENV...]: starts the batch, waits (<= 20 s) for its first camera
     # file, sleeps DELAY, sends SIGNAL, then checks the folder.
     kill_batch() {
@@ -274,7 +274,7 @@ json.load(open(rows[1]["camera_file"]))
         py -c 'import json, sys; json.load(open(sys.argv[1]))' "$f" || fail "$f is not whole JSON"
       done
     }
-    for delay in 0 0.05 0.3; do kill_batch KILL "$delay"; done
+    for delay in 0 0.1; do kill_batch KILL "$delay"; done
     # A temporary left by a kill over an hour ago is swept by the next write there; a recent one
     # (maybe another camproj's write in progress) is left alone.
     touch -d '2 hours ago' "$work/cams/.camproj-Stale1.tmp"
@@ -285,7 +285,6 @@ json.load(open(rows[1]["camera_file"]))
     # Without O_TMPFILE (forced): the named temporary is removed on SIGTERM and SIGHUP (SIGINT has
     # the same handler, but a background job of a script ignores it).
     kill_batch TERM 0 CAMPROJ_TEST_NO_TMPFILE=1
-    kill_batch TERM 0.1 CAMPROJ_TEST_NO_TMPFILE=1
     kill_batch HUP 0.05 CAMPROJ_TEST_NO_TMPFILE=1
     ;;
   file_size_limit)
@@ -373,9 +372,10 @@ INNER
 import json, sys
 d = json.load(open(sys.argv[1])); d["intrinsics"][sys.argv[2]] = 1e308
 json.dump(d, open(sys.argv[3], "w"))' "$data/projector/truth.json" "$field" "$work/big_$field.json"
-      # Every format for fx; for cx (the same check) the ones main let through and gl.
-      formats="gl glm opencv-yaml colmap three json"
-      [[ $field == cx ]] && formats="gl colmap"
+      # The reader refuses the camera, so every format alike: the two main wrote non-finite
+      # numbers in for fx (gl, json) and the one it let through for cx (colmap).
+      formats="gl json colmap"
+      [[ $field == cx ]] && formats="colmap"
       for to in $formats; do
         expect_exit 2 "$bin" export "$work/big_$field.json" --to "$to"
         expect_in err "big_$field.json: intrinsics: "
