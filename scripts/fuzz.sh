@@ -48,8 +48,11 @@ run_id=$(date +%Y%m%d-%H%M%S)
 artifacts="$build/artifacts/$run_id"
 work=$(mktemp -d "${TMPDIR:-/tmp}/camproj-fuzz.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-# Bounds: -timeout reports an input that takes longer than that (a hang); -max_len 64 KiB.
-common=(-rss_limit_mb=2048 -timeout=10 -max_len=65536)
+# Bounds: -timeout reports an input that takes longer than that (a hang); -max_len 64 KiB, but
+# for the camera-file reader its own size limit, 1 MiB: a deep nesting needs ~130 KB to crash a
+# recursive reader (issue #11).
+common=(-rss_limit_mb=2048 -timeout=10)
+declare -A max_len=([points_csv]=65536 [camera_json]=1048576)
 
 # Prints a failed step's log and the reproducers it left; $1 target, $2 step, $3 exit code, $4 log.
 report_failure() {
@@ -86,7 +89,7 @@ for target in "${targets[@]}"; do
   fuzzer="$build/fuzz/${target}_fuzzer"
   corpus="$root/fuzz/corpus/$target"
   mkdir -p "$artifacts/$target"
-  prefix=(-artifact_prefix="$artifacts/$target/")
+  prefix=(-artifact_prefix="$artifacts/$target/" -max_len="${max_len[$target]}")
 
   # Replay: every seed once, each on its own (a crashing seed is named in the log).
   seeds=("$corpus"/*)

@@ -17,6 +17,7 @@ expect_exit() {
   [[ $got -eq $want ]] || fail "exit $got, expected $want: $*\n--- stdout\n$(cat "$work/out")\n--- stderr\n$(cat "$work/err")"
 }
 expect_in() { grep -q -- "$2" "$work/$1" || fail "$1 lacks '$2':\n$(cat "$work/$1")"; }
+py() { /usr/bin/python3 "$@"; }
 
 case $case in
   fit_projector)
@@ -30,6 +31,11 @@ case $case in
     expect_in out "residuals: rms"
     expect_in out "worst points:"
     expect_in out "iteration  elapsed_us  rms_px"
+    # The fit's time and the command's wall time (reading and writing included) are both printed.
+    fit_ms=$(sed -n 's/^time: \([0-9.]*\) ms.*/\1/p' "$work/out")
+    wall_ms=$(sed -n 's/^wall time: \([0-9.]*\) ms (reading 20 points.*/\1/p' "$work/out")
+    [[ -n "$fit_ms" && -n "$wall_ms" ]] && py -c "import sys; sys.exit(not float(sys.argv[1]) <= float(sys.argv[2]))" "$fit_ms" "$wall_ms" \
+      || fail "fit time '$fit_ms' ms and wall time '$wall_ms' ms"
     [[ -f "$work/cam.json" ]] || fail "no camera file"
     grep -q '"fit"' "$work/cam.json" || fail "camera file lacks fit"
     # The fit is within a few sigma of the truth the data was made from.
@@ -237,6 +243,273 @@ EOF
     [[ $(head -c 8 "$work/o.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] || fail "not a PNG"
     expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
     [[ ! -e "$work/p.png" ]] || fail "partial output"
+    ;;
+  deep_json_refused)
+    # 100000 nested arrays inside a checked key (200 KB, under the 1 MiB limit): main crashed in
+    # nlohmann's recursive dump() building the message (SIGSEGV, exit 139).
+    py -c "n=100000; print('{\"image_size\": ' + '['*n + ']'*n + '}')" >"$work/deep.json"
+    for cmd in "export $work/deep.json" "project $work/deep.json $data/projector/points.csv" \
+               "overlay $work/deep.json $data/projector/points.csv -o $work/o.png" \
+               "fit $data/projector/points.csv --image-size 1920x1080 --intrinsics $work/deep.json"; do
+      expect_exit 2 "$bin" $cmd
+      expect_in err "deep.json: line 1: arrays and objects nest deeper than 32 levels"
+    done
+    # Just under the reader's 1 MiB limit, in objects, after a valid start.
+    py -c "n=174000; print('{\"image_size\": [640, 480], \"x\": ' + '{\"a\":'*n + '1' + '}'*n + '}')" >"$work/deep2.json"
+    expect_exit 2 "$bin" export "$work/deep2.json"
+    expect_in err "nest deeper"
+    # The reader's other bounds (docs/reliability.md): 1 MiB, and image_size up to 10^6.
+    { printf '{"image_size": [640, 480]'; head -c 1100000 /dev/zero | tr '\0' ' '; printf '}'; } >"$work/big.json"
+    expect_exit 2 "$bin" export "$work/big.json"
+    expect_in err "big.json: larger than 1048576 bytes"
+    printf '{"image_size": [1000001, 480]}' >"$work/wide.json"
+    expect_exit 2 "$bin" export "$work/wide.json"
+    expect_in err "wide.json: image_size: expected two positive integers"
+    # Wrong values are described, not quoted back.
+    printf '{"image_size": [640, [[1]]]}' >"$work/typed.json"
+    expect_exit 2 "$bin" export "$work/typed.json"
+    expect_in err 'image_size\[1\]: expected a number, got an array of 1 elements'
+    ;;
+  output_is_input_refused)
+    cp "$data/projector/points.csv" "$work/p.csv"
+    expect_exit 2 "$bin" fit "$work/p.csv" --image-size 1920x1080 -o "$work/p.csv"
+    expect_in err "p.csv: the output is the input"
+    cmp -s "$data/projector/points.csv" "$work/p.csv" || fail "fit replaced its input"
+    ln -s p.csv "$work/link.json"
+    ln "$work/p.csv" "$work/hard.json"
+    for out in link.json hard.json; do
+      expect_exit 2 "$bin" fit "$work/p.csv" --image-size 1920x1080 -o "$work/$out"
+      expect_in err "the output is the input"
+    done
+    cmp -s "$data/projector/points.csv" "$work/p.csv" || fail "fit replaced its input through a link"
+    cp "$data/projector/truth.json" "$work/cam.json"
+    expect_exit 2 "$bin" fit "$work/p.csv" --image-size 1920x1080 --intrinsics "$work/cam.json" -o "$work/cam.json"
+    cmp -s "$data/projector/truth.json" "$work/cam.json" || fail "fit replaced its --intrinsics file"
+    # overlay: the photo it draws on, and its camera and points files.
+    expect_exit 0 "$bin" overlay "$work/cam.json" "$work/p.csv" -o "$work/photo.png"
+    cp "$work/photo.png" "$work/photo.orig.png"
+    for out in photo.png cam.json p.csv; do
+      expect_exit 2 "$bin" overlay "$work/cam.json" "$work/p.csv" "$work/photo.png" -o "$work/$out"
+      expect_in err "the output is the input"
+    done
+    cmp -s "$work/photo.png" "$work/photo.orig.png" || fail "overlay replaced its photo"
+    cmp -s "$data/projector/truth.json" "$work/cam.json" || fail "overlay replaced its camera"
+    ;;
+  batch_name_collision_refused)
+    mkdir -p "$work/a" "$work/b"
+    cp "$data/projector/points.csv" "$work/a/cam.csv"
+    cp "$data/synthetic/points.csv" "$work/b/cam.csv"
+    expect_exit 1 "$bin" fit "$work/a/cam.csv" "$work/b/cam.csv" --image-size 1920x1080 -o "$work/cams"
+    expect_in err "inputs .*a/cam.csv and .*b/cam.csv would both write .*cams/cam.json"
+    [[ ! -e "$work/cams" ]] || fail "refused up front, yet something was written"
+    ;;
+  batch_json_lines)
+    mkdir -p "$work/in"
+    cp "$data/projector/points.csv" "$work/in/projector.csv"
+    printf 'X,Y,Z,u,v\n1,2,x,4,5\n' >"$work/in/broken.csv"
+    expect_exit 2 "$bin" fit "$work/in" --image-size 1920x1080 -o "$work/cams" --json --jobs 2
+    [[ $(wc -l <"$work/out") -eq 2 ]] || fail "expected 2 JSON lines:\n$(cat "$work/out")"
+    py -c '
+import json, sys
+rows = [json.loads(line) for line in open(sys.argv[1])]
+assert rows[0]["file"].endswith("broken.csv") and rows[0]["status"] == "bad input" and rows[0]["exit_code"] == 2 and rows[0]["camera_file"] is None, rows[0]
+assert rows[1]["status"] == "ok" and rows[1]["camera_file"].endswith("projector.json"), rows[1]
+json.load(open(rows[1]["camera_file"]))
+' "$work/out" || fail "bad JSON lines:\n$(cat "$work/out")"
+    expect_in err "1 of 2 fitted"
+    ;;
+  no_stray_temporary_after_kill)
+    # A signal in the middle of a batch, at several moments after the first camera file appeared:
+    # every camera file present is whole JSON and nothing else is in the folder (main left 1-2
+    # *.tmp.* files per SIGKILL). 20 fits of 3000 points take ~0.5 s on 2 threads in Release.
+    "$bin" synth --seed 2 --points 3000 -o "$work/big.csv" --truth "$work/truth.json" >/dev/null || fail "synth"
+    mkdir -p "$work/in"
+    for i in $(seq 1 20); do cp "$work/big.csv" "$work/in/s$i.csv"; done
+    # kill_batch SIGNAL DELAY [ENV...]: starts the batch, waits (<= 20 s) for its first camera
+    # file, sleeps DELAY, sends SIGNAL, then checks the folder.
+    kill_batch() {
+      local signal=$1 delay=$2; shift 2
+      rm -rf "$work/cams"
+      env "$@" "$bin" fit "$work/in" --image-size 1920x1080 -o "$work/cams" --jobs 2 >/dev/null 2>&1 &
+      local pid=$! waited=0
+      until compgen -G "$work/cams/*.json" >/dev/null || ((waited++ > 2000)); do sleep 0.01; done
+      sleep "$delay"
+      kill "-$signal" "$pid" 2>/dev/null
+      wait "$pid" 2>/dev/null
+      local stray
+      stray=$(ls -A "$work/cams" | grep -v '^s[0-9]*\.json$')
+      [[ -z "$stray" ]] || fail "left after SIG$signal at +${delay}s ($*): $stray"
+      for f in "$work/cams"/*.json; do
+        py -c 'import json, sys; json.load(open(sys.argv[1]))' "$f" || fail "$f is not whole JSON"
+      done
+    }
+    for delay in 0 0.1; do kill_batch KILL "$delay"; done
+    # A temporary left by a kill over an hour ago is swept by the next write there; a recent one
+    # (maybe another camproj's write in progress) is left alone.
+    touch -d '2 hours ago' "$work/cams/.camproj-Stale1.tmp"
+    touch "$work/cams/.camproj-Fresh1.tmp"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cams/one.json"
+    [[ ! -e "$work/cams/.camproj-Stale1.tmp" ]] || fail "a stale temporary was not swept"
+    [[ -e "$work/cams/.camproj-Fresh1.tmp" ]] || fail "a recent temporary was removed"
+    # Without O_TMPFILE (forced): the named temporary is removed on SIGTERM and SIGHUP (SIGINT has
+    # the same handler, but a background job of a script ignores it).
+    kill_batch TERM 0 CAMPROJ_TEST_NO_TMPFILE=1
+    kill_batch HUP 0.05 CAMPROJ_TEST_NO_TMPFILE=1
+    ;;
+  file_size_limit)
+    # ulimit -f 2 (2 KiB) is below a camera file (~6 KB): exit 2 naming the file and the reason,
+    # no partial file (main died of SIGXFSZ leaving out.json.tmp.XXXXXX).
+    for fallback in "" 1; do
+      rm -f "$work"/out.json* "$work"/.camproj-*
+      ( ulimit -f 2; CAMPROJ_TEST_NO_TMPFILE=$fallback exec "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/out.json" ) >"$work/out" 2>"$work/err"
+      code=$?
+      [[ $code -eq 2 ]] || fail "exit $code under ulimit -f (fallback '$fallback'):\n$(cat "$work/err")"
+      expect_in err "cannot write .*out.json: File too large"
+      [[ -z $(ls -A "$work" | grep -v '^out$\|^err$') ]] || fail "left behind: $(ls -A "$work")"
+    done
+    ;;
+  full_disk)
+    # A full file system (a 16 KiB tmpfs in a private mount namespace, filled to its last 4 KiB
+    # page): exit 2 naming the file and "No space left on device", the old file kept, nothing
+    # left. Needs the right to mount (root, or a user namespace): SKIPPED otherwise.
+    if ! unshare -rm true 2>/dev/null && ! unshare -m true 2>/dev/null; then
+      echo "SKIPPED [$case]: cannot create a mount namespace to mount a tmpfs"; exit 77
+    fi
+    cat >"$work/full.sh" <<'INNER'
+set -u
+bin=$1 data=$2 dir=$3
+mount -t tmpfs -o size=16k tmpfs "$dir" 2>/dev/null || exit 77
+printf '{"old": true}\n' >"$dir/cam.json"
+head -c 8192 /dev/zero >"$dir/filler" 2>/dev/null
+"$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$dir/cam.json" >/dev/null
+code=$?
+ls -A "$dir" >"$dir.list"
+cp "$dir/cam.json" "$dir.cam"
+exit $code
+INNER
+    mkdir -p "$work/mnt"
+    unshare -m bash "$work/full.sh" "$bin" "$data" "$work/mnt" >"$work/out" 2>"$work/err" ||
+      code=$?
+    code=${code:-0}
+    ((code == 77)) && { echo "SKIPPED [$case]: cannot mount a tmpfs"; exit 77; }
+    ((code == 2)) || fail "exit $code on a full file system:\n$(cat "$work/err")"
+    expect_in err "cannot write .*cam.json: .*No space left on device"
+    [[ $(cat "$work/mnt.list" | tr '\n' ' ') == "cam.json filler " ]] || fail "left: $(cat "$work/mnt.list")"
+    grep -q '"old"' "$work/mnt.cam" || fail "the old camera file was changed"
+    ;;
+  file_modes_and_links)
+    # A new file honours the umask; a replaced one keeps its mode (main: always 0644).
+    ( umask 077; exec "$bin" synth --seed 1 --points 10 -o "$work/new.csv" --truth "$work/new.json" ) >/dev/null 2>&1 || fail "synth failed"
+    [[ $(stat -c %a "$work/new.csv") == 600 ]] || fail "umask 077 gave $(stat -c %a "$work/new.csv")"
+    printf 'old' >"$work/cam.json"
+    chmod 640 "$work/cam.json"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cam.json"
+    [[ $(stat -c %a "$work/cam.json") == 640 ]] || fail "replaced file's mode became $(stat -c %a "$work/cam.json")"
+    # A symlinked output is written through: the link stays, its target gets the camera.
+    mkdir -p "$work/real"
+    ln -s real/target.json "$work/link.json"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/link.json"
+    [[ -L "$work/link.json" ]] || fail "the symlink was replaced by a file"
+    grep -q '"fit"' "$work/real/target.json" || fail "the link's target holds no camera"
+    # A 250-byte output name (main: the temporary name exceeded NAME_MAX).
+    long=$(printf 'c%.0s' $(seq 1 245)).json
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/$long"
+    [[ -s "$work/$long" ]] || fail "no 250-byte output"
+    # A device is never replaced.
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o /dev/null
+    expect_in err "/dev/null: it is a character device"
+    [[ -c /dev/null ]] || fail "/dev/null was replaced"
+    ;;
+  fifo_input_refused)
+    # A FIFO with no writer (main: blocked forever) and a character device: refused at once.
+    # timeout 20: a generous bound for a run that takes milliseconds.
+    mkfifo "$work/fifo.csv" "$work/fifo.json"
+    expect_exit 2 timeout 20 "$bin" fit "$work/fifo.csv" --image-size 640x480
+    expect_in err "fifo.csv: is a FIFO, expected a regular file"
+    expect_exit 2 timeout 20 "$bin" export "$work/fifo.json"
+    expect_in err "fifo.json: is a FIFO"
+    expect_exit 2 timeout 20 "$bin" export /dev/zero
+    expect_in err "/dev/zero: is a character device"
+    expect_exit 2 timeout 20 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/fifo.csv" -o "$work/o.png"
+    expect_in err "fifo.csv: is a FIFO"
+    ;;
+  export_non_finite_refused)
+    # fx = 1e308 overflowed the GL matrices to inf (gl) or null (json), exit 0; cx = 1e308 failed
+    # gl/json but passed the others. Now every reader and exporter refuses both alike.
+    for field in fx cx; do
+      py -c '
+import json, sys
+d = json.load(open(sys.argv[1])); d["intrinsics"][sys.argv[2]] = 1e308
+json.dump(d, open(sys.argv[3], "w"))' "$data/projector/truth.json" "$field" "$work/big_$field.json"
+      # The reader refuses the camera, so every format alike: the two main wrote non-finite
+      # numbers in for fx (gl, json) and the one it let through for cx (colmap).
+      formats="gl json colmap"
+      [[ $field == cx ]] && formats="colmap"
+      for to in $formats; do
+        expect_exit 2 "$bin" export "$work/big_$field.json" --to "$to"
+        expect_in err "big_$field.json: intrinsics: "
+        [[ ! -s "$work/out" ]] || fail "export $to of $field = 1e308 printed: $(head -c 300 "$work/out")"
+      done
+      expect_exit 2 "$bin" project "$work/big_$field.json" "$data/projector/points.csv"
+      expect_exit 2 "$bin" overlay "$work/big_$field.json" "$data/projector/points.csv" -o "$work/o.png"
+      [[ ! -e "$work/o.png" ]] || fail "overlay wrote for $field = 1e308"
+    done
+    ;;
+  overlay_image_limits)
+    # The output format follows the extension (main wrote PNG bytes to x.jpg) or is refused.
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/o.jpg"
+    [[ $(head -c 2 "$work/o.jpg" | od -An -tx1 | tr -d ' \n') == ffd8 ]] || fail "o.jpg is not a JPEG"
+    expect_exit 1 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/o.bmp"
+    expect_in err "o.bmp: the image format is chosen by the extension"
+    # A 16384^2 PNG (about 500 KB of file, 805 MB decoded): refused from its header; max RSS stays
+    # far below the decoded size (main decoded it first). Bound 400 MB: the binary's own
+    # footprint is ~20 MB in Release and ~100 MB under ASan.
+    py -c '
+import struct, sys, zlib
+w = h = 16384
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+z = zlib.compressobj(9)
+row = bytes(w + 1)
+body = b"".join(z.compress(row) for _ in range(h)) + z.flush()
+sys.stdout.buffer.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)) + chunk(b"IDAT", body) + chunk(b"IEND", b""))' >"$work/huge.png"
+    for size in "[16384, 16384]" "[1920, 1080]"; do
+      py -c '
+import json, sys
+d = json.load(open(sys.argv[1])); d["image_size"] = json.loads(sys.argv[2])
+json.dump(d, open(sys.argv[3], "w"))' "$data/projector/truth.json" "$size" "$work/cam.json"
+      rss_kb=$(py -c '
+import resource, subprocess, sys
+r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=open(sys.argv[-1] + ".err", "w"))
+print(r.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)' \
+        "$bin" overlay "$work/cam.json" "$data/projector/points.csv" "$work/huge.png" -o "$work/big.png")
+      [[ ${rss_kb%% *} -eq 2 ]] || fail "exit ${rss_kb%% *} for a 16384^2 PNG on a $size camera: $(cat "$work/big.png.err")"
+      (( ${rss_kb##* } < 400000 )) || fail "max RSS ${rss_kb##* } KB for a 16384^2 PNG on a $size camera"
+      [[ ! -e "$work/big.png" ]] || fail "wrote an overlay"
+    done
+    grep -q "beyond the 67108864 pixels" "$work/big.png.err" || grep -q "image is 16384x16384" "$work/big.png.err" || fail "$(cat "$work/big.png.err")"
+    # A blank canvas of an absurd image size: refused naming the camera file (main: OpenCV's
+    # allocation error, naming no file).
+    py -c '
+import json, sys
+d = json.load(open(sys.argv[1])); d["image_size"] = [100000, 100000]
+json.dump(d, open(sys.argv[2], "w"))' "$data/projector/truth.json" "$work/wide.json"
+    expect_exit 2 "$bin" overlay "$work/wide.json" "$data/projector/points.csv" -o "$work/w.png"
+    expect_in err "wide.json: the camera's image size 100000x100000 is beyond the 67108864 pixels"
+    ;;
+  messages_and_version)
+    expect_exit 0 "$bin" --version
+    expect_in out "^camproj [0-9]*\.[0-9]*\.[0-9]*$"
+    # Only camproj's own message on stderr (main: OpenCV's "[ WARN:...] imread_" line too).
+    expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
+    [[ $(wc -l <"$work/err") -eq 1 ]] || fail "stderr has more than camproj's message:\n$(cat "$work/err")"
+    expect_in err "^camproj: error: .*missing.jpg: cannot open"
+    # An id with a terminal escape, moved 300 px so that the summary names it: printed escaped.
+    awk -F, 'BEGIN { OFS = "," } NR == 2 { print $0, "id" ; next } /^[-0-9]/ { row++; if (row == 3) { $4 += 300; print $0, "\033[31mred" } else print $0, "p" row; next } { print }' \
+      "$data/synthetic/points.csv" >"$work/esc.csv"
+    expect_exit 0 "$bin" fit "$work/esc.csv" --image-size 1280x800
+    expect_in out '\\x1b\[31mred'
+    ! grep -q $'\033' "$work/out" || fail "a raw ESC reached the terminal"
     ;;
   *) fail "unknown case" ;;
 esac

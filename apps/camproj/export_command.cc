@@ -6,6 +6,7 @@
 
 #include "camproj/camera_file.h"
 #include "camproj/depth_precision.h"
+#include "camproj/errors.h"
 #include "camproj/export.h"
 #include "cli.h"
 
@@ -93,7 +94,13 @@ Command AddExportCommand(CLI::App& root) {
                 }
               }
             }
-            std::cout << ExportCamera(camera, format, options);
+            std::string text;
+            try {
+              text = ExportCamera(camera, format, options);
+            } catch (const std::invalid_argument& e) {
+              throw InputError(args->camera_path + ": cannot export as " + args->to + ": " + e.what());
+            }
+            std::cout << text;
             return kExitOk;
           }};
 }

@@ -8,17 +8,22 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "camproj/camera_file.h"
+#include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/fit.h"
 #include "camproj/fit_report.h"
 #include "camproj/model_select.h"
 #include "camproj/points_file.h"
+#include "camproj/terminal_text.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -82,6 +87,28 @@ FitResult RunFit(const Correspondences& data, const ImageSize& size, const FitRe
   AutoFitOptions options = request.auto_options;
   if (data.ids.size() == data.pixels.size()) options.point_names = data.ids;
   return FitCameraAuto(data.points_in_world, data.pixels, size, options);
+}
+
+// A file's correspondences and their fit. Running out of memory (a file with more rows than the
+// machine can hold or fit) is reported as bad input naming the file, not as "std::bad_alloc".
+struct FileFit {
+  Correspondences data;
+  FitResult fit;
+};
+FileFit FitFile(const std::string& path, const ImageSize& size, const FitRequest& request) {
+  FileFit result;
+  try {
+    result.data = ReadCorrespondencesFile(path);
+    result.fit = RunFit(result.data, size, request);
+  } catch (const std::bad_alloc&) {
+    const size_t rows = result.data.pixels.size();
+    throw InputError(path + ": out of memory " +
+                     (rows == 0 ? std::string("reading it")
+                                : "fitting its " + std::to_string(rows) + " points") +
+                     ": the automatic fit needs about 1 KB per point (docs/reliability.md); fit "
+                     "fewer points");
+  }
+  return result;
 }
 
 // Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none),
@@ -269,18 +296,52 @@ std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {
 // One row of the batch summary.
 struct BatchRow {
   std::string input;
+  std::string output;         // the camera file written for it (when ok)
   std::string status = "ok";  // ok | refused | bad input
   std::string detail;         // model and RMS, or the reason
   int exit_code = kExitOk;
 };
 
+// The camera file of each input in `folder`: its name with .json. Two inputs with the same name
+// (a/cam.csv, b/cam.csv) would overwrite each other, and an output that is an input would destroy
+// it: both are refused here, before anything is fitted.
+std::vector<std::string> BatchOutputs(const std::vector<std::string>& inputs, const std::string& folder) {
+  std::vector<std::string> outputs;
+  std::map<std::string, std::string> input_of;
+  for (const std::string& input : inputs) {
+    const std::string output =
+        (std::filesystem::path(folder) / (std::filesystem::path(input).stem().string() + ".json")).string();
+    const auto [it, added] = input_of.emplace(output, input);
+    if (!added) {
+      throw UsageError("inputs " + it->second + " and " + input + " would both write " + output +
+                       ": give the files different names or fit them in separate runs");
+    }
+    RequireOutputIsNotAnInput(output, inputs);
+    outputs.push_back(output);
+  }
+  return outputs;
+}
+
+// One JSON line of `camproj fit --json` in batch mode.
+std::string JsonLine(const BatchRow& row) {
+  nlohmann::json line = {{"file", row.input},
+                         {"status", row.status},
+                         {"exit_code", row.exit_code},
+                         {"detail", row.detail}};
+  line["camera_file"] = row.exit_code == kExitOk ? nlohmann::json(row.output) : nlohmann::json();
+  // Invalid UTF-8 in a file name or message is replaced, not thrown.
+  return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 // Fits every input on `jobs` threads: one camera file per input in the -o folder, a progress
-// line on a terminal, a summary table; one bad file is reported and does not stop the others.
+// line on a terminal, a summary table (--json: one JSON object per line, the totals on stderr);
+// one bad file is reported and does not stop the others.
 // Exit code: the worst of the inputs' (0 ok, 2 bad input, 3 refused).
 int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
              const FitRequest& request, const FitArgs& args) {
   if (args.output_path.empty()) throw UsageError("batch fitting needs -o OUTPUT_FOLDER");
-  if (args.json || args.trace) throw UsageError("--json and --trace are for a single input");
+  if (args.trace) throw UsageError("--trace is for a single input");
+  const std::vector<std::string> outputs = BatchOutputs(inputs, args.output_path);
   std::filesystem::create_directories(args.output_path);
   const int jobs = args.jobs > 0 ? args.jobs
                                  : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -294,12 +355,10 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
     for (size_t i = next++; i < inputs.size(); i = next++) {
       BatchRow& row = rows[i];
       row.input = inputs[i];
+      row.output = outputs[i];
       try {
-        const Correspondences data = ReadCorrespondencesFile(inputs[i]);
-        const FitResult fit = RunFit(data, size, request);
-        const std::filesystem::path output = std::filesystem::path(args.output_path) /
-                                             (std::filesystem::path(inputs[i]).stem().string() + ".json");
-        WriteFileAtomically(output.string(), CameraFileTextOf(fit, request.options().pixel_origin));
+        const auto [data, fit] = FitFile(inputs[i], size, request);
+        WriteFileAtomically(outputs[i], CameraFileTextOf(fit, request.options().pixel_origin));
         char detail[256];
         std::snprintf(detail, sizeof detail, "%s, rms %.3f px, %zu points", fit.model.c_str(),
                       fit.rms_px, data.pixels.size());
@@ -328,15 +387,21 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   int exit_code = kExitOk;
   int ok = 0;
-  std::cout << "file\tstatus\tdetail\n";
+  if (!args.json) std::cout << "file\tstatus\tdetail\n";
   for (const BatchRow& row : rows) {
-    std::cout << row.input << '\t' << row.status << '\t' << row.detail << '\n';
+    if (args.json) {
+      std::cout << JsonLine(row) << '\n';
+    } else {
+      std::cout << TerminalSafe(row.input + '\t' + row.status + '\t' + row.detail) << '\n';
+    }
     exit_code = std::max(exit_code, row.exit_code);
     ok += row.exit_code == kExitOk ? 1 : 0;
   }
-  std::printf("%d of %zu fitted in %.3f s on %d threads (%.1f fits/s); cameras in %s\n", ok,
-              inputs.size(), seconds, std::min<int>(jobs, static_cast<int>(inputs.size())),
-              inputs.size() / std::max(seconds, 1e-9), args.output_path.c_str());
+  char totals[256];
+  std::snprintf(totals, sizeof totals, "%d of %zu fitted in %.3f s on %d threads (%.1f fits/s); cameras in ",
+                ok, inputs.size(), seconds, std::min<int>(jobs, static_cast<int>(inputs.size())),
+                inputs.size() / std::max(seconds, 1e-9));
+  (args.json ? std::cerr : std::cout) << totals << TerminalSafe(args.output_path) << '\n';
   return exit_code;
 }
 
@@ -376,7 +441,9 @@ Command AddFitCommand(CLI::App& root) {
       ->check(CLI::NonNegativeNumber);
   app->add_option("--image-size", args->image_size, "image size WIDTHxHEIGHT in pixels")->required();
   app->add_option("-o,--output", args->output_path, "write the camera file here");
-  app->add_flag("--json", args->json, "print the camera file to stdout instead of the summary");
+  app->add_flag("--json", args->json,
+                "print the camera file to stdout instead of the summary; in batch mode one JSON "
+                "object per input and line (file, status, exit_code, detail, camera_file)");
   app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
   app->add_option("--model", args->model,
                   "auto (default): the simplest model the data support; or the free intrinsics "
@@ -436,15 +503,23 @@ Command AddFitCommand(CLI::App& root) {
             if (inputs.size() > 1 || std::filesystem::is_directory(args->points_paths.front())) {
               return FitBatch(inputs, size, request, *args);
             }
-            const Correspondences data = ReadCorrespondencesFile(inputs.front());
-            const FitResult fit = RunFit(data, size, request);
+            const auto begin = std::chrono::steady_clock::now();
+            if (!args->output_path.empty()) {
+              RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path});
+            }
+            const auto [data, fit] = FitFile(inputs.front(), size, request);
             const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
             if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
             if (args->json) {
               std::cout << text;
             } else {
-              std::cout << FitSummaryText(fit, data.ids);
-              if (!args->output_path.empty()) std::cout << "wrote " << args->output_path << "\n";
+              std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
+              if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
+              // The summary's time is the fit's; reading and writing the files add to it.
+              const double wall_ms = std::chrono::duration<double, std::milli>(
+                                         std::chrono::steady_clock::now() - begin).count();
+              std::printf("wall time: %.3f ms (reading %zu points, fitting, writing)\n", wall_ms,
+                          data.pixels.size());
             }
             if (args->trace) std::cout << FitTraceText(fit);
             return kExitOk;

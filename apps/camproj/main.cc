@@ -4,7 +4,10 @@
 #include <iostream>
 #include <vector>
 
+#include "camproj/file_io.h"
 #include "camproj/fit.h"
+#include "camproj/library_logging.h"
+#include "camproj/terminal_text.h"
 #include "cli.h"
 
 int main(int argc, char** argv) {
@@ -22,7 +25,12 @@ int main(int argc, char** argv) {
       "  camproj export camera.json --to gl",
       "camproj"};
   app.require_subcommand(1);
-  app.fallthrough(false);
+  // Root options (--verbose) may also follow the subcommand.
+  app.fallthrough(true);
+  app.set_version_flag("--version", "camproj " CAMPROJ_VERSION);
+  bool verbose = false;
+  app.add_flag("--verbose", verbose,
+               "also show the log lines of the libraries camproj calls (Ceres/glog, OpenCV)");
   const std::vector<Command> commands = {AddFitCommand(app),     AddExportCommand(app),
                                          AddProjectCommand(app), AddConvertCommand(app),
                                          AddSynthCommand(app),   AddOverlayCommand(app)};
@@ -32,20 +40,22 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
+  camproj::InstallTemporaryFileCleanup();
+  camproj::SetLibraryLogging(verbose);
   try {
     for (const Command& command : commands) {
       if (*command.app) return command.run();
     }
   } catch (const UsageError& e) {
-    std::cerr << "camproj: usage: " << e.what() << "\n(see camproj --help)\n";
+    std::cerr << "camproj: usage: " << camproj::TerminalSafe(e.what()) << "\n(see camproj --help)\n";
     return kExitUsage;
   } catch (const camproj::SceneError& e) {
-    std::cerr << "camproj: cannot fit: " << e.what() << '\n';
+    std::cerr << "camproj: cannot fit: " << camproj::TerminalSafe(e.what()) << '\n';
     return kExitScene;
   } catch (const std::exception& e) {
     // InputError (a file), std::invalid_argument (a value the library refused), or anything
     // else a library call threw: bad input, never an abort.
-    std::cerr << "camproj: error: " << e.what() << '\n';
+    std::cerr << "camproj: error: " << camproj::TerminalSafe(e.what()) << '\n';
     return kExitBadInput;
   }
   return kExitUsage;

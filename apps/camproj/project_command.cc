@@ -5,6 +5,7 @@
 
 #include "camproj/camera_file.h"
 #include "camproj/points_file.h"
+#include "camproj/terminal_text.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -31,7 +32,8 @@ Command AddProjectCommand(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "project",
       "Project world points through a camera: prints id,X,Y,Z,u,v,depth as CSV (depth = z in the\n"
-      "camera frame, world units; u, v empty for points behind the camera). POINTS.csv needs\n"
+      "camera frame, world units; u, v empty for points behind the camera; control characters in ids\n"
+      "printed escaped, as \\x1b). POINTS.csv needs\n"
       "X,Y,Z; u,v columns are ignored.\n\n"
       "Example:\n"
       "  camproj project camera.json points.csv");
@@ -50,7 +52,7 @@ Command AddProjectCommand(CLI::App& root) {
               const Eigen::Vector3d& x = points.points_in_world[i];
               const double depth = (camera.cam_from_world * x).z();
               const std::optional<Eigen::Vector2d> pixel = PixelFromWorld(camera, x);
-              std::cout << points.ids[i] << ',' << Number(x.x()) << ',' << Number(x.y()) << ','
+              std::cout << TerminalSafe(points.ids[i]) << ',' << Number(x.x()) << ',' << Number(x.y()) << ','
                         << Number(x.z()) << ',';
               if (pixel) {
                 const Eigen::Vector2d p = ConvertPixelOrigin(*pixel, PixelOrigin::kCenter, origin);

@@ -43,6 +43,32 @@ CameraViews ViewsOfCamera(const Camera& camera, double target_distance, const Gl
   return views;
 }
 
+void RequireFiniteViews(const Camera& camera, const GlDepth& depth) {
+  const CameraViews views = ViewsOfCamera(camera, 1.0, depth);
+  const char* what = "the values are too large for a double";
+  internal::Require(views.clip_from_gl_eye.allFinite(), "the projection matrix is not finite: ", what);
+  internal::Require(views.gl_eye_from_world.allFinite(), "the view matrix is not finite: ", what);
+  internal::Require(views.look_at.eye.allFinite() && views.look_at.target.allFinite() &&
+                        views.look_at.up.allFinite(),
+                    "the look-at is not finite: ", what);
+  if (views.frustum) {
+    const Frustum& f = *views.frustum;
+    internal::Require(std::isfinite(f.left) && std::isfinite(f.right) && std::isfinite(f.bottom) &&
+                          std::isfinite(f.top),
+                      "the frustum is not finite: ", what);
+  }
+  if (views.ortho) {
+    const Ortho& o = *views.ortho;
+    internal::Require(std::isfinite(o.left) && std::isfinite(o.right) && std::isfinite(o.bottom) &&
+                          std::isfinite(o.top),
+                      "the ortho box is not finite: ", what);
+  }
+  if (views.perspective) {
+    internal::Require(std::isfinite(views.perspective->fovy_deg) && std::isfinite(views.perspective->aspect),
+                      "the perspective is not finite: ", what);
+  }
+}
+
 std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
                                               const Eigen::Vector3d& point_in_world) {
   const Eigen::Vector3d point_in_cam = camera.cam_from_world * point_in_world;

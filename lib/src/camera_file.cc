@@ -12,7 +12,30 @@ namespace camproj {
 
 using json = nlohmann::json;
 
+// Deepest nesting of arrays and objects a camera file may have: the files camproj writes nest 5
+// deep (document > fit > selection > candidates > candidate).
+constexpr int kMaxJsonDepth = 32;
+
 namespace {
+
+// What a value is, for a message: its type and size, or a short scalar. Never the value's
+// subtree: dump() recurses once per nesting level and would quote a hostile file back.
+std::string Describe(const json& value) {
+  switch (value.type()) {
+    case json::value_t::object:
+      return "an object of " + std::to_string(value.size()) + " members";
+    case json::value_t::array:
+      return "an array of " + std::to_string(value.size()) + " elements";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return value.get<bool>() ? "true" : "false";
+    case json::value_t::null:
+      return "null";
+    default:
+      return "a number";
+  }
+}
 
 // Reads typed values out of a parsed document, naming the source and key path on failure.
 class Reader {
@@ -33,7 +56,7 @@ class Reader {
   }
 
   double Number(const json& value, const std::string& key) const {
-    if (!value.is_number()) Fail(key, "expected a number, got " + value.dump());
+    if (!value.is_number()) Fail(key, "expected a number, got " + Describe(value));
     const double number = value.get<double>();
     if (!std::isfinite(number)) Fail(key, "expected a finite number");
     return number;
@@ -47,7 +70,7 @@ class Reader {
 
   Eigen::VectorXd Vector(const json& value, const std::string& key, int size) const {
     if (!value.is_array() || static_cast<int>(value.size()) != size) {
-      Fail(key, "expected an array of " + std::to_string(size) + " numbers, got " + value.dump());
+      Fail(key, "expected an array of " + std::to_string(size) + " numbers, got " + Describe(value));
     }
     Eigen::VectorXd vector(size);
     for (int i = 0; i < size; ++i) {
@@ -100,7 +123,37 @@ Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
   return ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCenter);
 }
 
+// Throws InputError if arrays and objects nest deeper than kMaxJsonDepth anywhere in `text`.
+// Runs before the parser, so nothing recursive ever sees a deeper document: a linear scan that
+// skips strings (a bracket inside a string does not nest).
+void RequireShallowJson(const std::string& text, const std::string& source) {
+  int depth = 0;
+  bool in_string = false;
+  size_t line = 1;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) {
+        throw InputError(source + ": line " + std::to_string(line) + ": arrays and objects nest deeper than " +
+                         std::to_string(kMaxJsonDepth) + " levels");
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
 json ParseJson(const std::string& text, const std::string& source) {
+  RequireShallowJson(text, source);
   try {
     return json::parse(text);
   } catch (const json::parse_error& e) {
@@ -178,6 +231,11 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   } catch (const std::invalid_argument& e) {
     reader.Fail("frustum", e.what());
   }
+  try {
+    RequireFiniteViews(camera);
+  } catch (const std::invalid_argument& e) {
+    reader.Fail("intrinsics", e.what());
+  }
   return camera;
 }
 
@@ -197,6 +255,7 @@ Camera ReadCameraFile(const std::string& path) {
 std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options,
                              const FitRecord* fit) {
   options.Check();
+  RequireFiniteViews(camera, options.depth);
   const CameraViews views = ViewsOfCamera(camera, options.target_distance, options.depth);
   const Intrinsics k =
       ConvertPixelOrigin(camera.intrinsics, PixelOrigin::kCenter, options.pixel_origin);

@@ -377,6 +377,7 @@ ExportFormat ExportFormatFromString(const std::string& text) {
 }
 
 std::string ExportCamera(const Camera& camera, ExportFormat format, const ExportOptions& options) {
+  RequireFiniteViews(camera, options.depth);
   switch (format) {
     case ExportFormat::kGl:
       return ExportGlText(camera, options);

@@ -1,15 +1,19 @@
 #include "camproj/file_io.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <climits>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
-#include <vector>
+#include <ctime>
 
 #include "camproj/errors.h"
 
@@ -17,64 +21,316 @@ namespace camproj {
 
 namespace {
 
-std::string ErrnoText() { return std::strerror(errno); }
+std::string ErrnoText(int error) { return std::strerror(error); }
 
-}  // namespace
+// Temporaries with a name, for the signal handler to remove: a fixed table of fixed-size slots,
+// so that the handler only reads memory and calls unlink (async-signal-safe).
+constexpr int kMaxPendingTemporaries = 64;
+struct PendingTemporary {
+  std::atomic<bool> used{false};
+  std::atomic<bool> ready{false};
+  char path[PATH_MAX] = {};
+};
+PendingTemporary pending_temporaries[kMaxPendingTemporaries];
+// Set by the handler before it removes the registered temporaries: a thread that names a
+// temporary after that point removes it itself (AbandonIfDying), so none is created behind the
+// handler's back.
+std::atomic<bool> dying{false};
 
-void WriteFileAtomically(const std::string& path, const std::string& contents) {
-  // The temporary lives beside the target so that rename() stays within one file system.
-  std::vector<char> temp_path(path.begin(), path.end());
-  const std::string suffix = ".tmp.XXXXXX";
-  temp_path.insert(temp_path.end(), suffix.begin(), suffix.end());
-  temp_path.push_back('\0');
-  const int fd = mkstemp(temp_path.data());
-  if (fd < 0) throw InputError("cannot create a temporary file next to " + path + ": " + ErrnoText());
-  auto fail = [&](const std::string& what) {
-    const std::string reason = ErrnoText();
-    close(fd);
-    unlink(temp_path.data());
-    throw InputError("cannot write " + path + ": " + what + ": " + reason);
-  };
+// Called after a temporary's name is registered and created: if a handler has started, removes
+// it and waits for the process to die of the signal.
+void AbandonIfDying(const std::string& name) {
+  if (!dying) return;
+  unlink(name.c_str());
+  for (;;) pause();
+}
+
+// Registers a temporary's path for removal on a signal, until cleared or destroyed; silently
+// does nothing if the table is full or the path too long (the temporary then just is not removed
+// on a signal).
+class SignalCleanup {
+ public:
+  SignalCleanup() = default;
+  ~SignalCleanup() { Clear(); }
+  SignalCleanup(const SignalCleanup&) = delete;
+  SignalCleanup& operator=(const SignalCleanup&) = delete;
+
+  void Set(const std::string& path) {
+    Clear();
+    if (path.size() >= PATH_MAX) return;
+    for (PendingTemporary& slot : pending_temporaries) {
+      bool expected = false;
+      if (slot.used.compare_exchange_strong(expected, true)) {
+        std::memcpy(slot.path, path.c_str(), path.size() + 1);
+        slot.ready = true;
+        slot_ = &slot;
+        return;
+      }
+    }
+  }
+  void Clear() {
+    if (slot_ == nullptr) return;
+    slot_->ready = false;
+    slot_->used = false;
+    slot_ = nullptr;
+  }
+
+ private:
+  PendingTemporary* slot_ = nullptr;
+};
+
+extern "C" void RemoveTemporariesAndDie(int signal_number) {
+  dying = true;
+  for (PendingTemporary& slot : pending_temporaries) {
+    if (slot.ready) unlink(slot.path);
+  }
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
+// ".camproj-XXXXXX.tmp" in `folder`: 19 bytes whatever the target's name, so within NAME_MAX.
+std::string TemporaryName(const std::string& folder) {
+  static constexpr char kLetters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+  unsigned char random[6] = {};
+  if (getrandom(random, sizeof random, 0) != static_cast<ssize_t>(sizeof random)) {
+    // No entropy source: the process id and a counter are unique enough, and a collision is
+    // only a retry (O_EXCL, linkat's EEXIST).
+    static std::atomic<unsigned> counter{0};
+    const unsigned long long seed =
+        static_cast<unsigned long long>(getpid()) * 2654435761u + 977u * counter++;
+    for (size_t i = 0; i < sizeof random; ++i) random[i] = static_cast<unsigned char>(seed >> (8 * i));
+  }
+  std::string name = folder + "/.camproj-";
+  for (unsigned char c : random) name += kLetters[c % (sizeof kLetters - 1)];
+  return name + ".tmp";
+}
+
+// The file a write to `path` lands on: symbolic links followed (relative ones from their folder).
+std::string ResolveLinks(const std::string& path) {
+  std::string target = path;
+  for (int depth = 0; depth < 40; ++depth) {
+    struct stat info {};
+    if (lstat(target.c_str(), &info) != 0 || !S_ISLNK(info.st_mode)) return target;
+    std::string link(static_cast<size_t>(PATH_MAX), '\0');
+    const ssize_t n = readlink(target.c_str(), link.data(), link.size());
+    if (n < 0 || static_cast<size_t>(n) >= link.size()) return target;
+    link.resize(static_cast<size_t>(n));
+    const size_t slash = target.rfind('/');
+    target = link.front() == '/' || slash == std::string::npos ? link : target.substr(0, slash + 1) + link;
+  }
+  throw InputError("cannot write " + path + ": too many levels of symbolic links");
+}
+
+std::string FolderOf(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+void WriteAll(int fd, const std::string& contents, const std::string& path) {
   size_t written = 0;
   while (written < contents.size()) {
     const ssize_t n = write(fd, contents.data() + written, contents.size() - written);
     if (n < 0) {
       if (errno == EINTR) continue;
-      fail("write");
+      throw InputError("cannot write " + path + ": " + ErrnoText(errno));
     }
     written += static_cast<size_t>(n);
   }
-  // mkstemp creates 0600; a camera file is an ordinary document.
-  if (fchmod(fd, 0644) != 0) fail("chmod");
-  if (fsync(fd) != 0) fail("fsync");
-  if (close(fd) != 0) {
-    const std::string reason = ErrnoText();
-    unlink(temp_path.data());
-    throw InputError("cannot write " + path + ": close: " + reason);
+}
+
+// Closes on scope exit; removes the named temporary too unless released.
+struct TemporaryGuard {
+  int fd = -1;
+  std::string name;  // empty: nothing to remove
+  ~TemporaryGuard() {
+    if (fd >= 0) close(fd);
+    if (!name.empty()) unlink(name.c_str());
   }
-  if (std::rename(temp_path.data(), path.c_str()) != 0) {
-    const std::string reason = ErrnoText();
-    unlink(temp_path.data());
-    throw InputError("cannot write " + path + ": rename: " + reason);
+};
+
+// Removes this tool's temporaries in `folder` (".camproj-XXXXXX.tmp", regular files) last modified
+// over kStaleTemporarySeconds ago: left by a kill at the instant between linkat and rename, or
+// during a write on a file system without O_TMPFILE. A write in progress touches its temporary
+// within milliseconds, so an hour-old one belongs to no running camproj. Best effort: errors are
+// ignored.
+constexpr time_t kStaleTemporarySeconds = 3600;
+void SweepStaleTemporaries(const std::string& folder) {
+  DIR* dir = opendir(folder.c_str());
+  if (dir == nullptr) return;
+  const time_t now = time(nullptr);
+  static constexpr char kPrefix[] = ".camproj-";
+  static constexpr char kSuffix[] = ".tmp";
+  const size_t length = sizeof kPrefix - 1 + 6 + sizeof kSuffix - 1;
+  while (const dirent* entry = readdir(dir)) {
+    const std::string name = entry->d_name;
+    if (name.size() != length || name.compare(0, sizeof kPrefix - 1, kPrefix) != 0 ||
+        name.compare(length - (sizeof kSuffix - 1), std::string::npos, kSuffix) != 0) {
+      continue;
+    }
+    struct stat info {};
+    if (fstatat(dirfd(dir), name.c_str(), &info, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(info.st_mode) &&
+        info.st_mtime < now - kStaleTemporarySeconds) {
+      unlinkat(dirfd(dir), name.c_str(), 0);
+    }
+  }
+  closedir(dir);
+}
+
+const char* KindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+}  // namespace
+
+void InstallTemporaryFileCleanup() {
+  struct sigaction action {};
+  action.sa_handler = RemoveTemporariesAndDie;
+  sigemptyset(&action.sa_mask);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction previous {};
+    // A signal the caller's parent set to be ignored (nohup) stays ignored.
+    if (sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
+    sigaction(signal_number, &action, nullptr);
+  }
+  std::signal(SIGXFSZ, SIG_IGN);
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& contents) {
+  const std::string target = ResolveLinks(path);
+  const std::string folder = FolderOf(target);
+  struct stat existing {};
+  const bool replacing = stat(target.c_str(), &existing) == 0;
+  if (replacing && !S_ISREG(existing.st_mode)) {
+    throw InputError("cannot write " + path + ": it is " + KindOf(existing.st_mode) +
+                     ", not a regular file");
+  }
+
+  TemporaryGuard temporary;
+  // An unnamed file first: nothing to leave behind if the process dies while writing. The test
+  // suite sets CAMPROJ_TEST_NO_TMPFILE to run the fallback on file systems that have O_TMPFILE.
+  const bool try_unnamed = std::getenv("CAMPROJ_TEST_NO_TMPFILE") == nullptr;
+  temporary.fd = try_unnamed ? open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666) : -1;
+  const bool unnamed = temporary.fd >= 0;
+  std::string name;
+  SignalCleanup cleanup;
+  if (!unnamed) {
+    for (int attempt = 0; attempt < 100 && temporary.fd < 0; ++attempt) {
+      name = TemporaryName(folder);
+      cleanup.Set(name);
+      temporary.fd = open(name.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0666);
+      if (temporary.fd < 0) {
+        const int error = errno;
+        cleanup.Clear();
+        if (error != EEXIST) {
+          throw InputError("cannot write " + path + ": cannot create a file in " + folder + ": " +
+                           ErrnoText(error));
+        }
+      }
+    }
+    if (temporary.fd < 0) throw InputError("cannot write " + path + ": no free temporary name in " + folder);
+    temporary.name = name;
+    AbandonIfDying(name);
+  }
+  WriteAll(temporary.fd, contents, path);
+  if (replacing) {
+    // The replaced file's owner and permissions carry over (the owner only where allowed).
+    if (fchown(temporary.fd, existing.st_uid, existing.st_gid) != 0) {
+      // Not the owner: the new file is ours, with the old permission bits.
+    }
+    if (fchmod(temporary.fd, existing.st_mode & 07777) != 0) {
+      throw InputError("cannot write " + path + ": chmod: " + ErrnoText(errno));
+    }
+  }
+  if (fsync(temporary.fd) != 0) throw InputError("cannot write " + path + ": fsync: " + ErrnoText(errno));
+  if (unnamed) {
+    // Give it a name only now, for the instant before rename (linkat cannot replace a file).
+    const std::string fd_path = "/proc/self/fd/" + std::to_string(temporary.fd);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      name = TemporaryName(folder);
+      cleanup.Set(name);
+      if (linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+        AbandonIfDying(name);
+        break;
+      }
+      if (errno != EEXIST) {
+        const int error = errno;
+        cleanup.Clear();
+        throw InputError("cannot write " + path + ": link: " + ErrnoText(error));
+      }
+      cleanup.Clear();
+      name.clear();
+    }
+    if (name.empty()) throw InputError("cannot write " + path + ": no free temporary name in " + folder);
+    temporary.name = name;
+  }
+  const int fd = temporary.fd;
+  temporary.fd = -1;
+  if (close(fd) != 0) throw InputError("cannot write " + path + ": close: " + ErrnoText(errno));
+  if (std::rename(name.c_str(), target.c_str()) != 0) {
+    throw InputError("cannot write " + path + ": rename: " + ErrnoText(errno));
+  }
+  temporary.name.clear();
+  SweepStaleTemporaries(folder);
+}
+
+InputFile::InputFile(const std::string& path) : path_(path) {
+  // O_NONBLOCK: opening a FIFO with no writer returns at once instead of waiting for one.
+  fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd_ < 0) throw InputError(path + ": cannot open: " + ErrnoText(errno));
+  struct stat info {};
+  if (fstat(fd_, &info) != 0) {
+    const int error = errno;
+    close(fd_);
+    throw InputError(path + ": cannot read: " + ErrnoText(error));
+  }
+  if (!S_ISREG(info.st_mode)) {
+    close(fd_);
+    throw InputError(path + ": is " + std::string(KindOf(info.st_mode)) + ", expected a regular file");
+  }
+}
+
+InputFile::~InputFile() { close(fd_); }
+
+size_t InputFile::Read(char* buffer, size_t size) {
+  for (;;) {
+    const ssize_t n = read(fd_, buffer, size);
+    if (n >= 0) return static_cast<size_t>(n);
+    if (errno != EINTR) throw InputError(path_ + ": cannot read: " + ErrnoText(errno));
   }
 }
 
 std::string ReadWholeFile(const std::string& path, size_t max_bytes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open: " + ErrnoText());
-  struct stat info {};
-  if (stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) {
-    throw InputError(path + ": is a directory, expected a file");
-  }
+  InputFile in(path);
   std::string contents;
   char buffer[1 << 16];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-    contents.append(buffer, static_cast<size_t>(in.gcount()));
+  for (size_t n; (n = in.Read(buffer, sizeof buffer)) > 0;) {
+    contents.append(buffer, n);
     if (contents.size() > max_bytes) {
       throw InputError(path + ": larger than " + std::to_string(max_bytes) + " bytes");
     }
   }
   return contents;
+}
+
+void RequireOutputIsNotAnInput(const std::string& output_path,
+                               const std::vector<std::string>& input_paths) {
+  struct stat output {};
+  if (stat(output_path.c_str(), &output) != 0) return;
+  for (const std::string& input_path : input_paths) {
+    struct stat input {};
+    if (stat(input_path.c_str(), &input) == 0 && input.st_dev == output.st_dev &&
+        input.st_ino == output.st_ino) {
+      throw InputError(output_path + ": the output is the input " + input_path +
+                       " (the same file): writing it would destroy the input; choose another "
+                       "output path");
+    }
+  }
 }
 
 }  // namespace camproj

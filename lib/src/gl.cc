@@ -14,19 +14,31 @@ using internal::RequireFiniteAll;
 
 namespace {
 
+// f n / (f - n) and (f + n) / (f - n) without the overflow of f n or f + n when the depths are
+// huge (a world in units of 2^-600): the plain forms wherever they are finite, so that ordinary
+// depths keep their rounding (and glm's); a factor 2 is exact, so 2 f n / (f - n) is 2 times it.
+double ProductOverRange(double n, double f) {
+  const double plain = f * n / (f - n);
+  return std::isfinite(plain) ? plain : n * (f / (f - n));
+}
+double SumOverRange(double n, double f) {
+  const double plain = (f + n) / (f - n);
+  return std::isfinite(plain) ? plain : f / (f - n) + n / (f - n);
+}
+
 // The depth row (A, B) of a perspective projection: clip.z = A z_eye + B, clip.w = -z_eye.
 // See the table in gl.h.
 Eigen::Vector2d DepthRow(double n, double f, const GlDepth& depth) {
   const bool infinite = std::isinf(f);
   const bool zo = depth.clip_depth == ClipDepth::kZeroToOne;
   if (!depth.reversed_z) {
-    if (zo) return infinite ? Eigen::Vector2d(-1.0, -n) : Eigen::Vector2d(-f / (f - n), -f * n / (f - n));
+    if (zo) return infinite ? Eigen::Vector2d(-1.0, -n) : Eigen::Vector2d(-f / (f - n), -ProductOverRange(n, f));
     return infinite ? Eigen::Vector2d(-1.0, -2.0 * n)
-                    : Eigen::Vector2d(-(f + n) / (f - n), -2.0 * f * n / (f - n));
+                    : Eigen::Vector2d(-SumOverRange(n, f), -2.0 * ProductOverRange(n, f));
   }
-  if (zo) return infinite ? Eigen::Vector2d(0.0, n) : Eigen::Vector2d(n / (f - n), f * n / (f - n));
+  if (zo) return infinite ? Eigen::Vector2d(0.0, n) : Eigen::Vector2d(n / (f - n), ProductOverRange(n, f));
   return infinite ? Eigen::Vector2d(1.0, 2.0 * n)
-                  : Eigen::Vector2d((f + n) / (f - n), 2.0 * f * n / (f - n));
+                  : Eigen::Vector2d(SumOverRange(n, f), 2.0 * ProductOverRange(n, f));
 }
 
 Eigen::Matrix4d PerspectiveMatrix(double x_scale, double x_skew, double x_offset, double y_scale,

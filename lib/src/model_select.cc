@@ -16,6 +16,7 @@
 #include "fit/gate.h"
 #include "fit/mirror.h"
 #include "fit/outliers.h"
+#include "fit/scene.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
 
@@ -442,6 +443,21 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
 
 }  // namespace
 
+namespace {
+
+// A camera whose GL matrices overflow a double (a world scaled by 2^600) could not be written
+// or exported (RequireFiniteViews): refused as too large, with the advice to change units.
+void RequireRepresentableCamera(const Camera& camera) {
+  try {
+    RequireFiniteViews(camera);
+  } catch (const std::invalid_argument& e) {
+    const SceneError refusal = internal::TooLargeForDouble();
+    throw SceneError(refusal.reason(), std::string(refusal.what()) + " (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
 void AutoFitOptions::Check() const {
   fit.Check();
   Require(fit.loss == LossType::kNone,
@@ -478,8 +494,13 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
           "got ", options.point_names.size(), " point names for ", points_in_world.size(),
           " points");
   try {
-    return RunPipeline(points_in_world, observed_pixels, image_size, options, start);
+    FitResult result = RunPipeline(points_in_world, observed_pixels, image_size, options, start);
+    RequireRepresentableCamera(result.camera);
+    return result;
   } catch (const SceneError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    // Not a property of the values: the caller says which input was too large.
     throw;
   } catch (const std::exception& e) {
     // Well-formed input never reaches here by design; if it does, it is still a refusal of

@@ -1,6 +1,5 @@
 #include "camproj/points_file.h"
 
-#include <sys/stat.h>
 
 #include <array>
 #include <cctype>
@@ -10,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -18,6 +16,7 @@
 #include <unordered_set>
 
 #include "camproj/errors.h"
+#include "camproj/file_io.h"
 #include "check.h"
 
 namespace camproj {
@@ -311,19 +310,14 @@ Correspondences CorrespondencesFromCsvText(const std::string& text, const std::s
 Correspondences ReadCorrespondencesFile(const std::string& path,
                                         const CorrespondencesLimits& limits) {
   limits.Check();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
-  struct stat info {};
-  if (stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) {
-    throw InputError(path + ": is a directory, expected a file");
-  }
+  InputFile in(path);
   CsvParser parser(path, limits);
   // `pending` holds the start of a line that runs past the buffer; a line may end in '\r' that
   // AddLine drops, so one byte more than the limit is still a candidate.
   std::string pending;
   std::vector<char> buffer(size_t{1} << 16);
-  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
-    const std::string_view chunk(buffer.data(), static_cast<size_t>(in.gcount()));
+  for (size_t n; (n = in.Read(buffer.data(), buffer.size())) > 0;) {
+    const std::string_view chunk(buffer.data(), n);
     size_t begin = 0;
     while (begin < chunk.size()) {
       const size_t newline = chunk.find('\n', begin);
@@ -344,7 +338,6 @@ Correspondences ReadCorrespondencesFile(const std::string& path,
       begin = end + 1;
     }
   }
-  if (in.bad()) throw InputError(path + ": cannot read: " + std::strerror(errno));
   if (!pending.empty()) parser.AddLine(pending);
   return parser.Finish();
 }

@@ -50,6 +50,12 @@ struct CameraViews {
 CameraViews ViewsOfCamera(const Camera& camera, double target_distance = 1.0,
                           const GlDepth& depth = {});
 
+// Throws std::invalid_argument, naming what overflowed, unless every number ViewsOfCamera derives
+// is finite (a far plane at kInfinity excepted): the projection and view matrices, the frustum or
+// ortho box, the look-at. A valid camera with extreme values (fx = 1e308, cx = 1e308) overflows
+// them; the camera-file reader and every exporter refuse it alike.
+void RequireFiniteViews(const Camera& camera, const GlDepth& depth = {});
+
 // The pixel (kCenter) of a world point, distortion included; std::nullopt if the point is not in
 // front of the camera (z_cam <= 0), for either projection.
 std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,

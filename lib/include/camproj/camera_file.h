@@ -63,7 +63,9 @@ struct FitRecord {
 
 // Parses camera-file text. `source` names the text in messages ("camera.json"). Throws
 // InputError naming the source, the line and column of a JSON syntax error, or the key path
-// ("intrinsics.fx") of a missing or invalid value.
+// ("intrinsics.fx") of a missing or invalid value. Arrays and objects nested deeper than 32
+// levels are refused before parsing (no recursion grows with the input), and messages describe a
+// wrong value by its type and size, never by quoting it.
 Camera CameraFromJsonText(const std::string& text, const std::string& source);
 
 // ReadWholeFile + CameraFromJsonText.

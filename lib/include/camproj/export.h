@@ -55,8 +55,9 @@ struct ExportOptions {
 };
 
 // The text of `camera` in `format` (see the file comment), ending in a newline.
-// Throws std::invalid_argument on an invalid camera, or when the format cannot represent it,
-// saying why: opencv-yaml and colmap refuse skew != 0 (OpenCV's projectPoints ignores
+// Throws std::invalid_argument on an invalid camera, on one whose derived numbers overflow
+// (RequireFiniteViews: every format alike, nothing non-finite is ever written), or when the format
+// cannot represent it, saying why: opencv-yaml and colmap refuse skew != 0 (OpenCV's projectPoints ignores
 // camera_matrix(0,1), and no COLMAP camera model has skew).
 std::string ExportCamera(const Camera& camera, ExportFormat format,
                          const ExportOptions& options = {});

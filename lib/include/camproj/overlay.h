@@ -12,7 +12,7 @@ namespace camproj {
 
 struct OverlayOptions {
   double magnify = 10.0;  // residual vectors are drawn this many times their length, > 0
-  std::string background_path;  // image to draw on (any format OpenCV reads); empty: blank
+  std::string background_path;  // image to draw on, PNG or JPEG; empty: blank
   void Check() const;
 };
 
@@ -21,11 +21,14 @@ struct OverlayStats {
   int behind = 0;  // points behind the camera (listed in the legend, not drawn)
 };
 
-// Draws and writes a PNG to `output_path` atomically. Pixels of `correspondences` are in kCenter.
-// Throws InputError if the background cannot be read or its size differs from the camera's
-// image size, or the output cannot be written.
-OverlayStats WriteOverlayPng(const Camera& camera, const Correspondences& correspondences,
-                             const OverlayOptions& options, const std::string& output_path);
+// Draws and writes the picture to `output_path` atomically, as PNG or JPEG by its extension
+// (ImageFormatOfPath). Pixels of `correspondences` are in kCenter.
+// Throws std::invalid_argument if the extension is neither or the camera's image size is beyond
+// kMaxImagePixels (before allocating anything); InputError if the background is not a PNG or JPEG,
+// its header states another size than the camera's (checked before decoding), it cannot be
+// decoded, or the output cannot be written.
+OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
+                               const OverlayOptions& options, const std::string& output_path);
 
 }  // namespace camproj
 

@@ -1,0 +1,35 @@
+// Image dimensions read from a PNG or JPEG file's header, before anything is decoded.
+#ifndef CAMPROJ_IMAGE_HEADER_H_
+#define CAMPROJ_IMAGE_HEADER_H_
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace camproj {
+
+// The most pixels camproj decodes or draws: 8192 x 8192 (about 200 MB as 8-bit BGR). An image or
+// an overlay canvas beyond it is refused before memory is allocated for it.
+constexpr int64_t kMaxImagePixels = int64_t{8192} * 8192;
+
+enum class ImageFormat { kPng, kJpeg };
+
+struct ImageHeader {
+  ImageFormat format = ImageFormat::kPng;
+  int width = 0;   // px
+  int height = 0;  // px
+};
+
+// The format and size stated by the file's first bytes: a PNG's IHDR chunk, or a JPEG's first
+// start-of-frame segment (any SOFn). `source` names the bytes in messages. Throws InputError
+// naming `source` if the bytes are neither format, or the header is cut short or states a zero
+// size. Reads only the header: cost and memory do not depend on the stated size.
+ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source);
+
+// The image format an output path asks for by its extension (case-insensitive): .png, or .jpg /
+// .jpeg. Throws std::invalid_argument naming the path and the extensions accepted otherwise.
+ImageFormat ImageFormatOfPath(const std::string& path);
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_IMAGE_HEADER_H_

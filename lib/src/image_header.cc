@@ -1,0 +1,93 @@
+#include "camproj/image_header.h"
+
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+
+#include "camproj/errors.h"
+
+namespace camproj {
+
+namespace {
+
+uint32_t BigEndian(std::string_view bytes, size_t at, int size) {
+  uint32_t value = 0;
+  for (int i = 0; i < size; ++i) value = value << 8 | static_cast<unsigned char>(bytes[at + i]);
+  return value;
+}
+
+// JPEG (ITU T.81, B.1.1): after SOI (FF D8), segments FF <marker> <16-bit length incl. itself>;
+// SOF0..SOF15 except DHT (C4), JPG (C8), DAC (CC) hold precision, height, width.
+ImageHeader JpegHeader(std::string_view bytes, const std::string& source) {
+  size_t at = 2;
+  while (at + 4 <= bytes.size()) {
+    if (static_cast<unsigned char>(bytes[at]) != 0xff) break;
+    const unsigned char marker = static_cast<unsigned char>(bytes[at + 1]);
+    if (marker == 0xff) {  // fill byte
+      ++at;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) {  // no length
+      at += 2;
+      continue;
+    }
+    const size_t length = BigEndian(bytes, at + 2, 2);
+    if (length < 2) break;
+    const bool frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (frame) {
+      if (at + 9 > bytes.size() || length < 7) break;
+      ImageHeader header;
+      header.format = ImageFormat::kJpeg;
+      header.height = static_cast<int>(BigEndian(bytes, at + 5, 2));
+      header.width = static_cast<int>(BigEndian(bytes, at + 7, 2));
+      if (header.width == 0 || header.height == 0) {
+        throw InputError(source + ": the JPEG header states a zero width or height");
+      }
+      return header;
+    }
+    if (marker == 0xda || marker == 0xd9) break;  // image data or end before any frame header
+    at += 2 + length;
+  }
+  throw InputError(source + ": a JPEG without a readable frame header (cut short or corrupt)");
+}
+
+}  // namespace
+
+ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source) {
+  static constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
+  if (bytes.substr(0, 8) == kPngSignature) {
+    // The first chunk must be IHDR (PNG spec 5.6): length 13, "IHDR", width, height.
+    if (bytes.size() < 24 || bytes.substr(12, 4) != "IHDR") {
+      throw InputError(source + ": a PNG without its IHDR header (cut short or corrupt)");
+    }
+    const uint32_t width = BigEndian(bytes, 16, 4);
+    const uint32_t height = BigEndian(bytes, 20, 4);
+    // PNG allows up to 2^31 - 1 per side.
+    if (width == 0 || height == 0 || width > 0x7fffffffu || height > 0x7fffffffu) {
+      throw InputError(source + ": the PNG header states an invalid size " + std::to_string(width) +
+                       "x" + std::to_string(height));
+    }
+    return {ImageFormat::kPng, static_cast<int>(width), static_cast<int>(height)};
+  }
+  if (bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0xff &&
+      static_cast<unsigned char>(bytes[1]) == 0xd8) {
+    return JpegHeader(bytes, source);
+  }
+  throw InputError(source + ": not a PNG or JPEG file (camproj reads images of these formats only)");
+}
+
+ImageFormat ImageFormatOfPath(const std::string& path) {
+  const size_t dot = path.rfind('.');
+  const size_t slash = path.rfind('/');
+  std::string extension;
+  if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) {
+    extension = path.substr(dot + 1);
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  }
+  if (extension == "png") return ImageFormat::kPng;
+  if (extension == "jpg" || extension == "jpeg") return ImageFormat::kJpeg;
+  throw std::invalid_argument(path + ": the image format is chosen by the extension: .png, .jpg or .jpeg");
+}
+
+}  // namespace camproj
