@@ -177,6 +177,11 @@ EOF
     expect_exit 1 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --object-points "$work/vertices.csv" \
       --model focal --loss huber:2
     expect_in err "object-points"
+    # The object points are an input: a camera file written over them is refused, and they survive.
+    cp "$work/vertices.csv" "$work/vertices.before"
+    expect_exit 2 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --object-points "$work/vertices.csv" \
+      -o "$work/vertices.csv"
+    cmp -s "$work/vertices.csv" "$work/vertices.before" || fail "the object points file was replaced"
     ;;
   fit_robust_loss)
     # A robust loss runs with a forced model (Ceres, said in the summary); the automatic

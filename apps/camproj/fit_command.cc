@@ -304,8 +304,12 @@ struct BatchRow {
 
 // The camera file of each input in `folder`: its name with .json. Two inputs with the same name
 // (a/cam.csv, b/cam.csv) would overwrite each other, and an output that is an input would destroy
-// it: both are refused here, before anything is fitted.
-std::vector<std::string> BatchOutputs(const std::vector<std::string>& inputs, const std::string& folder) {
+// it (as would one that is the --intrinsics or --object-points file, in `also_read`): both are
+// refused here, before anything is fitted.
+std::vector<std::string> BatchOutputs(const std::vector<std::string>& inputs, const std::string& folder,
+                                      const std::vector<std::string>& also_read) {
+  std::vector<std::string> read = inputs;
+  read.insert(read.end(), also_read.begin(), also_read.end());
   std::vector<std::string> outputs;
   std::map<std::string, std::string> input_of;
   for (const std::string& input : inputs) {
@@ -316,7 +320,7 @@ std::vector<std::string> BatchOutputs(const std::vector<std::string>& inputs, co
       throw UsageError("inputs " + it->second + " and " + input + " would both write " + output +
                        ": give the files different names or fit them in separate runs");
     }
-    RequireOutputIsNotAnInput(output, inputs);
+    RequireOutputIsNotAnInput(output, read);
     outputs.push_back(output);
   }
   return outputs;
@@ -341,7 +345,8 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
              const FitRequest& request, const FitArgs& args) {
   if (args.output_path.empty()) throw UsageError("batch fitting needs -o OUTPUT_FOLDER");
   if (args.trace) throw UsageError("--trace is for a single input");
-  const std::vector<std::string> outputs = BatchOutputs(inputs, args.output_path);
+  const std::vector<std::string> outputs =
+      BatchOutputs(inputs, args.output_path, {args.intrinsics_path, args.object_points_path});
   std::filesystem::create_directories(args.output_path);
   const int jobs = args.jobs > 0 ? args.jobs
                                  : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -505,7 +510,8 @@ Command AddFitCommand(CLI::App& root) {
             }
             const auto begin = std::chrono::steady_clock::now();
             if (!args->output_path.empty()) {
-              RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path});
+              RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path,
+                                                            args->object_points_path});
             }
             const auto [data, fit] = FitFile(inputs.front(), size, request);
             const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
