@@ -382,6 +382,10 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
         method = search->method;
       }
     };
+    // A failed screen that the mirrored world passes is a mirror, not outliers: refuse it
+    // before the outlier search, which would crawl through samples that no proper camera fits
+    // (or find a subset that one does).
+    if (!screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
     if (!screen.consistent && options.find_outliers) run_search();
     std::optional<SceneError> refusal;
     std::string problem;
