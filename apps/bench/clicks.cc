@@ -644,14 +644,20 @@ struct Outcome {
   double unseen_mean_px = NAN;
 };
 
+// A point of the true world as the clicks give it: mirrored in the mirrored band.
+Eigen::Vector3d InGivenWorld(const Case& c, const Eigen::Vector3d& point) {
+  Eigen::Vector3d given = point;
+  if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
+  return given;
+}
+
 // |projection by `camera` - projection by the truth| over the unseen points; the camera was fitted
 // in the given (possibly mirrored) world, so the points are mirrored the same way first.
 void Score(const Camera& camera, const Case& c, Outcome* outcome) {
   double max = 0.0;
   double sum = 0.0;
   for (const Eigen::Vector3d& x : c.scene.unseen_points) {
-    Eigen::Vector3d given = x;
-    if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
+    const Eigen::Vector3d given = InGivenWorld(c, x);
     double error = INFINITY;
     try {
       const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, given);
@@ -734,9 +740,7 @@ std::vector<Eigen::Vector3d> ModelVertices(const Case& c) {
   std::vector<Eigen::Vector3d> vertices;
   for (const Box& box : c.scene.boxes) {
     for (int bits = 0; bits < 8; ++bits) {
-      Eigen::Vector3d given = Corner(box, bits);
-      if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
-      vertices.push_back(given);
+      vertices.push_back(InGivenWorld(c, Corner(box, bits)));
     }
   }
   return vertices;
@@ -1222,9 +1226,7 @@ void DumpCase(const std::string& dir, const Band& band, const Case& c) {
   write(base.string() + "-truth.json", CameraToJsonText(c.scene.truth));
   Correspondences unseen;
   for (const Eigen::Vector3d& x : c.scene.unseen_points) {
-    Eigen::Vector3d given = x;
-    if (c.mirror_axis >= 0) given(c.mirror_axis) = -given(c.mirror_axis);
-    unseen.points_in_world.push_back(given);
+    unseen.points_in_world.push_back(InGivenWorld(c, x));
     unseen.pixels.push_back(*PixelFromWorld(c.scene.truth, x));
     unseen.ids.push_back(std::to_string(unseen.ids.size() + 1));
   }

@@ -341,7 +341,8 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
                          const std::optional<SceneError>& refusal, const std::string& problem,
                          const internal::Screen& screen, const std::vector<int>& left_out,
                          const std::optional<internal::OutlierSearch>& search) {
-  MirrorDiagnosis(points, pixels, size, options, noise);
+  // A failed screen was diagnosed before the outlier search (RunPipeline).
+  if (screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
   if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
   std::string text =
       problem.empty() ? "the points do not fit one camera (" + screen.summary + ")" : problem;
@@ -444,10 +445,6 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
   result.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   return result;
 }
-
-}  // namespace
-
-namespace {
 
 // A camera whose GL matrices overflow a double (a world scaled by 2^600) could not be written
 // or exported (RequireFiniteViews): refused as too large, with the advice to change units.
