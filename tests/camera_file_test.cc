@@ -11,6 +11,7 @@
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -39,7 +40,7 @@ std::string ExpectInputError(const std::string& text) {
 }
 
 TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
-  std::mt19937_64 rng(8);
+  std::mt19937_64 rng(testing::Seed(8));
   for (int i = 0; i < 200; ++i) {
     const Camera camera = RandomFileCamera(rng);
     CameraFileOptions options;
@@ -66,7 +67,7 @@ TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
 // An orthographic camera keeps its projection through the file; its glOrtho box is written, and
 // no frustum or perspective (they do not exist for it).
 TEST(CameraFileTest, OrthographicCameraRoundTrips) {
-  std::mt19937_64 rng(9);
+  std::mt19937_64 rng(testing::Seed(9));
   Camera camera = RandomFileCamera(rng);
   camera.projection = Projection::kOrthographic;
   camera.intrinsics.k1 = 0.0;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/gl.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -110,7 +111,7 @@ TEST(DepthPrecisionTest, IssueFiguresAtNear01Far1000Z500) {
 // ---- The definition: at the step the stored value changes, at half of it it does not.
 
 TEST(DepthPrecisionTest, StepIsTheWidthOfTheSimulatedQuantizationBin) {
-  std::mt19937_64 rng(7);
+  std::mt19937_64 rng(testing::Seed(7));
   const std::pair<double, double> ranges[] = {{0.1, 1000.0}, {1.0, 20.0}, {1e-3, 1e3}};
   const std::pair<GlDepth, DepthBuffer> configs[] = {
       {kStandardNo, DepthBuffer::kFixed24}, {kStandardNo, DepthBuffer::kFloat32},

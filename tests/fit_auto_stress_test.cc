@@ -40,6 +40,7 @@
 #include "camproj/camera_file.h"
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -456,7 +457,7 @@ StressScene WildIntrinsics(std::mt19937_64& rng) {
 Category CategoryOf(int seed) { return static_cast<Category>(seed % kNumCategories); }
 
 StressScene MakeStressScene(int seed) {
-  std::mt19937_64 rng(0x5eed0000ULL + static_cast<uint64_t>(seed));
+  std::mt19937_64 rng(testing::Seed(0x5eed0000ULL + static_cast<uint64_t>(seed)));
   switch (CategoryOf(seed)) {
     case kExtremeScale: return ExtremeScale(rng);
     case kLargeOffset: return LargeOffset(rng);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/synth.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -77,7 +78,7 @@ class NoiseFreeTest : public ::testing::TestWithParam<NoiseFreeCase> {};
 
 TEST_P(NoiseFreeTest, RecoversTheCameraExactly) {
   const NoiseFreeCase& c = GetParam();
-  std::mt19937_64 rng(std::hash<std::string>{}(c.name));
+  std::mt19937_64 rng(testing::Seed(std::hash<std::string>{}(c.name)));
   for (int i = 0; i < c.count; ++i) {
     RandomCameraOptions camera_options;
     camera_options.min_fov_deg = 5;
@@ -209,7 +210,7 @@ class NoisyFitTest : public ::testing::TestWithParam<NoisyCase> {};
 // sqrt(2 / (p T)) = 2.6 % for p = 10, T = 300 (bound 10 %: 3.9 sd).
 TEST_P(NoisyFitTest, ResidualsAndReportedSigmasMatchTheirDistributions) {
   const NoisyCase& c = GetParam();
-  std::mt19937_64 rng(1000 + c.num_points);
+  std::mt19937_64 rng(testing::Seed(1000 + c.num_points));
   double sum_rms2 = 0.0;
   double sum_nees = 0.0;
   int p = 0;
@@ -253,7 +254,7 @@ INSTANTIATE_TEST_SUITE_P(SigmaOnePixel, NoisyFitTest,
 // it, rounding 4e6 + x moves a point by ~5e-13 m, which a weak planar fit -- sigma_eye ~ 0.1 m --
 // turns into ~5e-9 relative: a property of the data, not of the fitter.)
 TEST(FitTest, InvariantToWorldUnitsAndOffsets) {
-  std::mt19937_64 rng(77);
+  std::mt19937_64 rng(testing::Seed(77));
   for (int i = 0; i < 20; ++i) {
     const RandomCamera camera = ProjectorLikeCamera(rng);
     SceneOptions scene_options;
@@ -298,7 +299,7 @@ TEST(FitTest, InvariantToWorldUnitsAndOffsets) {
 // (Before: the small scales were refused as collinear, the large ones ended in "K must be
 // finite".)
 TEST(FitTest, ExtremeWorldScalesGiveTheSameCameraBitForBit) {
-  std::mt19937_64 rng(78);
+  std::mt19937_64 rng(testing::Seed(78));
   const RandomCamera camera = ProjectorLikeCamera(rng);
   SceneOptions scene_options;
   scene_options.num_points = 30;
@@ -338,7 +339,7 @@ TEST(FitTest, ExtremeWorldScalesGiveTheSameCameraBitForBit) {
 // -- which is a refusal, if not the right one.)
 TEST(FitTest, APlaneAndOnePointNeverStartFromAReflection) {
   for (uint64_t seed = 0; seed < 200; ++seed) {
-    std::mt19937_64 rng(seed);
+    std::mt19937_64 rng(testing::Seed(seed));
     RandomCamera camera = MakeRandomCamera(rng);
     camera.intrinsics.fy = camera.intrinsics.fx;
     camera.intrinsics.skew = 0.0;
@@ -384,7 +385,7 @@ SceneError::Reason RefusalOf(const std::vector<Eigen::Vector3d>& points,
 class RefusalTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::mt19937_64 rng(5);
+    std::mt19937_64 rng(testing::Seed(5));
     camera_ = ProjectorLikeCamera(rng);
     SceneOptions options;
     options.num_points = 20;
@@ -456,7 +457,7 @@ TEST_F(RefusalTest, CollinearPoints) {
 }
 
 TEST_F(RefusalTest, PlanarSceneWithTooManyFreeIntrinsicsNamesWhatToFix) {
-  std::mt19937_64 rng(6);
+  std::mt19937_64 rng(testing::Seed(6));
   SceneOptions options;
   options.planar = true;
   options.num_points = 30;
@@ -572,7 +573,7 @@ TEST_F(RefusalTest, BadOptionsAreInvalidArguments) {
 }
 
 TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
-  std::mt19937_64 rng(9);
+  std::mt19937_64 rng(testing::Seed(9));
   SceneOptions options;
   options.num_points = 20;
   options.pixel_noise = 1.0;
@@ -597,7 +598,7 @@ TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
 // Three mis-clicked points (60 px off) among 40: a Cauchy loss with a 2 px scale keeps the camera
 // near the truth; plain least squares is pulled away by them.
 TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
-  std::mt19937_64 rng(31);
+  std::mt19937_64 rng(testing::Seed(31));
   const RandomCamera camera = ProjectorLikeCamera(rng);
   SceneOptions scene_options;
   scene_options.num_points = 40;
@@ -622,7 +623,7 @@ TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
 // The result names what refined it (docs say the least-squares path is the project's own LM and
 // Ceres runs only for a robust loss and the orthographic fit): one scene, every path.
 TEST(FitTest, NamesItsRefiner) {
-  std::mt19937_64 rng(33);
+  std::mt19937_64 rng(testing::Seed(33));
   const RandomCamera camera = ProjectorLikeCamera(rng);
   SceneOptions scene_options;
   scene_options.num_points = 30;
@@ -656,7 +657,7 @@ TEST(FitTest, NamesItsRefiner) {
 // A 3-degree field of view: focal length and distance trade off almost exactly (a telephoto
 // view is nearly affine), and the result says so.
 TEST(FitTest, ReportsTheFocalDistanceCorrelationOfANarrowView) {
-  std::mt19937_64 rng(32);
+  std::mt19937_64 rng(testing::Seed(32));
   RandomCamera camera = ProjectorLikeCamera(rng);
   camera.intrinsics.fx = camera.intrinsics.fy = 0.5 * camera.size.width / std::tan(1.5 * M_PI / 180.0);
   camera.intrinsics.cx = 0.5 * (camera.size.width - 1);
@@ -688,7 +689,7 @@ TEST(FitTest, FewPointsNeverEndAboveTheTruthsCost) {
   int checked = 0;
   for (uint64_t seed = 1; seed <= 300; ++seed) {
     SynthOptions synth;
-    synth.seed = seed;
+    synth.seed = testing::Seed(seed);
     synth.num_points = 6 + static_cast<int>(seed % 5);
     synth.noise_px = 0.5;
     synth.fovy_deg = 45;
@@ -725,7 +726,7 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
   for (uint64_t seed = 1; seed <= 400; ++seed) {
     for (const double noise_px : {2.0, 5.0}) {
       SynthOptions synth;
-      synth.seed = seed;
+      synth.seed = testing::Seed(seed);
       synth.num_points = 6;
       synth.noise_px = noise_px;
       synth.principal_point_offset = Eigen::Vector2d(0, 0.5);
@@ -769,7 +770,7 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
 // point is not a parameter. With 0.5 px noise the reported sigmas cover the error: each within 5
 // sigma (Gaussian two-sided 6e-7 per check).
 TEST(OrthographicFitTest, RecoversTheCameraAndReportsItsUncertainty) {
-  std::mt19937_64 rng(21);
+  std::mt19937_64 rng(testing::Seed(21));
   for (int trial = 0; trial < 50; ++trial) {
     Camera truth;
     truth.image_size = {1280, 720};
@@ -840,7 +841,7 @@ TEST(OrthographicFitTest, RecoversTheCameraAndReportsItsUncertainty) {
 // be positive" (exit 2), and one such candidate aborted the whole automatic selection.
 TEST(OrthographicFitTest, ScaleAndAspectComeBackPositive) {
   for (int seed = 0; seed < 400; ++seed) {
-    std::mt19937_64 rng(seed);
+    std::mt19937_64 rng(testing::Seed(seed));
     const RandomCamera camera = MakeRandomCamera(rng);
     SceneOptions scene_options;
     scene_options.num_points = 6 + seed % 20;
@@ -918,7 +919,7 @@ class RansacTest : public ::testing::TestWithParam<RansacCase> {};
 // from the inliers alone and must match the truth to a few sigma of 0.5 px noise on 40+ points.
 TEST_P(RansacTest, FindsTheOutliersAndTheCamera) {
   const RansacCase& c = GetParam();
-  std::mt19937_64 rng(std::hash<std::string>{}(c.name));
+  std::mt19937_64 rng(testing::Seed(std::hash<std::string>{}(c.name)));
   for (int trial = 0; trial < 10; ++trial) {
     RandomCamera camera = ProjectorLikeCamera(rng);
     if (c.planar) camera.intrinsics.fy = camera.intrinsics.fx;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/gl.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -117,7 +118,7 @@ TEST(FrustumTest, OffAxisFrustumHasNoPerspectiveForm) {
 }
 
 TEST(FrustumTest, IntrinsicsFrustumRoundTrip) {
-  std::mt19937_64 rng(17);
+  std::mt19937_64 rng(testing::Seed(17));
   for (int i = 0; i < 1000; ++i) {
     testing::RandomCameraOptions options;
     options.max_skew_ratio = 0.0;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -56,7 +57,7 @@ TEST(IntrinsicsTest, KRoundTripsAndPixelOriginShiftsThePrincipalPoint) {
 }
 
 TEST(IntrinsicsTest, RayFromPixelInvertsProjection) {
-  std::mt19937_64 rng(11);
+  std::mt19937_64 rng(testing::Seed(11));
   for (int i = 0; i < 1000; ++i) {
     Intrinsics k;
     k.fx = testing::LogUniform(rng, 100, 10000);

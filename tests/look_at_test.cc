@@ -9,6 +9,7 @@
 
 #include "camproj/gl.h"
 #include "glm_compare.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -39,7 +40,7 @@ TEST(LookAtTest, HandComputedCameraAtZLookingAtOrigin) {
 }
 
 TEST(LookAtTest, ViewMatrixEqualsGlmLookAt) {
-  std::mt19937_64 rng(3);
+  std::mt19937_64 rng(testing::Seed(3));
   for (int i = 0; i < 1000; ++i) {
     const LookAt look_at = RandomLookAt(rng);
     const Eigen::Matrix4d expected = testing::FromGlm(glm::lookAtRH(
@@ -50,7 +51,7 @@ TEST(LookAtTest, ViewMatrixEqualsGlmLookAt) {
 }
 
 TEST(LookAtTest, PoseToLookAtAndBackIsExact) {
-  std::mt19937_64 rng(5);
+  std::mt19937_64 rng(testing::Seed(5));
   for (int i = 0; i < 1000; ++i) {
     const Rigid3 cam_from_world = CamFromWorldFromCenter(
         testing::RandomRotation(rng), Eigen::Vector3d(testing::Uniform(rng, -10, 10),

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "camproj/synth.h"
+#include "seeds.h"
 #include "fit/common.h"
 
 namespace camproj {
@@ -24,7 +25,7 @@ using internal::MirroredZ;
 TEST(MirrorTest, NeckerReversalReflectsDepthAboutTheCentroid) {
   for (uint64_t seed = 1; seed <= 50; ++seed) {
     SynthOptions synth;
-    synth.seed = seed;
+    synth.seed = testing::Seed(seed);
     synth.object = seed % 2 ? SynthObject::kCloud : SynthObject::kBox;
     synth.principal_point_offset = Eigen::Vector2d(0.1, 0.4);
     const SynthScene scene = SynthesizeScene(synth);
@@ -59,7 +60,7 @@ TEST(MirrorTest, RefinementFromTheReversalOfTheReversalFindsTheTruth) {
   FitOptions model;  // focal, aspect, principal point free
   for (uint64_t seed = 1; seed <= 50; ++seed) {
     SynthOptions synth;
-    synth.seed = seed;
+    synth.seed = testing::Seed(seed);
     synth.object = seed % 2 ? SynthObject::kCloud : SynthObject::kBox;
     synth.principal_point_offset = Eigen::Vector2d(0.0, 0.4);
     synth.aspect = 1.01;

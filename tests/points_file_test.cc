@@ -1,4 +1,5 @@
 #include "camproj/points_file.h"
+#include "seeds.h"
 
 #include <unistd.h>
 
@@ -210,7 +211,7 @@ TEST(PointsFileTest, LimitsOnLineLengthAndRowCount) {
 }
 
 TEST(PointsFileTest, WritingThenReadingGivesBitIdenticalDoubles) {
-  std::mt19937_64 rng(11);
+  std::mt19937_64 rng(testing::Seed(11));
   std::uniform_real_distribution<double> unit(-1, 1);
   std::uniform_int_distribution<uint64_t> any_bits;
   Correspondences c;

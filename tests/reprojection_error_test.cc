@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -16,7 +17,7 @@ namespace {
 constexpr double kJacobianRelative = 1e-10;
 
 TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
-  std::mt19937_64 rng(21);
+  std::mt19937_64 rng(testing::Seed(21));
   for (int i = 0; i < 500; ++i) {
     const Eigen::Quaterniond q(testing::RandomRotation(rng));
     const Eigen::Vector3d center(testing::Uniform(rng, -2, 2), testing::Uniform(rng, -2, 2),

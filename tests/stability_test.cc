@@ -46,6 +46,7 @@
 #include "camproj/look_at.h"
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -322,7 +323,7 @@ Scenario FromSynth(const SynthOptions& synth) {
 SynthOptions Synth(uint64_t seed, int num_points, double fovx_deg = 60.0,
                    SynthObject object = SynthObject::kCloud) {
   SynthOptions o;
-  o.seed = seed;
+  o.seed = testing::Seed(seed);
   o.num_points = num_points;
   o.object = object;
   // Horizontal field of view -> the vertical one synth.h takes (square pixels).
@@ -337,7 +338,7 @@ SynthOptions Synth(uint64_t seed, int num_points, double fovx_deg = 60.0,
 // intrinsics, a seeded rotation and a centre within 5 units of the origin.
 Scenario FromIntrinsics(const Intrinsics& k, const ImageSize& size, uint64_t seed, int num_points,
                         double noise_px, bool planar = false) {
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng(testing::Seed(seed));
   testing::RandomCamera camera;
   camera.size = size;
   camera.intrinsics = k;
@@ -769,7 +770,7 @@ Row RunAutoOrthographic(const Case& c, const Scenario& s, double sigma) {
 
 // The scene with seeded Gaussian pixel noise of `sigma` px per axis.
 Scenario WithNoise(Scenario s, double sigma, uint64_t seed) {
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng(testing::Seed(seed));
   std::normal_distribution<double> normal;
   for (auto& pixel : s.pixels) pixel += sigma * Eigen::Vector2d(normal(rng), normal(rng));
   s.noisy = true;
@@ -822,7 +823,7 @@ Scenario NearPlanar(double thickness, bool full_model) {
     centred.row(i) = (s.points[i] - centroid).transpose();
   const Eigen::Vector3d normal =
       Eigen::JacobiSVD<Eigen::MatrixXd>(centred, Eigen::ComputeThinV).matrixV().col(2);
-  std::mt19937_64 rng(15);
+  std::mt19937_64 rng(testing::Seed(15));
   for (size_t i = 0; i < s.points.size(); ++i) {
     if (thickness > 0.0) {
       s.points[i] += thickness * testing::Uniform(rng, -0.5, 0.5) * normal;
@@ -843,7 +844,7 @@ Scenario FewPoints(int n, const FitOptions& options) {
 // A projector-like scene with noise and `fraction` of the points moved far from their pixel.
 Scenario Outliers(double fraction, uint64_t seed) {
   Scenario s = FromIntrinsics(MakeIntrinsics(1200, 1180, 660, 760), {1280, 800}, seed, 80, 0.5);
-  std::mt19937_64 rng(seed + 1);
+  std::mt19937_64 rng(testing::Seed(seed + 1));
   std::vector<int> order(s.points.size());
   std::iota(order.begin(), order.end(), 0);
   std::shuffle(order.begin(), order.end(), rng);
@@ -868,7 +869,7 @@ Scenario Outliers(double fraction, uint64_t seed) {
 // projective camera gives each (x / z, y / z, also for z < 0): no real camera sees them all.
 Scenario CameraInsideCloud() {
   Scenario s = FromSynth(Synth(17, 8, 60.0));
-  std::mt19937_64 rng(18);
+  std::mt19937_64 rng(testing::Seed(18));
   std::normal_distribution<double> normal;
   int front = 0;
   int back = 0;
@@ -925,7 +926,7 @@ Row RunLookAtRefusal(const Case& c, const LookAt& look_at, const std::string& wo
 Row RunLookAtPose(const Case& c, double sin_up_gaze, double gaze_length,
                   const Eigen::Vector3d& eye) {
   Row row = RowOf(c);
-  std::mt19937_64 rng(19);
+  std::mt19937_64 rng(testing::Seed(19));
   const Eigen::Matrix3d rotation = testing::RandomRotation(rng);
   const Eigen::Vector3d gaze = rotation.row(2).transpose();
   const Eigen::Vector3d up = -rotation.row(1).transpose();
@@ -979,7 +980,7 @@ Row RunGl(const Case& c, const GlDepth& depth, double z_far) {
   Camera camera;
   camera.image_size = {1280, 800};
   camera.intrinsics = MakeIntrinsics(1000, 1100, 700.25, 1200.0, 50.0);
-  std::mt19937_64 rng(20);
+  std::mt19937_64 rng(testing::Seed(20));
   camera.cam_from_world =
       CamFromWorldFromCenter(testing::RandomRotation(rng), Eigen::Vector3d(3.0, -2.0, 5.0));
   camera.z_near = 1e-6;

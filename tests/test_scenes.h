@@ -2,6 +2,7 @@
 #ifndef CAMPROJ_TESTS_TEST_SCENES_H_
 #define CAMPROJ_TESTS_TEST_SCENES_H_
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -36,7 +37,7 @@ inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
 }
 
 struct RandomCameraOptions {
-  double min_fov_deg = 1.0;          // horizontal field of view range (narrow to wide)
+  double min_fov_deg = 1.0;          // field of view range across the wider side (narrow to wide)
   double max_fov_deg = 150.0;
   double max_aspect_ratio = 2.0;     // fy/fx in [1/r, r]
   double max_principal_offset = 1.0; // cx, cy within the image +- this many image sizes
@@ -57,10 +58,15 @@ inline RandomCamera MakeRandomCamera(std::mt19937_64& rng, const RandomCameraOpt
   camera.size.height = static_cast<int>(Uniform(rng, 32, 4096));
   const double fov = Uniform(rng, options.min_fov_deg, options.max_fov_deg) * kPi / 180.0;
   Intrinsics& k = camera.intrinsics;
-  k.fx = 0.5 * camera.size.width / std::tan(0.5 * fov);
-  k.fy = k.fx * LogUniform(rng, 1.0 / options.max_aspect_ratio, options.max_aspect_ratio);
   const double w = camera.size.width;
   const double h = camera.size.height;
+  // The field of view spans the image's wider angular side: width and height are drawn
+  // independently (a 53 x 2107 strip is possible), and a view set across the width alone gave
+  // such a strip ~170 degrees along its length, beyond any lens the tests mean to model.
+  const double aspect = LogUniform(rng, 1.0 / options.max_aspect_ratio, options.max_aspect_ratio);
+  const double widest_half_tangent = std::max(0.5 * w, 0.5 * h / aspect);  // in units of fx
+  k.fx = widest_half_tangent / std::tan(0.5 * fov);
+  k.fy = k.fx * aspect;
   k.cx = Uniform(rng, -options.max_principal_offset * w, (1.0 + options.max_principal_offset) * w);
   k.cy = Uniform(rng, -options.max_principal_offset * h, (1.0 + options.max_principal_offset) * h);
   k.skew = Uniform(rng, -options.max_skew_ratio, options.max_skew_ratio) * k.fx;
