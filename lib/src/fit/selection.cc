@@ -192,6 +192,10 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     for (int top = static_cast<int>(candidates.size()); top >= 0 && !found; --top) {
       FitOptions richest = base;
       for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
+      // Only its sum of squares is used. The prior tells its refinement when the fit is already
+      // consistent with the noise, so that it need not restart from other principal points
+      // (refine.cc, radial distortion).
+      richest.pixel_sigma = options.prior_sigma_px;
       if (num_equations - NumParameters(richest) < 1) continue;
       const Evaluation e = top == 0 ? base_fit : evaluate(richest);
       if (e.fit && num_equations > e.num_params) {
