@@ -85,8 +85,9 @@ bool MayBeAboveTheMinimum(const LeastSquaresOutcome& outcome, const Scene& scene
   if (!outcome.ok || !options.pixel_sigma) return true;
   const double dof = 2.0 * scene.NumPoints() - 6 - outcome.model.NumFree();
   if (dof < 1.0) return true;
-  const double sigma = *options.pixel_sigma;
-  return outcome.normal.cost > sigma * sigma * ChiSquareQuantile(dof, kConsistentQuantile);
+  const double chi_square = outcome.normal.cost / (*options.pixel_sigma * *options.pixel_sigma);
+  // The quantile is above the mean dof: most consistent fits need no quantile (a bisection).
+  return chi_square > dof && chi_square > ChiSquareQuantile(dof, kConsistentQuantile);
 }
 
 // Least squares from the start and, for a DLT on fewer than kSecondStartBelowPoints points with
