@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <random>
@@ -9,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "seeds.h"
 #include "test_scenes.h"
@@ -685,9 +687,21 @@ TEST(FitTest, ReportsTheFocalDistanceCorrelationOfANarrowView) {
 // The true camera is a feasible point of the model, so the fit's cost can never be above the
 // truth's: a fit that ends higher stopped in a local minimum. Six points (the fewest for the
 // DLT) is where the DLT's principal point is worst and LM most easily trapped.
+//
+// FitCamera refines from two starts (the DLT's and the image centre's principal point); that is
+// a local method and at six points two minima can both fit within the noise (regression case
+// below: cy 336 px at RMS 0.76 px against the lens shift's minimum at RMS 0.47 px). Measured:
+// 2 distinct scenes of about 6000 end above the truth's cost (CAMPROJ_SEED_OFFSET 0-60 and
+// 1001); the rate asserted is p = 1e-3 per scene, 3x that. Starting also from the four edge
+// midpoints finds both, but costs 2.6x the default path's instructions at N = 6 (bench
+// --stage-cost), so the default path relies instead on its determination check: what
+// `camproj fit --model focal+principal-point` runs (FitCameraAuto, forced model) must never
+// answer with a camera above the truth's cost -- every seed.
 TEST(FitTest, FewPointsNeverEndAboveTheTruthsCost) {
+  constexpr int kSeeds = 300;
   int checked = 0;
-  for (uint64_t seed = 1; seed <= 300; ++seed) {
+  int above = 0;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
     SynthOptions synth;
     synth.seed = testing::Seed(seed);
     synth.num_points = 6 + static_cast<int>(seed % 5);
@@ -695,25 +709,75 @@ TEST(FitTest, FewPointsNeverEndAboveTheTruthsCost) {
     synth.fovy_deg = 45;
     synth.principal_point_offset = Eigen::Vector2d(0, seed % 2 ? 0.5 : 0.0);
     const SynthScene scene = SynthesizeScene(synth);
+    const Correspondences& c = scene.correspondences;
     double truth_sum = 0.0;
-    for (size_t i = 0; i < scene.correspondences.pixels.size(); ++i) {
-      truth_sum += (*PixelFromWorld(scene.truth, scene.correspondences.points_in_world[i]) -
-                    scene.correspondences.pixels[i]).squaredNorm();
+    for (size_t i = 0; i < c.pixels.size(); ++i) {
+      truth_sum += (*PixelFromWorld(scene.truth, c.points_in_world[i]) - c.pixels[i]).squaredNorm();
     }
-    const double truth_rms = std::sqrt(truth_sum / scene.correspondences.pixels.size());
+    const double truth_rms = std::sqrt(truth_sum / c.pixels.size());
     FitOptions options;
     options.aspect = ParameterMode::Default();
     try {
-      const FitResult fit = FitCamera(scene.correspondences.points_in_world,
-                                      scene.correspondences.pixels, synth.image_size, options);
-      EXPECT_LE(fit.rms_px, truth_rms * (1.0 + 1e-9)) << "seed " << seed;
+      const FitResult fit = FitCamera(c.points_in_world, c.pixels, synth.image_size, options);
       ++checked;
+      if (fit.rms_px > truth_rms * (1.0 + 1e-9)) {
+        ++above;
+        std::printf("seed %llu (synth seed %llu, N %d): FitCamera ends at rms %.6g px above the "
+                    "truth's %.6g px\n", static_cast<unsigned long long>(seed),
+                    static_cast<unsigned long long>(synth.seed), synth.num_points, fit.rms_px,
+                    truth_rms);
+      }
     } catch (const SceneError& e) {
       // A refusal is allowed (never a wrong camera); count them so they cannot hide failures.
       RecordProperty("refused_seed_" + std::to_string(seed), e.what());
     }
+    AutoFitOptions forced;  // the options --model focal+principal-point makes
+    forced.fit.principal_point = ParameterMode::Free();
+    forced.fit.aspect = ParameterMode::Fixed(1.0);
+    forced.fit.skew = forced.fit.k1 = forced.fit.k2 = ParameterMode::Fixed(0.0);
+    try {
+      const FitResult fit = FitCameraAuto(c.points_in_world, c.pixels, synth.image_size, forced);
+      EXPECT_LE(fit.rms_px, truth_rms * (1.0 + 1e-9))
+          << "seed " << seed << " (synth seed " << synth.seed << "): the default path answered a "
+          << "local minimum";
+    } catch (const SceneError&) {
+      // Refused: the determination check saw the other minimum, or the points do not determine.
+    }
   }
   EXPECT_GE(checked, 290);
+  testing::ExpectRate("FitCamera above the truth's cost at 6-10 points", above, checked, 1e-3);
+}
+
+// The regression case of the test above (camproj synth --seed 309 --points 6 --noise 0.5
+// --principal-point-offset 0,0.5 --fovy 45; issue #17): FitCamera from its two starts ends at the
+// minimum with cy 336 px (RMS 0.758 px; the truth's RMS is 0.607 px), and the default path with
+// that model forced (camproj fit --model focal+principal-point) ends at the lens shift's minimum
+// (cy 1074 px, RMS 0.468 px) -- its screen and selection fits start from other cameras.
+TEST(FitTest, SixPointLocalMinimumIsNotAnswered) {
+  SynthOptions synth;
+  synth.seed = 309;
+  synth.num_points = 6;
+  synth.noise_px = 0.5;
+  synth.fovy_deg = 45;
+  synth.principal_point_offset = Eigen::Vector2d(0, 0.5);
+  const SynthScene scene = SynthesizeScene(synth);
+  const Correspondences& c = scene.correspondences;
+  double truth_sum = 0.0;
+  for (size_t i = 0; i < c.pixels.size(); ++i) {
+    truth_sum += (*PixelFromWorld(scene.truth, c.points_in_world[i]) - c.pixels[i]).squaredNorm();
+  }
+  const double truth_rms = std::sqrt(truth_sum / c.pixels.size());
+  AutoFitOptions forced;  // the options --model focal+principal-point makes
+  forced.fit.principal_point = ParameterMode::Free();
+  forced.fit.aspect = ParameterMode::Fixed(1.0);
+  forced.fit.skew = forced.fit.k1 = forced.fit.k2 = ParameterMode::Fixed(0.0);
+  try {
+    const FitResult fit = FitCameraAuto(c.points_in_world, c.pixels, synth.image_size, forced);
+    EXPECT_LE(fit.rms_px, truth_rms * (1.0 + 1e-9));
+    EXPECT_NEAR(fit.camera.intrinsics.cy, 1079.5, 3.0 * 30.0);  // its own sigma: 30 px
+  } catch (const SceneError&) {
+    // A refusal is as good (never the local minimum).
+  }
 }
 
 // Under noise a six-point DLT of a right-handed world can flip its determinant's sign; the fitter

@@ -15,6 +15,7 @@
 #include "fit/determination.h"
 #include "fit/gate.h"
 #include "fit/mirror.h"
+#include "fit/other_minima.h"
 #include "fit/outliers.h"
 #include "fit/scene.h"
 #include "fit/selection.h"
@@ -171,6 +172,34 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
   return rival;
 }
 
+// At six points (fit/other_minima.h) the chosen perspective model with the principal point free,
+// refitted from each edge midpoint's principal point: every camera found, as a rival that the
+// determination check refuses when it fits about as well or better and puts the scene elsewhere.
+std::vector<internal::Rival> OtherMinima(const internal::Selection& selection,
+                                         const std::vector<Eigen::Vector3d>& kept_points,
+                                         const std::vector<Eigen::Vector2d>& kept_pixels,
+                                         const ImageSize& size) {
+  constexpr size_t kOtherMinimaMaxPoints = 6;  // the DLT's one redundant equation
+  std::vector<internal::Rival> rivals;
+  if (kept_points.size() > kOtherMinimaMaxPoints ||
+      selection.options.projection != Projection::kPerspective ||
+      !selection.options.principal_point.IsFree()) {
+    return rivals;
+  }
+  const double n = static_cast<double>(kept_points.size());
+  const double sigma2 = selection.sigma_px * selection.sigma_px;
+  for (const internal::Reading& reading :
+       internal::FitFromEdgePrincipalPoints(kept_points, kept_pixels, size, selection.options,
+                                            selection.fit.camera.intrinsics)) {
+    internal::Rival rival{internal::kOtherMinimumName, selection.options, reading.camera,
+                          n * reading.rms_px * reading.rms_px / sigma2 +
+                              selection.penalty * internal::NumParameters(selection.options)};
+    rival.same_model = true;
+    rivals.push_back(rival);
+  }
+  return rivals;
+}
+
 // "c4 (118 px from where the camera puts it), c7 (64 px ...)": the left-out points.
 std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
                         const std::vector<int>& left_out, const std::vector<std::string>& names) {
@@ -274,6 +303,9 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                                       : "; if your points are this noisy, give --sigma PX"));
   }
   if (mirrored) gated.selection.rivals.push_back(*mirrored);
+  for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, Kept(pixels, left_out), size)) {
+    gated.selection.rivals.push_back(std::move(rival));
+  }
   const DeterminationCheck determination =
       internal::CheckDetermination(gated.selection, kept_points, options);
   RefuseIfUndetermined(determination, gated.selection.fit.model,

@@ -370,8 +370,8 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   std::optional<TestPoints> rival_test;  // computed for the first (unmirrored) rival that counts
   for (const Rival& rival : selection.rivals) {
     const double excess = rival.criterion - selection.criterion;
-    if (!(rival.mirrored_world ? excess <= kEqualFitCriterion
-                               : std::abs(excess) <= kEqualFitCriterion)) {
+    if (!(rival.mirrored_world || rival.same_model ? excess <= kEqualFitCriterion
+                                                   : std::abs(excess) <= kEqualFitCriterion)) {
       continue;
     }
     if (!rival_test && !rival.mirrored_world) {

@@ -5,8 +5,8 @@
 #include "camproj/pose.h"
 #include "fit/closed_form.h"
 #include "fit/common.h"
-#include "fit/least_squares.h"
 #include "fit/model.h"
+#include "fit/reading.h"
 #include "fit/scene.h"
 #include "fit/start.h"
 
@@ -37,34 +37,6 @@ namespace {
 constexpr int kReversalIterations = 10;
 constexpr int kFreshStartIterations = 20;
 
-// `model` with its free slots at `intrinsics`, distortion included.
-Model ModelAt(const Model& model, const Intrinsics& intrinsics) {
-  Model at = ProjectOntoModel(model, intrinsics);
-  if (at.free[5]) at.value[5] = intrinsics.k1;
-  if (at.free[6]) at.value[6] = intrinsics.k2;
-  return at;
-}
-
-// LM (one round of options.max_iterations) in `scene`'s normalized world from `start`: the
-// camera as `like` (projection, image size, depth range) with the refined pose and intrinsics,
-// and its RMS; nothing if a point ends behind it or its focal length or aspect is not positive.
-std::optional<MirroredReading> Refine(const Scene& scene, const StartCamera& start,
-                                      const Model& start_model, const FitOptions& options,
-                                      const Camera& like) {
-  const LeastSquaresOutcome outcome =
-      RefineLeastSquares(scene.points, scene.pixels, start.rotation, start.center, start_model,
-                         options, Clock::now(), /*max_rounds=*/1);
-  if (!outcome.ok) return std::nullopt;
-  MirroredReading reading;
-  reading.camera = like;
-  reading.camera.intrinsics = outcome.model.ToIntrinsics();
-  reading.camera.intrinsics.skew += 0.0;  // no -0
-  reading.camera.cam_from_world =
-      CamFromWorldFromCenter(outcome.rotation, scene.centroid + scene.scale * outcome.center);
-  reading.rms_px = std::sqrt(outcome.normal.cost / static_cast<double>(scene.NumPoints()));
-  return reading;
-}
-
 }  // namespace
 
 std::optional<MirroredReading> FitMirroredReading(
@@ -80,7 +52,7 @@ std::optional<MirroredReading> FitMirroredReading(
     StartCamera start;
     start.rotation = reversed.cam_from_world.rotation;
     start.center = (CameraCenterInWorld(reversed.cam_from_world) - scene.centroid) / scene.scale;
-    return Refine(scene, start, ModelAt(scene.model, camera.intrinsics), options, camera);
+    return RefineReading(scene, start, ModelAt(scene.model, camera.intrinsics), options, camera);
   } catch (const SceneError&) {
     return std::nullopt;  // the mirrored scene has no valid start (ValidateScene's refusals)
   }
@@ -110,7 +82,7 @@ std::optional<MirroredReading> FitMirroredWorld(
     }
     Camera like;
     like.image_size = image_size;
-    return Refine(scene, start, start_model, options, like);
+    return RefineReading(scene, start, start_model, options, like);
   } catch (const SceneError&) {
     return std::nullopt;  // no start, or no valid scene
   }

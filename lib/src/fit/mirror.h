@@ -14,6 +14,7 @@
 
 #include "camproj/camera.h"
 #include "camproj/fit.h"
+#include "fit/reading.h"
 
 namespace camproj {
 namespace internal {
@@ -27,11 +28,9 @@ Camera NeckerReversal(const Camera& camera, const std::vector<Eigen::Vector3d>& 
 // The model name of a mirrored reading where it is a rival (DeterminationCheck::rival).
 inline constexpr char kMirroredReadingName[] = "the same model with one world axis flipped";
 
-// A proper camera of the mirrored world (the points with z negated, MirroredZ) and its RMS.
-struct MirroredReading {
-  Camera camera;  // sees MirroredZ(points_in_world): pixel of x is PixelFromWorld(camera, M x)
-  double rms_px = 0.0;
-};
+// A proper camera of the mirrored world (the points with z negated, MirroredZ) and its RMS: its
+// camera sees MirroredZ(points_in_world), the pixel of x is PixelFromWorld(camera, M x).
+using MirroredReading = Reading;
 
 // `model` fitted by least squares (at most 10 LM iterations) to the points with z negated, from
 // NeckerReversal(camera, points): a proper camera of the mirrored world whose RMS is at or above

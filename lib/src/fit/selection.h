@@ -25,6 +25,9 @@ struct Rival {
   // world. It counts when it fits about as well or better (a better one by more than the
   // mirror test's margin is refused before).
   bool mirrored_world = false;
+  // The chosen model itself at another of its minima (fit/other_minima.h): it too counts when it
+  // fits better, as then the chosen camera is not the least-squares optimum.
+  bool same_model = false;
 };
 
 struct Selection {
