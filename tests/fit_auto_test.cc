@@ -63,9 +63,15 @@ AutoFitOptions Forced() {
 }
 
 // A world with one axis negated fits no proper camera: refused in the automatic and the forced
-// model, at 6, 20 and 300 points, with advice that names the mirror -- never answered by an
-// orthographic camera. Every seed (a mirrored world is never right).
+// model, at 6, 20 and 300 points -- never answered, by an orthographic camera or any other, in
+// any seed (a mirrored world is never right). The refusal names the mirror with its advice in
+// every seed at 20 and 300 points; at 6 points some are refused for another reason first (a
+// point behind the best linear camera, a camera not determined): the click benchmark's mirrored
+// N = 6 band names another reason in 7 of 99 refusals (docs/bench/clicks), so the rate asserted
+// is p = 0.15 per scene, twice that.
 TEST(FitAutoTest, MirroredWorldsAreRefused) {
+  int six_point_refusals = 0;
+  int six_point_unnamed = 0;
   for (const int n : {6, 20, 300}) {
     for (const SynthObject object : {SynthObject::kBox, SynthObject::kCloud}) {
       // Fewer seeds at 300 points: each costs ~100 fits (CI runs this under ASan too).
@@ -80,13 +86,20 @@ TEST(FitAutoTest, MirroredWorldsAreRefused) {
             ADD_FAILURE() << "n " << n << " seed " << seed << " forced " << forced
                           << ": answered " << fit.model << ", rms " << fit.rms_px;
           } catch (const SceneError& e) {
-            EXPECT_NE(std::string(e.what()).find("mirror"), std::string::npos)
-                << "n " << n << " seed " << seed << ": " << e.what();
+            const bool named = std::string(e.what()).find("mirror") != std::string::npos;
+            if (n == 6) {
+              ++six_point_refusals;
+              if (!named) ++six_point_unnamed;
+            } else {
+              EXPECT_TRUE(named) << "n " << n << " seed " << seed << ": " << e.what();
+            }
           }
         }
       }
     }
   }
+  testing::ExpectRate("mirrored 6-point scenes refused without naming the mirror",
+                      six_point_unnamed, six_point_refusals, 0.15);
 }
 
 // Six clicked corners of a mirrored world (bench --clicks, band "mirrored N=6", scenes 29 and
@@ -345,6 +358,8 @@ TEST(FitAutoTest, OneMisclickAmongEightIsNamed) {
   int named = 0;
   int among_candidates = 0;
   constexpr int kSeeds = 200;
+  constexpr double kNotNamedAlone = 0.11;
+  constexpr double kNotNamed = 0.05;
   for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
     SynthScene scene = Clicks(seed, 8);
     std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
@@ -378,10 +393,9 @@ TEST(FitAutoTest, OneMisclickAmongEightIsNamed) {
       }
     }
   }
-  RecordProperty("named", named);
-  RecordProperty("named_among_candidates", among_candidates);
-  EXPECT_GE(named, 0.89 * kSeeds);
-  EXPECT_GE(named + among_candidates, 0.95 * kSeeds);
+  testing::ExpectRate("mis-clicks among 8 not named alone", kSeeds - named, kSeeds, kNotNamedAlone);
+  testing::ExpectRate("mis-clicks among 8 not named, alone or among candidates",
+                      kSeeds - named - among_candidates, kSeeds, kNotNamed);
 }
 
 // Six points and one mis-click: leaving any point out leaves too few to check the rest, so the
