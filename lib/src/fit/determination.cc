@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "camproj/conventions.h"
+#include "camproj/intrinsics.h"
 #include "camproj/pose.h"
 #include "check.h"
 #include "fit/common.h"
@@ -242,6 +243,26 @@ struct TestPoints {
   std::vector<bool> object;  // an object point (AutoFitOptions::object_points_in_world)
 };
 
+// Whether the image shows `point_in_world` at `pixel` (its pixel under `camera`): beyond the first
+// fold of the radial distortion (intrinsics.h) the model folds the image over, and a point there
+// lands on a pixel whose ray is another (seen: a box corner 20 degrees outside a 60 degree view
+// with k1 = -0.2 judged inside the image, at 20 times the uncertainty of any point seen).
+bool BeforeTheFold(const Camera& camera, const Eigen::Vector3d& point_in_world,
+                   const Eigen::Vector2d& pixel) {
+  const Intrinsics& k = camera.intrinsics;
+  if (k.k1 == 0.0 && k.k2 == 0.0) return true;
+  // The ray's inversion converges to ~1e-15 in normalized units; the other branch is far.
+  constexpr double kSameRay = 1e-9;
+  const Eigen::Vector3d in_cam = camera.cam_from_world * point_in_world;
+  const Eigen::Vector2d normalized = in_cam.head<2>() / in_cam.z();
+  try {
+    const Eigen::Vector3d ray = CamRayFromPixel(k, pixel);  // kCenter, as PixelFromWorld's
+    return (ray.head<2>() - normalized).norm() <= kSameRay * (1.0 + normalized.norm());
+  } catch (const std::domain_error&) {
+    return false;  // at or beyond the fold's distorted radius
+  }
+}
+
 TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
                         double min_thickness,
                         const std::vector<Eigen::Vector3d>& object_points = {}) {
@@ -281,7 +302,7 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
   for (size_t k = 0; k < candidates.size(); ++k) {
     const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, candidates[k]);
     if (u && u->x() >= -0.5 && u->x() <= camera.image_size.width - 0.5 && u->y() >= -0.5 &&
-        u->y() <= camera.image_size.height - 0.5) {
+        u->y() <= camera.image_size.height - 0.5 && BeforeTheFold(camera, candidates[k], *u)) {
       inside.points.push_back(candidates[k]);
       inside.fitted.push_back(k < points.size() ? static_cast<int>(k) : -1);
       inside.object.push_back(k >= candidates.size() - object_points.size());
