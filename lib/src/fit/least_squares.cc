@@ -59,6 +59,52 @@ class ChartProblem {
     return true;
   }
 
+  // J(u)^T r''(u; v), r'' the second directional derivative of the residuals along v, by the
+  // finite difference (2 / h) ((r(u + h v) - r(u)) / h - J v) (Transtrum and Sethna 2012,
+  // "Improvements to the Levenberg-Marquardt algorithm for nonlinear least-squares
+  // minimization", eq. 15). False if a point is behind the camera at u or u + h v.
+  bool JacobianTransposeSecondDerivative(const ParamVector& u, const ParamVector& v, double h,
+                                         ParamVector* out) const {
+    Eigen::Matrix3d rotation, moved_rotation;
+    Eigen::Vector3d center, moved_center;
+    IntrinsicValues intrinsics, moved_intrinsics;
+    Unpack(u, &rotation, &center, &intrinsics);
+    Unpack(u + h * v, &moved_rotation, &moved_center, &moved_intrinsics);
+    // v in the local frame of LocalNormalEquations: dtheta = J_l(omega) domega, dc = R dC.
+    const int p = static_cast<int>(u.size());
+    ParamVector v_local = v;
+    v_local.head<3>() = LeftJacobian(u) * v.head<3>();
+    v_local.segment<3>(3) = rotation * v.segment<3>(3);
+    ParamVector sum = ParamVector::Zero(p);
+    for (size_t i = 0; i < points_.size(); ++i) {
+      const Eigen::Vector3d q = rotation * (points_[i] - center);
+      const Eigen::Vector3d moved_q = moved_rotation * (points_[i] - moved_center);
+      if (!(q.z() > 0.0) || !(moved_q.z() > 0.0)) return false;
+      double r[2], moved_r[2], jk[2 * kFitIntrinsicsSize], jp[6];
+      ResidualOfCamPoint(intrinsics.data(), q, pixels_[i], r, jk, jp);
+      ResidualOfCamPoint(moved_intrinsics.data(), moved_q, pixels_[i], moved_r, nullptr, nullptr);
+      Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxParams> j(2, p);
+      for (int row = 0; row < 2; ++row) {
+        const Eigen::Vector3d a(jp[3 * row], jp[3 * row + 1], jp[3 * row + 2]);
+        j.block<1, 3>(row, 0) = q.cross(a).transpose();
+        j.block<1, 3>(row, 3) = -a.transpose();
+        int next = 6;
+        for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+          if (model_.free[slot]) j(row, next++) = jk[kFitIntrinsicsSize * row + slot];
+        }
+      }
+      const Eigen::Vector2d second =
+          (2.0 / h) * ((Eigen::Vector2d(moved_r[0], moved_r[1]) - Eigen::Vector2d(r[0], r[1])) / h -
+                       j * v_local);
+      sum += j.transpose() * second;
+    }
+    // Back to the chart: J_chart = J_local T, T = diag(J_l(omega), R, I).
+    *out = sum;
+    out->head<3>() = LeftJacobian(u).transpose() * sum.head<3>();
+    out->segment<3>(3) = rotation.transpose() * sum.segment<3>(3);
+    return true;
+  }
+
  private:
   // Unpack without copying the model's descriptions (strings): for every pass over the points.
   void Unpack(const ParamVector& u, Eigen::Matrix3d* rotation, Eigen::Vector3d* center,
@@ -145,9 +191,19 @@ struct LmSummary {
 // every candidate is accepted and then needs them (TinySolver evaluates it twice); and a candidate
 // that puts a point behind the camera is rejected and the damping raised (TinySolver ignores the
 // failed evaluation and compares stale residuals). Each accepted iterate is recorded in the trace.
+//
+// With `geodesic`, each step also gets Transtrum and Sethna's geodesic acceleration (2012, cited
+// at JacobianTransposeSecondDerivative): the second-order correction a = -(J^T J + damping)^-1
+// J^T r''(v) to the step v, taken as v + a / 2 when |a| <= kGeodesicAlpha |v| / 2 (else the
+// step is rejected and the damping raised). It follows a curved valley to second order where
+// plain LM steps leave it after a tiny fraction of its length (the cost rises across it).
 LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptions& options,
-                                     Clock::time_point start_time, ParamVector* u,
+                                     Clock::time_point start_time, bool geodesic, ParamVector* u,
                                      std::vector<TraceEntry>* trace) {
+  // Transtrum and Sethna's defaults: the finite-difference step along v and the largest
+  // acceptable |a| / |v| (times 2).
+  constexpr double kGeodesicStep = 0.1;
+  constexpr double kGeodesicAlpha = 0.75;
   // TinySolver's defaults where FitOptions has no say.
   const double cost_threshold = std::numeric_limits<double>::epsilon();
   constexpr double kInitialTrustRegionRadius = 1e4;
@@ -206,12 +262,28 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       regularized(i, i) += lm_diagonal * lm_diagonal;
     }
     ldlt.compute(regularized);
-    const ParamVector lm_step = ldlt.solve(gradient);
-    const ParamVector step = scaling.asDiagonal() * lm_step;
+    ParamVector lm_step = ldlt.solve(gradient);
+    ParamVector step = scaling.asDiagonal() * lm_step;
     // Adding parameter_tolerance to |u| keeps the test meaningful near u = 0.
     if (step.norm() < options.parameter_tolerance * (u->norm() + options.parameter_tolerance)) {
       summary.status = LmStatus::kRelativeStepTooSmall;
       break;
+    }
+    ParamVector velocity = lm_step;
+    if (geodesic) {
+      ParamVector second;
+      if (problem.JacobianTransposeSecondDerivative(*u, step, kGeodesicStep, &second)) {
+        const ParamVector acceleration = -ldlt.solve(scaling.asDiagonal() * second);
+        if (!acceleration.allFinite() ||
+            2.0 * acceleration.norm() > kGeodesicAlpha * lm_step.norm()) {
+          damping *= damping_factor;
+          damping_factor *= 2.0;
+          continue;
+        }
+        velocity = lm_step;
+        lm_step += 0.5 * acceleration;
+        step = scaling.asDiagonal() * lm_step;
+      }
     }
     const ParamVector candidate = *u + step;
     if (!problem.Linearize(candidate, &chart, &local)) {
@@ -222,7 +294,9 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       continue;
     }
     const double cost_change = 2.0 * cost - chart.cost;
-    const double model_cost_change = lm_step.dot(2.0 * gradient - jtj * lm_step);
+    // With the acceleration, the reduction the linear model predicts for the velocity (the
+    // acceleration's own is second order, which the linear model does not see).
+    const double model_cost_change = velocity.dot(2.0 * gradient - jtj * velocity);
     // rho: the actual reduction over the reduction the linear model predicts.
     const double rho = cost_change / model_cost_change;
     if (rho > 0.0) {
@@ -355,8 +429,10 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
     const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
     ParamVector u = problem.Pack(outcome.center);
+    // The first round is TinySolver's LM; where its answer is short of the minimum (a curved
+    // valley), the next rounds add geodesic acceleration.
     const LmSummary summary =
-        MinimizeLevenbergMarquardt(problem, options, start_time, &u, &outcome.trace);
+        MinimizeLevenbergMarquardt(problem, options, start_time, round > 0, &u, &outcome.trace);
     problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
     outcome.iterations += summary.iterations;
     outcome.termination = LmStatusText(summary.status);
