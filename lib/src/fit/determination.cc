@@ -416,6 +416,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     PixelUncertainty uncertainty;
   };
   std::vector<Counted> counted;
+  counted.reserve(selection.rivals.size());  // moved in once, never copied
   for (const Rival& rival : selection.rivals) {
     const double excess = rival.criterion - selection.criterion;
     if (!(rival.mirrored_world ? excess <= kEqualFitCriterion
