@@ -240,7 +240,11 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
                    "the points cannot tell " + model + " from " + check.rival +
-                       ": both fit about as well, but they put the scene up to " +
+                       ": both fit about as well" +
+                       (check.rival_predicts_better
+                            ? " (and the latter predicts each point from the others better)"
+                            : "") +
+                       ", but they put the scene up to " +
                        Px(check.rival_shift_px) + " apart (bound " + Px(check.bound_px) +
                        ", --max-uncertainty). " + advice);
 }

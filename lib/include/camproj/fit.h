@@ -228,6 +228,9 @@ struct DeterminationCheck {
   double bound_px = 0.0;      // AutoFitOptions::max_uncertainty_px
   std::string rival;          // the model that fits about as well and moves a test point most
   double rival_shift_px = 0.0;  // by how much (0: no such model)
+  // The rival predicts each kept point from the others better than the returned model
+  // (leave-one-out, at up to 12 points): its shift counts even within its own 3 sigma.
+  bool rival_predicts_better = false;
   std::string summary;        // one line in words
 };
 
