@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <random>
 
@@ -597,29 +598,61 @@ TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
   EXPECT_FALSE(fit.views.perspective.has_value());  // off-axis
 }
 
-// Three mis-clicked points (60 px off) among 40: a Cauchy loss with a 2 px scale keeps the camera
-// near the truth; plain least squares is pulled away by them.
+// Three mis-clicked points (75 px off) among 40: a Cauchy loss with a 2 px scale keeps the camera
+// where least squares on the 37 good points puts it (plain least squares on all 40 is pulled
+// away). Per scene, the robust fit's focal error is within 4 sigma of the good points' own fit
+// (pixel sigma 0.5 given): the Cauchy weights w = 1 / (1 + (r / 2)^2) of the good points are
+// >= 0.94 at 0.5 px noise (efficiency > 0.97, sigma at most 1.05x) and each outlier pulls with
+// weight (2 / 75)^2 ~ 1 / 1400, so |error| > 4 sigma has probability about P(|z| > 3.8) = 1.4e-4;
+// the rate asserted over 50 scenes is p = 1e-3 per scene. (One scene, as before, failed in 4 of
+// 30 seed offsets: the plain fit's error happened to be small there, which is no property.)
+// The outliers stand out in every scene's residuals: moved 75 px, predicted within ~1 px.
 TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
   std::mt19937_64 rng(testing::Seed(31));
-  const RandomCamera camera = ProjectorLikeCamera(rng);
-  SceneOptions scene_options;
-  scene_options.num_points = 40;
-  scene_options.pixel_noise = 0.5;
-  Scene scene = MakeScene(rng, camera, scene_options);
-  for (int i : {3, 17, 29}) scene.observed_pixels[i] += Eigen::Vector2d(60, -45);
-  FitOptions plain;
-  FitOptions robust;
-  robust.loss = LossType::kCauchy;
-  robust.loss_scale_px = 2.0;
-  const FitResult a = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, plain);
-  const FitResult b = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, robust);
-  const double plain_error = std::abs(a.camera.intrinsics.fx / camera.intrinsics.fx - 1.0);
-  const double robust_error = std::abs(b.camera.intrinsics.fx / camera.intrinsics.fx - 1.0);
-  EXPECT_LT(robust_error, 0.01);
-  EXPECT_LT(robust_error, 0.25 * plain_error);
-  // The outliers stand out in the robust fit's residuals.
-  for (int i : {3, 17, 29}) EXPECT_GT(b.residuals_px[i].norm(), 40.0) << i;
-  EXPECT_LT(b.median_px, 1.5);
+  constexpr int kScenes = 50;
+  int beyond = 0;
+  int plain_beyond = 0;
+  for (int scene_index = 0; scene_index < kScenes; ++scene_index) {
+    const RandomCamera camera = ProjectorLikeCamera(rng);
+    SceneOptions scene_options;
+    scene_options.num_points = 40;
+    scene_options.pixel_noise = 0.5;
+    Scene scene = MakeScene(rng, camera, scene_options);
+    std::vector<int> bad(40);
+    std::iota(bad.begin(), bad.end(), 0);
+    std::shuffle(bad.begin(), bad.end(), rng);
+    bad.resize(3);
+    std::vector<Eigen::Vector3d> good_points;
+    std::vector<Eigen::Vector2d> good_pixels;
+    for (int i = 0; i < 40; ++i) {
+      if (std::find(bad.begin(), bad.end(), i) != bad.end()) {
+        scene.observed_pixels[i] += Eigen::Vector2d(60, -45);
+      } else {
+        good_points.push_back(scene.points_in_world[i]);
+        good_pixels.push_back(scene.observed_pixels[i]);
+      }
+    }
+    FitOptions oracle;
+    oracle.pixel_sigma = 0.5;
+    const FitResult good = FitCamera(good_points, good_pixels, camera.size, oracle);
+    double sigma_fx = 0.0;
+    for (const ParameterSigma& s : good.sigmas) {
+      if (s.name == "fx") sigma_fx = s.sigma;
+    }
+    ASSERT_GT(sigma_fx, 0.0);
+    FitOptions robust;
+    robust.loss = LossType::kCauchy;
+    robust.loss_scale_px = 2.0;
+    const FitResult b = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, robust);
+    const FitResult a = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, {});
+    if (std::abs(b.camera.intrinsics.fx - camera.intrinsics.fx) > 4.0 * sigma_fx) ++beyond;
+    if (std::abs(a.camera.intrinsics.fx - camera.intrinsics.fx) > 4.0 * sigma_fx) ++plain_beyond;
+    for (const int i : bad) EXPECT_GT(b.residuals_px[i].norm(), 40.0) << scene_index << " " << i;
+    EXPECT_LT(b.median_px, 1.5) << scene_index;
+  }
+  std::printf("plain least squares: focal beyond 4 sigma in %d of %d scenes\n", plain_beyond,
+              kScenes);
+  testing::ExpectRate("robust focal beyond 4 sigma of the good points' fit", beyond, kScenes, 1e-3);
 }
 
 // The result names what refined it (docs say the least-squares path is the project's own LM and
