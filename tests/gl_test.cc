@@ -156,13 +156,18 @@ TEST(GlTest, OrthographicCameraEqualsGlOrthoAndItsPixels) {
                     kPixelAgreement * std::max(1.0, k.fx * std::abs(x)))
               << "camera " << i;
           const double linear = (depth - z_near) / (z_far - z_near);
-          // The world point's coordinates carry rounding of ~1e-16 of their size, which the
-          // depth row divides by far - near (a 1e6-unit-wide view with a 0.01-deep range makes
-          // 1e-8): a few ulps of that, plus the window arithmetic's own.
+          // The world point's coordinates carry rounding of their size, which the depth row
+          // divides by far - near (a 1e6-unit-wide view with a 0.01-deep range makes 1e-8):
+          // making the point, R^T (p - t), errs by ~4 unit roundoffs of |p| + |t| per
+          // coordinate, the view row's 4-term dot by ~4 of |X| + |t|, with |p|, |X| and |t| each
+          // at most world_size: ~24 unit roundoffs of world_size in the eye depth; kWorldRoundings
+          // = 32. Plus the window arithmetic's own on O(1) values. (9 unit roundoffs, 1e-15,
+          // failed at 2 of 40 seed offsets, by up to 1.2x.)
+          constexpr double kWorldRoundings = 32.0;
           const double world_size =
               std::max({std::abs(x), std::abs(y), depth, camera.cam_from_world.translation.norm()});
           EXPECT_NEAR(gl.window_depth, depth_convention.reversed_z ? 1.0 - linear : linear,
-                      1e-15 * world_size / (z_far - z_near) + 1e-14)
+                      kWorldRoundings * 0x1p-53 * world_size / (z_far - z_near) + 1e-14)
               << "camera " << i;
         }
       }
