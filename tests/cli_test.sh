@@ -38,7 +38,6 @@ case $case in
       || fail "fit time '$fit_ms' ms and wall time '$wall_ms' ms"
     [[ -f "$work/cam.json" ]] || fail "no camera file"
     grep -q '"fit"' "$work/cam.json" || fail "camera file lacks fit"
-    # The fit is within a few sigma of the truth the data was made from.
     expect_exit 0 "$bin" export "$work/cam.json" --to gl
     expect_in out "^projection "
     ;;
@@ -506,6 +505,54 @@ json.dump(d, open(sys.argv[2], "w"))' "$data/projector/truth.json" "$work/wide.j
     expect_exit 0 "$bin" fit "$work/esc.csv" --image-size 1280x800
     expect_in out '\\x1b\[31mred'
     ! grep -q $'\033' "$work/out" || fail "a raw ESC reached the terminal"
+    ;;
+  fit_matches_truth)
+    # camproj fit with no options on synth scenes (a projector with lens shift, 30 points, 0.5 px
+    # noise) lands within 4 of its own sigmas of the truth synth wrote, for the focal length, the
+    # principal point and the eye. Per scene and parameter |error| > 4 sigma has probability
+    # 6.3e-5 for a Gaussian error; the sigmas use a noise estimate pulled up toward the 1 px
+    # prior, so less. Over the 6 parameters (Bonferroni) p = 1e-3 per scene is asserted as a rate
+    # over 20 scenes (binomial bound at level 1e-6), seeds shifted by CAMPROJ_SEED_OFFSET.
+    offset=${CAMPROJ_SEED_OFFSET:-0}
+    for i in $(seq 1 20); do
+      seed=$((i + offset))
+      "$bin" synth --seed "$seed" --points 30 --noise 0.5 --principal-point-offset 0,0.4 \
+        -o "$work/p$i.csv" --truth "$work/t$i.json" >/dev/null || fail "synth seed $seed"
+      "$bin" fit "$work/p$i.csv" --image-size 1920x1080 -o "$work/c$i.json" >/dev/null 2>&1
+      echo "$?" >"$work/rc$i"
+    done
+    py - "$work" <<'PY' || fail "fitted cameras against the truth"
+import json, math, os, sys
+work = sys.argv[1]
+beyond = 0
+answered = 0
+for i in range(1, 21):
+    if open(os.path.join(work, "rc%d" % i)).read().strip() != "0":
+        continue  # a refusal is not a wrong camera (exit 3 says why)
+    answered += 1
+    cam = json.load(open(os.path.join(work, "c%d.json" % i)))
+    truth = json.load(open(os.path.join(work, "t%d.json" % i)))
+    sigma = cam["fit"]["sigma"]
+    errors = {}
+    for name in ("fx", "cx", "cy"):
+        if name in sigma:
+            errors[name] = cam["intrinsics"][name] - truth["intrinsics"][name]
+    for axis, name in enumerate(("eye_x", "eye_y", "eye_z")):
+        errors[name] = cam["look_at"]["eye"][axis] - truth["look_at"]["eye"][axis]
+    worst = max(abs(e) / sigma[n] for n, e in errors.items())
+    if worst > 4.0:
+        beyond += 1
+        print("scene %d: a parameter %.2f sigma from the truth: %s" % (i, worst, errors))
+# The most failures of `answered` trials at p = 1e-3 that a test at level 1e-6 accepts.
+p, level = 1e-3, 1e-6
+def tail(n, k):
+    return sum(math.comb(n, j) * p**j * (1 - p)**(n - j) for j in range(k + 1, n + 1))
+bound = 0
+while bound < answered and tail(answered, bound) > level:
+    bound += 1
+print("[ RATE ] fitted camera beyond 4 sigma of the truth: %d / %d (bound %d)" % (beyond, answered, bound))
+sys.exit(0 if answered >= 15 and beyond <= bound else 1)
+PY
     ;;
   *) fail "unknown case" ;;
 esac
