@@ -48,6 +48,7 @@
 #include "camproj/synth.h"
 #include "seeds.h"
 #include "test_scenes.h"
+#include "truth_condition.h"
 
 namespace camproj {
 namespace {
@@ -78,10 +79,11 @@ constexpr double kEvalRoundings = 32.0;
 // rotation through a quaternion and back (~8); 16 is twice that.
 constexpr double kOutputRoundings = 16.0;
 
-// fit.h: a fit whose scaled Jacobian has a condition number above this is refused as
-// undetermined (SceneError kDegenerate). The suite computes the condition number at the true
-// camera independently (ConditionAtTruth) and expects a camera below it, that refusal above it.
-constexpr double kFitterConditionLimit = 1e6;
+// fit.h: a fit whose scaled Jacobian has a condition number above testing::kFitterConditionLimit
+// is refused as undetermined (SceneError kDegenerate). The suite computes the condition number at
+// the true camera independently (ConditionAtTruth) and expects a camera below it, that refusal
+// above it.
+using testing::kFitterConditionLimit;
 
 // Noisy fits and RANSAC: each case's statistical check fails by chance with at most this
 // probability: NEES below its 99.99 % quantile, and every parameter within the two-sided
@@ -419,72 +421,10 @@ double PerturbationNorm(const Scenario& s) {
   return static_cast<double>(std::sqrt(data)) + std::sqrt(eval);
 }
 
-// The condition number of the scaled Jacobian at the true camera, in the fitter's
-// parameterization (fit.h, src/fit/): pose in the world centred on the points and scaled to unit
-// RMS distance, rotation R = exp(omega) R_true, then the free slots focal, aspect (fy / fx), cx,
-// cy, skew; columns scaled to unit norm. Central differences in long double (step 1e-6 relative:
-// truncation ~1e-12, rounding ~1e-19 / 1e-6 = 1e-13 relative), independent of the fitter's code.
+// The condition number of the scaled Jacobian at the true camera (truth_condition.h).
 double ConditionAtTruth(const Scenario& s) {
-  using Vector = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
-  using Matrix = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
-  const Truth& t = s.truth;
-  const FitOptions& o = s.options;
-  const bool known = o.known_intrinsics.has_value();
-  const bool free[5] = {!known && o.focal.IsFree(), !known && o.aspect.IsFree(),
-                        !known && o.principal_point.IsFree(), !known && o.principal_point.IsFree(),
-                        !known && o.skew.IsFree()};
-  const int n = static_cast<int>(s.points.size());
-  Vector3l centroid = Vector3l::Zero();
-  for (const auto& x : s.points) centroid += x.cast<long double>();
-  centroid /= n;
-  long double scale = 0.0L;
-  for (const auto& x : s.points) scale += (x.cast<long double>() - centroid).squaredNorm();
-  scale = std::sqrt(scale / n);
-  const Intrinsics& k = t.intrinsics;
-  const long double slot_values[5] = {k.fx, k.fy / static_cast<long double>(k.fx), k.cx, k.cy,
-                                      k.skew};
-  std::vector<int> slots;
-  for (int slot = 0; slot < 5; ++slot) {
-    if (free[slot]) slots.push_back(slot);
-  }
-  const int p = 6 + static_cast<int>(slots.size());
-  Vector u0 = Vector::Zero(p);
-  u0.segment<3>(3) = (t.center.cast<long double>() - centroid) / scale;
-  for (size_t j = 0; j < slots.size(); ++j) u0(6 + j) = slot_values[slots[j]];
-  auto residuals = [&](const Vector& u) {
-    const Vector3l omega = u.head<3>();
-    const long double angle = omega.norm();
-    Eigen::Matrix<long double, 3, 3> rotation = t.rotation.cast<long double>();
-    if (angle > 0.0L) rotation = Eigen::AngleAxis<long double>(angle, omega / angle) * rotation;
-    long double v[5] = {slot_values[0], slot_values[1], slot_values[2], slot_values[3],
-                        slot_values[4]};
-    for (size_t j = 0; j < slots.size(); ++j) v[slots[j]] = u(6 + j);
-    Vector r(2 * n);
-    for (int i = 0; i < n; ++i) {
-      const Vector3l q =
-          rotation * ((s.points[i].cast<long double>() - centroid) / scale - u.segment<3>(3));
-      const long double x = q.x() / q.z();
-      const long double y = q.y() / q.z();
-      r(2 * i) = v[0] * x + v[4] * y + v[2];
-      r(2 * i + 1) = v[1] * v[0] * y + v[3];
-    }
-    return r;
-  };
-  Matrix jacobian(2 * n, p);
-  for (int j = 0; j < p; ++j) {
-    const long double h = 1e-6L * std::max(1.0L, std::abs(u0(j)));
-    Vector plus = u0;
-    Vector minus = u0;
-    plus(j) += h;
-    minus(j) -= h;
-    jacobian.col(j) = (residuals(plus) - residuals(minus)) / (2.0L * h);
-    const long double norm = jacobian.col(j).norm();
-    if (!(norm > 0.0L)) return kInfinity;
-    jacobian.col(j) /= norm;
-  }
-  const Vector singular = Eigen::JacobiSVD<Matrix>(jacobian).singularValues();
-  if (!(singular(p - 1) > 0.0L)) return kInfinity;
-  return static_cast<double>(singular(0) / singular(p - 1));
+  return testing::ConditionAtTruth(s.points, s.truth.rotation, s.truth.center,
+                                   s.truth.intrinsics, s.options);
 }
 
 // The fit's error in its own parameterization (fit.h: rotation as omega with
