@@ -291,19 +291,23 @@ bool PnpStart(const std::vector<Eigen::Vector3d>& points,
 
 bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& guess,
-                     double aspect, int image_width, StartCamera* start) {
+                     double aspect, int image_width, StartCamera* start,
+                     std::vector<StartCamera>* other_minima) {
   constexpr double kPi = 3.14159265358979323846;
   constexpr int kSteps = 48;
   constexpr double kMinFovDeg = 0.5;
   constexpr double kMaxFovDeg = 175.0;
   const double f_min = 0.5 * image_width / std::tan(0.5 * kMaxFovDeg * kPi / 180.0);
   const double f_max = 0.5 * image_width / std::tan(0.5 * kMinFovDeg * kPi / 180.0);
-  double best_rms = std::numeric_limits<double>::infinity();
+  const double kNone = std::numeric_limits<double>::infinity();
+  std::vector<double> rms(kSteps, kNone);
+  std::vector<StartCamera> candidates(kSteps);
+  int best = -1;
   for (int i = 0; i < kSteps; ++i) {
     Intrinsics k = guess;
     k.fx = f_min * std::pow(f_max / f_min, i / (kSteps - 1.0));
     k.fy = aspect * k.fx;
-    StartCamera candidate;
+    StartCamera& candidate = candidates[i];
     if (!PnpStart(points, pixels, k, &candidate)) continue;
     double sum = 0.0;
     bool all_in_front = true;
@@ -316,13 +320,22 @@ bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
       sum += (PixelFromCam(k, p) - pixels[j]).squaredNorm();
     }
     if (!all_in_front) continue;
-    const double rms = std::sqrt(sum / static_cast<double>(points.size()));
-    if (rms < best_rms) {
-      best_rms = rms;
-      *start = candidate;
-    }
+    rms[i] = std::sqrt(sum / static_cast<double>(points.size()));
+    if (best < 0 || rms[i] < rms[best]) best = i;
   }
-  return std::isfinite(best_rms);
+  if (best < 0) return false;
+  *start = candidates[best];
+  if (other_minima != nullptr) {
+    std::vector<int> minima;
+    for (int i = 0; i < kSteps; ++i) {
+      const bool below_left = i == 0 || rms[i] < rms[i - 1];
+      const bool below_right = i == kSteps - 1 || rms[i] <= rms[i + 1];
+      if (i != best && std::isfinite(rms[i]) && below_left && below_right) minima.push_back(i);
+    }
+    std::sort(minima.begin(), minima.end(), [&](int a, int b) { return rms[a] < rms[b]; });
+    for (const int i : minima) other_minima->push_back(candidates[i]);
+  }
+  return true;
 }
 
 }  // namespace internal

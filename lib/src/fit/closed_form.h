@@ -55,10 +55,13 @@ bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               StartCamera* start);
 
 // Focal length unknown, everything else given: SQPnP over a log-spaced sweep of focal lengths
-// (fields of view from 0.5 to 175 degrees across the image width), keeping the lowest RMS.
+// (fields of view from 0.5 to 175 degrees across the image width), keeping the lowest RMS. With
+// `other_minima`, also the sweep's other local minima of the RMS (best first): with few points
+// the RMS over the focal length can have several valleys, and LM stays in the one it starts in.
 bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& guess,
-                     double aspect, int image_width, StartCamera* start);
+                     double aspect, int image_width, StartCamera* start,
+                     std::vector<StartCamera>* other_minima = nullptr);
 
 }  // namespace internal
 }  // namespace camproj

@@ -86,7 +86,8 @@ StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& points,
 
 // The closed form for the scene: its camera (K as the closed form found it) and *method.
 StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
-                            Clock::time_point start_time, std::string* method) {
+                            Clock::time_point start_time, std::string* method,
+                            std::vector<StartCamera>* other_sweep_minima) {
   const std::vector<Eigen::Vector3d>& points = scene.points;
   const std::vector<Eigen::Vector2d>& pixels = scene.pixels;
   const Model& start_model = scene.model;
@@ -111,7 +112,8 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
                         start_model.free[1], &start)) {
       *method = "homography";
     } else if (focal_free && FocalSweepStart(points, pixels, guess, start_model.value[1],
-                                             scene.image_size.width, &start)) {
+                                             scene.image_size.width, &start,
+                                             other_sweep_minima)) {
       *method = "pnp-focal-sweep";
     } else {
       throw SceneError(SceneError::Reason::kDegenerate,
@@ -130,7 +132,7 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
              !start_model.free[4]) {
     const bool ok = start_model.free[0]
                         ? FocalSweepStart(points, pixels, guess, start_model.value[1],
-                                          scene.image_size.width, &start)
+                                          scene.image_size.width, &start, other_sweep_minima)
                         : PnpStart(points, pixels, guess, &start);
     if (!ok) {
       throw SceneError(SceneError::Reason::kDegenerate,
@@ -151,7 +153,8 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
 Start ClosedFormStart(const Scene& scene, const FitOptions& options,
                       Clock::time_point start_time) {
   Start start;
-  start.camera = SolveClosedForm(scene, options, start_time, &start.method);
+  start.camera =
+      SolveClosedForm(scene, options, start_time, &start.method, &start.other_sweep_minima);
   // Start values of the free slots from the closed form, fixed ones as given. DLT's K is
   // projected onto the model (square pixels: geometric mean of fx, fy).
   const Intrinsics& k0 = start.camera.intrinsics;

@@ -10,6 +10,7 @@
 #define CAMPROJ_SRC_FIT_START_H_
 
 #include <string>
+#include <vector>
 
 #include "camproj/fit.h"
 #include "fit/closed_form.h"
@@ -25,6 +26,8 @@ struct Start {
   StartCamera camera;
   std::string method;  // FitResult::start_method: "pnp", "homography", "pnp-focal-sweep", "dlt"
   Model model;         // the scene's model, its free slots from the closed form
+  // "pnp-focal-sweep" only: the sweep's other local minima, best first (FocalSweepStart).
+  std::vector<StartCamera> other_sweep_minima;
 };
 
 // Throws SceneError where no start exists: kDegenerate (no pose, focal length or camera found),
