@@ -62,17 +62,22 @@ class TraceCallback : public ceres::IterationCallback {
   std::vector<TraceEntry>* trace_;
 };
 
+// `other` replaces `*best` if it is a camera at a lower cost (by more than rounding).
+void KeepTheLower(LeastSquaresOutcome other, LeastSquaresOutcome* best) {
+  if (other.ok && (!best->ok || other.normal.cost < best->normal.cost * (1.0 - 1e-9))) {
+    *best = std::move(other);
+  }
+}
+
 // Refines from `model` (its free values the start) with an SQPnP pose for its pinhole part,
 // and makes it `*best` if it ends at a lower cost.
 void RefineAlsoFrom(const Scene& scene, const Model& model, const FitOptions& options,
                     Clock::time_point start_time, LeastSquaresOutcome* best) {
   StartCamera start;
   if (!PnpStart(scene.points, scene.pixels, model.ToIntrinsics(), &start)) return;
-  LeastSquaresOutcome other = RefineLeastSquares(scene.points, scene.pixels, start.rotation,
-                                                 start.center, model, options, start_time);
-  if (other.ok && (!best->ok || other.normal.cost < best->normal.cost * (1.0 - 1e-9))) {
-    *best = std::move(other);
-  }
+  KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, start.rotation, start.center, model,
+                                  options, start_time),
+               best);
 }
 
 // True unless `outcome` fits as well as `options.pixel_sigma` says it can: its sum of squares
@@ -113,12 +118,10 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
   // noise-free points fitted at fx 3292 px, RMS 0.19 px, for a true 1220 px; tests/fit_test.cc
   // NoiseFreeTest GluPerspective): refine also from each other valley's start.
   for (const StartCamera& other : start.other_sweep_minima) {
-    LeastSquaresOutcome outcome =
-        RefineLeastSquares(scene.points, scene.pixels, other.rotation, other.center,
-                           ProjectOntoModel(start.model, other.intrinsics), options, start_time);
-    if (outcome.ok && (!best.ok || outcome.normal.cost < best.normal.cost * (1.0 - 1e-9))) {
-      best = std::move(outcome);
-    }
+    KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, other.rotation, other.center,
+                                    ProjectOntoModel(start.model, other.intrinsics), options,
+                                    start_time),
+                 &best);
   }
   const bool distortion_free = scene.model.free[5] || scene.model.free[6];
   if (distortion_free && scene.model.free[2] && MayBeAboveTheMinimum(best, scene, options)) {
