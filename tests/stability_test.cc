@@ -64,20 +64,11 @@ constexpr double kUnitRoundoff = 0x1p-53;
 
 // --- Tolerances -----------------------------------------------------------------------------
 
-// Noise-free fits: |e_j| <= kFirstOrderMargin sigma_j(1 px) |r|_2. The bound is exact to first
-// order; the factor 2 covers the second-order terms (the Jacobian at the fit rather than at the
-// truth differs by O(e), i.e. ~1e-10 relative) and a Gauss-Newton polish that stops within its
-// own rounding floor, not at the exact fixed point.
-constexpr double kFirstOrderMargin = 2.0;
-// The fitter's rounding when it evaluates one residual, in unit roundoffs per term: centring and
-// scaling the world (2), X - C and the quaternion rotation (about 12 operations deep), the
-// perspective division (1), then fx x + skew y + cx (3); each step errs by at most one unit
-// roundoff of the magnitude it handles. About 18 in all; 32 leaves a margin of almost 2.
-constexpr double kEvalRoundings = 32.0;
-// Rounding of the returned camera itself, in unit roundoffs of each value: the eye is
-// centroid + scale * centre and goes through t = -R C and back (C = -R^T t: ~8 roundings), the
-// rotation through a quaternion and back (~8); 16 is twice that.
-constexpr double kOutputRoundings = 16.0;
+// Noise-free fits: |e_j| <= kFirstOrderMargin sigma_j(1 px) |r|_2 plus the returned value's own
+// rounding (truth_condition.h, with the rounding counts kEvalRoundings and kOutputRoundings).
+using testing::kEvalRoundings;
+using testing::kFirstOrderMargin;
+using testing::kOutputRoundings;
 
 // fit.h: a fit whose scaled Jacobian has a condition number above testing::kFitterConditionLimit
 // is refused as undetermined (SceneError kDegenerate). The suite computes the condition number at
@@ -382,10 +373,6 @@ FitOptions FocalOnly() {
 // rounding), as the reference for what the float64 pipelines compute.
 using Vector3l = Eigen::Matrix<long double, 3, 1>;
 
-Vector3l CamPointLong(const Truth& t, const Eigen::Vector3d& x) {
-  return t.rotation.cast<long double>() * (x.cast<long double>() - t.center.cast<long double>());
-}
-
 Eigen::Matrix<long double, 2, 1> PixelLong(const Intrinsics& k, const Vector3l& p) {
   const long double slots[7] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
   long double pixel[2];
@@ -393,32 +380,10 @@ Eigen::Matrix<long double, 2, 1> PixelLong(const Intrinsics& k, const Vector3l& 
   return {pixel[0], pixel[1]};
 }
 
-// |r|_2 of what perturbs a noise-free fit: the data's inconsistency with the true camera plus
-// the bound on the fitter's own evaluation rounding (kEvalRoundings).
+// |r|_2 of what perturbs a noise-free fit (truth_condition.h).
 double PerturbationNorm(const Scenario& s) {
-  const Truth& t = s.truth;
-  const Intrinsics& k = t.intrinsics;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& x : s.points) centroid += x;
-  centroid /= static_cast<double>(s.points.size());
-  long double data = 0.0L;
-  double eval = 0.0;
-  for (size_t i = 0; i < s.points.size(); ++i) {
-    const Vector3l p = CamPointLong(t, s.points[i]);
-    const Eigen::Matrix<long double, 2, 1> pixel = PixelLong(k, p);
-    data += (s.pixels[i].cast<long double>() - pixel).squaredNorm();
-    const double z = static_cast<double>(p.z());
-    const double x = static_cast<double>(p.x()) / z;
-    const double y = static_cast<double>(p.y()) / z;
-    const double per_term =
-        (k.fx + k.fy + std::abs(k.skew)) * (1.0 + std::abs(x) + std::abs(y)) *
-            ((s.points[i] - centroid).norm() + (t.center - centroid).norm()) / std::abs(z) +
-        std::abs(static_cast<double>(pixel.x())) + std::abs(static_cast<double>(pixel.y())) +
-        std::abs(k.cx) + std::abs(k.cy);
-    const double bound = kEvalRoundings * kUnitRoundoff * per_term;
-    eval += 2.0 * bound * bound;  // u and v
-  }
-  return static_cast<double>(std::sqrt(data)) + std::sqrt(eval);
+  return testing::PerturbationNorm(s.points, s.pixels, s.truth.rotation, s.truth.center,
+                                   s.truth.intrinsics);
 }
 
 // The condition number of the scaled Jacobian at the true camera (truth_condition.h).
@@ -452,17 +417,9 @@ Eigen::VectorXd EstimationError(const FitResult& fit, const Truth& truth) {
   return error;
 }
 
-// Rounding of the returned value of parameter j (kOutputRoundings).
+// Rounding of the returned value of parameter j (truth_condition.h).
 double OutputRounding(const FitResult& fit, const Truth& truth, int j, const Scenario& s) {
-  if (j < 3) return kOutputRoundings * kUnitRoundoff * kDegPerRad;
-  if (j < 6) {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const auto& x : s.points) centroid += x;
-    centroid /= static_cast<double>(s.points.size());
-    return kOutputRoundings * kUnitRoundoff *
-           (truth.center.cwiseAbs().maxCoeff() + centroid.cwiseAbs().maxCoeff());
-  }
-  return kOutputRoundings * kUnitRoundoff * std::abs(fit.sigmas[j].value);
+  return testing::OutputRounding(fit, truth.center, s.points, j);
 }
 
 // The errors users read: worst relative intrinsic error (principal point and skew relative to

@@ -1,6 +1,11 @@
-// The condition number of the fitter's scaled Jacobian at a true camera, computed independently
-// of the fitter's code: what decides whether a noise-free scene must be fitted (below the
-// fitter's limit) or refused as undetermined (above it).
+// What a true camera says about a noise-free fit, computed independently of the fitter's code:
+// the condition number of the fitter's scaled Jacobian there, which decides whether the scene
+// must be fitted (below the fitter's limit) or refused as undetermined (above it); and the
+// first-order bound on the fit's error. The fit's error in parameter j is
+// e_j = -[(J^T J)^-1 J^T r]_j, so |e_j| <= sigma_j(1 px) |r|_2 (Cauchy-Schwarz), sigma_j(1 px)
+// the fit's own sigma at a pixel sigma of 1 and r what perturbs the data: the pixels'
+// inconsistency with the true camera (in long double) plus a bound on the fitter's own rounding
+// when it evaluates residuals. This is "condition number x rounding" made per parameter.
 #ifndef CAMPROJ_TESTS_TRUTH_CONDITION_H_
 #define CAMPROJ_TESTS_TRUTH_CONDITION_H_
 
@@ -12,7 +17,9 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "camproj/camera.h"
 #include "camproj/fit.h"
+#include "camproj/pose.h"
 #include "camproj/intrinsics.h"
 
 namespace camproj {
@@ -22,6 +29,79 @@ namespace testing {
 // undetermined (SceneError kDegenerate; assess.cc: reciprocal condition of the Jacobi-scaled
 // normal equations below 1e-12).
 inline constexpr double kFitterConditionLimit = 1e6;
+
+// Unit roundoff of float64: every correctly rounded operation errs by at most this relative.
+inline constexpr double kUnitRoundoff = 0x1p-53;
+// |e_j| <= kFirstOrderMargin sigma_j(1 px) |r|_2: the bound is exact to first order; the factor
+// 2 covers the second-order terms (the Jacobian at the fit rather than at the truth differs by
+// O(e), i.e. ~1e-10 relative) and a Gauss-Newton polish that stops within its own rounding
+// floor, not at the exact fixed point.
+inline constexpr double kFirstOrderMargin = 2.0;
+// The fitter's rounding when it evaluates one residual, in unit roundoffs per term: centring and
+// scaling the world (2), X - C and the quaternion rotation (about 12 operations deep), the
+// perspective division (1), the distortion (3), then fx x + skew y + cx (3); each step errs by
+// at most one unit roundoff of the magnitude it handles. About 21 in all; 32 leaves a margin of
+// 1.5.
+inline constexpr double kEvalRoundings = 32.0;
+// Rounding of the returned camera itself, in unit roundoffs of each value: the eye is
+// centroid + scale * centre and goes through t = -R C and back (C = -R^T t: ~8 roundings), the
+// rotation through a quaternion and back (~8); 16 is twice that.
+inline constexpr double kOutputRoundings = 16.0;
+
+// |r|_2 of what perturbs a noise-free fit of `pixels`: their inconsistency with the true camera
+// (in long double) plus the bound on the fitter's own evaluation rounding (kEvalRoundings): per
+// term, the magnitudes it handles, (fx + fy + |skew|) (1 + |x| + |y|) d'(r) (|X - c| + |C - c|) / z
+// + |u| + |v| + |cx| + |cy| with c the points' centroid and d'(r) = 1 + 3 |k1| r^2 + 5 |k2| r^4
+// the radial map's slope bound.
+inline double PerturbationNorm(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<Eigen::Vector2d>& pixels,
+                               const Eigen::Matrix3d& true_rotation,
+                               const Eigen::Vector3d& true_center, const Intrinsics& k) {
+  using Vector3l = Eigen::Matrix<long double, 3, 1>;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& x : points) centroid += x;
+  centroid /= static_cast<double>(points.size());
+  const long double slots[7] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+  long double data = 0.0L;
+  double eval = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vector3l p = true_rotation.cast<long double>() *
+                       (points[i].cast<long double>() - true_center.cast<long double>());
+    long double pixel[2];
+    PixelFromNormalized<long double>(slots, p.x() / p.z(), p.y() / p.z(), pixel);
+    data += (pixels[i].cast<long double>() - Eigen::Matrix<long double, 2, 1>(pixel[0], pixel[1]))
+                .squaredNorm();
+    const double z = static_cast<double>(p.z());
+    const double x = static_cast<double>(p.x()) / z;
+    const double y = static_cast<double>(p.y()) / z;
+    const double r2 = x * x + y * y;
+    const double slope = 1.0 + 3.0 * std::abs(k.k1) * r2 + 5.0 * std::abs(k.k2) * r2 * r2;
+    const double per_term =
+        (k.fx + k.fy + std::abs(k.skew)) * (1.0 + std::abs(x) + std::abs(y)) * slope *
+            ((points[i] - centroid).norm() + (true_center - centroid).norm()) / std::abs(z) +
+        std::abs(static_cast<double>(pixel[0])) + std::abs(static_cast<double>(pixel[1])) +
+        std::abs(k.cx) + std::abs(k.cy);
+    const double bound = kEvalRoundings * kUnitRoundoff * per_term;
+    eval += 2.0 * bound * bound;  // u and v
+  }
+  return static_cast<double>(std::sqrt(data)) + std::sqrt(eval);
+}
+
+// Rounding of the returned value of the fit's parameter j (fit.h's order: rotation in degrees,
+// eye in world units, then the free intrinsics), kOutputRoundings unit roundoffs of it.
+inline double OutputRounding(const FitResult& fit, const Eigen::Vector3d& true_center,
+                             const std::vector<Eigen::Vector3d>& points, int j) {
+  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  if (j < 3) return kOutputRoundings * kUnitRoundoff * kDegPerRad;
+  if (j < 6) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& x : points) centroid += x;
+    centroid /= static_cast<double>(points.size());
+    return kOutputRoundings * kUnitRoundoff *
+           (true_center.cwiseAbs().maxCoeff() + centroid.cwiseAbs().maxCoeff());
+  }
+  return kOutputRoundings * kUnitRoundoff * std::abs(fit.sigmas[j].value);
+}
 
 // The condition number of the scaled Jacobian at the true camera (rotation of cam_from_world,
 // centre in world, intrinsics) in the fitter's parameterization (fit.h, src/fit/): pose in the
