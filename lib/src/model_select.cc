@@ -116,6 +116,15 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
 // the determination check, which refuses when it fits about as well (criterion within
 // kEqualFitCriterion, or lower) and puts the scene elsewhere. Nothing for an orthographic camera:
 // its depth reversal has the same pixels everywhere.
+// The selection's criterion of another reading of the `num_points` kept points: its sum of
+// squares at the selection's noise plus the penalty for `model`'s parameters.
+double CriterionOf(const internal::Selection& selection, const FitOptions& model, double rms_px,
+                   size_t num_points) {
+  return static_cast<double>(num_points) * rms_px * rms_px /
+             (selection.sigma_px * selection.sigma_px) +
+         selection.penalty * internal::NumParameters(model);
+}
+
 std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, double rms_px,
                                           const std::vector<Eigen::Vector3d>& kept_points,
                                           const std::vector<Eigen::Vector2d>& kept_pixels,
@@ -128,11 +137,9 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
   constexpr size_t kMirrorScreenMaxPoints = 8;
   if (selection.options.projection != Projection::kPerspective) return std::nullopt;
   const double n = static_cast<double>(kept_points.size());
-  const double sigma2 = selection.sigma_px * selection.sigma_px;
   std::optional<internal::Rival> rival;
   auto consider = [&](const Camera& camera, const FitOptions& model, double mirrored_rms_px) {
-    const double criterion = n * mirrored_rms_px * mirrored_rms_px / sigma2 +
-                             selection.penalty * internal::NumParameters(model);
+    const double criterion = CriterionOf(selection, model, mirrored_rms_px, kept_points.size());
     if (rival && !(criterion < rival->criterion)) return;
     rival = internal::Rival{internal::kMirroredReadingName, model, camera, criterion,
                             /*mirrored_world=*/true};
@@ -186,14 +193,12 @@ std::vector<internal::Rival> OtherMinima(const internal::Selection& selection,
       !selection.options.principal_point.IsFree()) {
     return rivals;
   }
-  const double n = static_cast<double>(kept_points.size());
-  const double sigma2 = selection.sigma_px * selection.sigma_px;
   for (const internal::Reading& reading :
        internal::FitFromEdgePrincipalPoints(kept_points, kept_pixels, size, selection.options,
                                             selection.fit.camera.intrinsics)) {
     internal::Rival rival{internal::kOtherMinimumName, selection.options, reading.camera,
-                          n * reading.rms_px * reading.rms_px / sigma2 +
-                              selection.penalty * internal::NumParameters(selection.options)};
+                          CriterionOf(selection, selection.options, reading.rms_px,
+                                      kept_points.size())};
     rival.same_model = true;
     rivals.push_back(rival);
   }

@@ -34,6 +34,18 @@ inline Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points) {
   return centroid / static_cast<double>(points.size());
 }
 
+// The midpoints of the image's four edges (left, right, top, bottom) moved outward by `beyond`
+// image sizes, in kCenter px: the principal points the refinement restarts from where the closed
+// form's says little (fit/refine.cc, fit/other_minima.cc).
+inline std::vector<Eigen::Vector2d> EdgeMidpoints(const ImageSize& size, double beyond) {
+  const double w = size.width;
+  const double h = size.height;
+  const double cx = 0.5 * (w - 1.0);  // the image centre
+  const double cy = 0.5 * (h - 1.0);
+  return {{-beyond * w - 0.5, cy}, {(1.0 + beyond) * w - 0.5, cy},
+          {cx, -beyond * h - 0.5}, {cx, (1.0 + beyond) * h - 0.5}};
+}
+
 // The points with the world's z negated: the same scene seen through a mirror.
 inline std::vector<Eigen::Vector3d> MirroredZ(std::vector<Eigen::Vector3d> points) {
   for (Eigen::Vector3d& x : points) x.z() = -x.z();

@@ -1,6 +1,7 @@
 #include "fit/other_minima.h"
 
 #include "fit/closed_form.h"
+#include "fit/common.h"
 #include "fit/scene.h"
 
 namespace camproj {
@@ -18,14 +19,9 @@ std::vector<Reading> FitFromEdgePrincipalPoints(const std::vector<Eigen::Vector3
   std::vector<Reading> readings;
   try {
     const Scene scene = ValidateScene(points_in_world, observed_pixels, image_size, options);
-    const double w = image_size.width;
-    const double h = image_size.height;
-    const double cx = 0.5 * (w - 1.0);  // the image centre, kCenter px
-    const double cy = 0.5 * (h - 1.0);
-    const Eigen::Vector2d edge_midpoints[] = {{-0.5, cy}, {w - 0.5, cy}, {cx, -0.5}, {cx, h - 0.5}};
     Camera like;
     like.image_size = image_size;
-    for (const Eigen::Vector2d& principal_point : edge_midpoints) {
+    for (const Eigen::Vector2d& principal_point : EdgeMidpoints(image_size, 0.0)) {
       Intrinsics k = intrinsics;
       k.cx = principal_point.x();
       k.cy = principal_point.y();

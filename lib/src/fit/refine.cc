@@ -12,6 +12,7 @@
 
 #include "check.h"
 #include "fit/closed_form.h"
+#include "fit/common.h"
 #include "fit/least_squares.h"
 #include "fit/reprojection_error.h"
 #include "fit/statistics.h"
@@ -133,16 +134,8 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
     // of the image beyond each edge's midpoint, without distortion: one of them is on the
     // right side.
     constexpr double kBeyondEdge = 0.25;
-    const double w = scene.image_size.width;
-    const double h = scene.image_size.height;
-    const double cx = scene.model.value[2];  // the image centre (kCenter)
-    const double cy = scene.model.value[3];
-    const Eigen::Vector2d beyond[] = {{-kBeyondEdge * w - 0.5, cy},
-                                      {(1.0 + kBeyondEdge) * w - 0.5, cy},
-                                      {cx, -kBeyondEdge * h - 0.5},
-                                      {cx, (1.0 + kBeyondEdge) * h - 0.5}};
     const Model from = best.ok ? best.model : start.model;
-    for (const Eigen::Vector2d& principal_point : beyond) {
+    for (const Eigen::Vector2d& principal_point : EdgeMidpoints(scene.image_size, kBeyondEdge)) {
       Model model = from;
       model.value[2] = principal_point.x();
       model.value[3] = principal_point.y();
