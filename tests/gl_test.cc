@@ -21,24 +21,15 @@ namespace {
 using testing::kExactRelative;
 
 // The CV path K [R|t] and the GL path P V X -> divide -> viewport -> pixel are different
-// algebra on the same numbers, each erring by rounding of the magnitudes it handles (the
-// derivation of stability_test.cc's GL cases): cam coordinates err by ~kGlRoundings unit
-// roundoffs of |X|_1 + |t|_1, which moves a perspective pixel by
-// (fx + fy + |skew| + |u - cx| + |v - cy|) / z per unit (an orthographic one by fx + fy + |skew|),
-// and the projection itself by ~kGlRoundings unit roundoffs of the magnitudes it adds up. The two
-// paths differ by at most twice that. (A fixed 1e-9 px failed at 5 of 100 seed offsets: a
-// principal point 2000 px off the image, orthographic scales of 1e4 px per unit.)
-constexpr double kGlRoundings = 32.0;
-
-// Twice the rounding bound of a pixel computed from `point_in_world` (above); `sensitivity` is
-// the pixel's change per unit of cam coordinates.
+// algebra on the same numbers, each erring by rounding of the magnitudes it handles
+// (testing::PixelRoundingBound); the two differ by at most twice that. (A fixed 1e-9 px failed at
+// 5 of 100 seed offsets: a principal point 2000 px off the image, orthographic scales of 1e4 px
+// per unit.)
 double PixelAgreement(const Intrinsics& k, const ImageSize& size, const Rigid3& cam_from_world,
                       const Eigen::Vector3d& point_in_world, const Eigen::Vector2d& pixel,
                       double sensitivity) {
-  const double cam_rounding = point_in_world.lpNorm<1>() + cam_from_world.translation.lpNorm<1>();
-  return 2.0 * kGlRoundings * 0x1p-53 *
-         (sensitivity * cam_rounding + std::abs(pixel.x()) + std::abs(pixel.y()) +
-          std::abs(k.cx) + std::abs(k.cy) + size.width + size.height);
+  return 2.0 * testing::PixelRoundingBound(k, size, cam_from_world, point_in_world, pixel,
+                                           sensitivity);
 }
 
 const GlDepth kAllDepths[] = {

@@ -59,8 +59,8 @@ using Reason = SceneError::Reason;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegPerRad = 180.0 / kPi;
 
-// Unit roundoff of float64: every correctly rounded operation errs by at most this relative.
-constexpr double kUnitRoundoff = 0x1p-53;
+// Unit roundoff of float64 (truth_condition.h).
+using testing::kUnitRoundoff;
 
 // --- Tolerances -----------------------------------------------------------------------------
 
@@ -98,10 +98,9 @@ constexpr double kLinearRegimeCondition = 1e3;
 // inlier with 0.5 px noise is outside 4 px with probability exp(-4^2 / (2 0.5^2)) = exp(-32).
 constexpr double kFarOutlierPx = 20.0;
 
-// GL export, in unit roundoffs per term: world -> gl_eye (a 4-term dot product: 4), clip (4),
-// the divide (1), viewport and pixel origin (3), and the entries of the matrices themselves (3),
-// about 15; 32 leaves a margin of 2. Applied to the magnitudes each stage handles (RunGl).
-constexpr double kGlRoundings = 32.0;
+// GL export: testing::kGlRoundings unit roundoffs per term (test_scenes.h), applied to the
+// magnitudes each stage handles (RunGl).
+using testing::kGlRoundings;
 
 // Look-at: the roll comes from up x w, whose relative error is (rounding of up and of the gaze
 // direction) / sin(angle(up, gaze)). Rounding of up: 1 unit roundoff; of the gaze
@@ -928,20 +927,16 @@ Row RunGl(const Case& c, const GlDepth& depth, double z_far) {
                             cv.has_value() && cv->allFinite();
         EXPECT_TRUE(finite) << "depth " << depths[d];
         if (!finite) continue;
-        // Rounding propagated to pixels: cam coordinates err by ~kGlRoundings u (|X|_1 + |t|_1),
-        // which moves the pixel by (fx + fy + |skew| + |u - cx| + |v - cy|) / z per unit; the
-        // projection itself errs by ~kGlRoundings u of the magnitudes it adds up.
+        // Rounding propagated to pixels (testing::PixelRoundingBound).
         const double z = static_cast<double>(p.z());
         const double u = static_cast<double>(exact.x());
         const double v = static_cast<double>(exact.y());
         const double world_to_cam =
             (x.lpNorm<1>() + camera.cam_from_world.translation.lpNorm<1>()) / z;
-        const double pixel_tolerance =
-            kGlRoundings * kUnitRoundoff *
-            ((k.fx + k.fy + std::abs(k.skew) + std::abs(u - k.cx) + std::abs(v - k.cy)) *
-                 world_to_cam +
-             std::abs(u) + std::abs(v) + std::abs(k.cx) + std::abs(k.cy) + w + h);
         const Eigen::Vector2d exact_pixel(u, v);
+        const double pixel_tolerance = testing::PixelRoundingBound(
+            k, camera.image_size, camera.cam_from_world, x, exact_pixel,
+            (k.fx + k.fy + std::abs(k.skew) + std::abs(u - k.cx) + std::abs(v - k.cy)) / z);
         const double gl_error = (gl.pixel - exact_pixel).norm();
         const double cv_error = (*cv - exact_pixel).norm();
         EXPECT_LE(gl_error, pixel_tolerance) << "GL pixel at depth " << depths[d];

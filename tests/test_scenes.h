@@ -21,6 +21,27 @@ namespace testing {
 // Exact algebra in double: a few dozen roundings of unit-sized quantities.
 inline constexpr double kExactRelative = 1e-12;
 
+// GL export, in unit roundoffs per term: world -> gl_eye (a 4-term dot product: 4), clip (4),
+// the divide (1), viewport and pixel origin (3), and the entries of the matrices themselves (3),
+// about 15; 32 leaves a margin of 2. Applied to the magnitudes each stage handles.
+inline constexpr double kGlRoundings = 32.0;
+
+// The rounding bound of a pixel that a camera's path computes from `point_in_world` (the pinhole
+// path K [R|t] or GL's P V X -> divide -> viewport): the cam coordinates err by ~kGlRoundings unit
+// roundoffs of |X|_1 + |t|_1, which move the pixel by `sensitivity` per unit of them
+// ((fx + fy + |skew| + |u - cx| + |v - cy|) / z for a perspective camera, fx + fy + |skew| for an
+// orthographic one), and the projection itself errs by ~kGlRoundings unit roundoffs of the
+// magnitudes it adds up (the pixel, the principal point, the viewport).
+inline double PixelRoundingBound(const Intrinsics& k, const ImageSize& size,
+                                 const Rigid3& cam_from_world,
+                                 const Eigen::Vector3d& point_in_world,
+                                 const Eigen::Vector2d& pixel, double sensitivity) {
+  const double cam_rounding = point_in_world.lpNorm<1>() + cam_from_world.translation.lpNorm<1>();
+  return kGlRoundings * 0x1p-53 *
+         (sensitivity * cam_rounding + std::abs(pixel.x()) + std::abs(pixel.y()) +
+          std::abs(k.cx) + std::abs(k.cy) + size.width + size.height);
+}
+
 inline double Uniform(std::mt19937_64& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
