@@ -12,10 +12,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <gtest/gtest.h>
 
 #include "camproj/camera.h"
 #include "camproj/fit.h"
@@ -101,6 +103,86 @@ inline double OutputRounding(const FitResult& fit, const Eigen::Vector3d& true_c
            (true_center.cwiseAbs().maxCoeff() + centroid.cwiseAbs().maxCoeff());
   }
   return kOutputRoundings * kUnitRoundoff * std::abs(fit.sigmas[j].value);
+}
+
+// The fit's error in its own parameterization (fit.h: rotation as omega with
+// R = exp(omega) R_fit, degrees; eye in world units; free intrinsics in px), in the order of
+// fit.free_parameters.
+inline Eigen::VectorXd EstimationError(const FitResult& fit, const Eigen::Matrix3d& true_rotation,
+                                       const Eigen::Vector3d& true_center, const Intrinsics& t) {
+  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  const int p = static_cast<int>(fit.free_parameters.size());
+  Eigen::VectorXd error(p);
+  const Eigen::AngleAxisd omega_true(true_rotation *
+                                     fit.camera.cam_from_world.rotation.transpose());
+  error.head<3>() = -omega_true.angle() * omega_true.axis() * kDegPerRad;
+  error.segment<3>(3) = CameraCenterInWorld(fit.camera.cam_from_world) - true_center;
+  const Intrinsics& k = fit.camera.intrinsics;
+  for (int j = 6; j < p; ++j) {
+    const std::string& name = fit.free_parameters[j];
+    if (name == "fx") error(j) = k.fx - t.fx;
+    if (name == "fy") error(j) = k.fy - t.fy;
+    if (name == "cx") error(j) = k.cx - t.cx;
+    if (name == "cy") error(j) = k.cy - t.cy;
+    if (name == "skew") error(j) = k.skew - t.skew;
+    if (name == "k1") error(j) = k.k1 - t.k1;
+    if (name == "k2") error(j) = k.k2 - t.k2;
+  }
+  return error;
+}
+
+// A noise-free fit of `points` / `pixels` (fitted with pixel_sigma = 1, so that its covariance
+// is (J^T J)^-1) against the true camera: every free parameter within
+// kFirstOrderMargin sigma_j(1 px) |r|_2 plus its output rounding, every intrinsic the fit did not
+// estimate at the truth's value (as given) to kOutputRoundings unit roundoffs. EXPECTs each;
+// returns the worst |e_j| / bound.
+inline double ExpectWithinFirstOrderBound(const FitResult& fit,
+                                          const std::vector<Eigen::Vector3d>& points,
+                                          const std::vector<Eigen::Vector2d>& pixels,
+                                          const Eigen::Matrix3d& true_rotation,
+                                          const Eigen::Vector3d& true_center,
+                                          const Intrinsics& t, const std::string& label) {
+  EXPECT_TRUE(fit.covariance_available) << label;
+  if (!fit.covariance_available) return std::numeric_limits<double>::infinity();
+  const Eigen::VectorXd e = EstimationError(fit, true_rotation, true_center, t);
+  const double r = PerturbationNorm(points, pixels, true_rotation, true_center, t);
+  double worst = 0.0;
+  for (int j = 0; j < static_cast<int>(e.size()); ++j) {
+    const double bound = kFirstOrderMargin * std::sqrt(fit.covariance(j, j)) * r +
+                         OutputRounding(fit, true_center, points, j);
+    EXPECT_LE(std::abs(e(j)), bound)
+        << label << ": " << fit.free_parameters[j] << " (|r|_2 = " << r << ")";
+    worst = std::max(worst, std::abs(e(j)) / bound);
+  }
+  // With the aspect not free, fy = aspect fx follows fx: check the aspect instead.
+  const Intrinsics& k = fit.camera.intrinsics;
+  auto is_free = [&](const char* name) {
+    return std::find(fit.free_parameters.begin(), fit.free_parameters.end(), name) !=
+           fit.free_parameters.end();
+  };
+  const double given = kOutputRoundings * kUnitRoundoff;
+  if (!is_free("fx")) {
+    EXPECT_NEAR(k.fx, t.fx, given * t.fx) << label << ": fx (not free)";
+  }
+  if (!is_free("fy")) {
+    EXPECT_NEAR(k.fy / k.fx, t.fy / t.fx, given * t.fy / t.fx) << label << ": aspect (not free)";
+  }
+  if (!is_free("cx")) {
+    EXPECT_NEAR(k.cx, t.cx, given * (std::abs(t.cx) + t.fx)) << label << ": cx (not free)";
+  }
+  if (!is_free("cy")) {
+    EXPECT_NEAR(k.cy, t.cy, given * (std::abs(t.cy) + t.fy)) << label << ": cy (not free)";
+  }
+  if (!is_free("skew")) {
+    EXPECT_NEAR(k.skew, t.skew, given * t.fx) << label << ": skew (not free)";
+  }
+  if (!is_free("k1")) {
+    EXPECT_NEAR(k.k1, t.k1, given) << label << ": k1 (not free)";
+  }
+  if (!is_free("k2")) {
+    EXPECT_NEAR(k.k2, t.k2, given) << label << ": k2 (not free)";
+  }
+  return worst;
 }
 
 // The condition number of the scaled Jacobian at the true camera (rotation of cam_from_world,

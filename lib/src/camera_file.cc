@@ -351,6 +351,12 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["pixel_sigma_estimated"] = fit->pixel_sigma_estimated;
     record["iterations"] = fit->iterations;
     record["jacobian_condition"] = fit->jacobian_condition;
+    if (fit->linearity.checked) {
+      const LinearityCheck& l = fit->linearity;
+      record["linearity"] = {{"linear", l.linear}, {"level", l.level},
+                             {"worst_deviation", l.worst_deviation}, {"bound", l.bound},
+                             {"worst_direction", l.worst_direction}};
+    }
     record["time_ms"] = fit->time_ms;
     document["fit"] = record;
   }

@@ -8,6 +8,7 @@
 
 #include "check.h"
 #include "fit/assess.h"
+#include "fit/candidate.h"
 #include "fit/common.h"
 #include "fit/orthographic_fit.h"
 #include "fit/ransac.h"
@@ -70,11 +71,14 @@ void FitOptions::Check() const {
           "strong correlation threshold must be in (0, 1], got ", strong_correlation);
 }
 
+namespace {
+
 // The stages in lib/src/fit/, in the order the data flows: scene -> (RANSAC: the consensus, fitted
-// without RANSAC) -> closed-form start -> refinement -> assessment.
-FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
-                    const std::vector<Eigen::Vector2d>& observed_pixels,
-                    const ImageSize& image_size, const FitOptions& options) {
+// without RANSAC) -> closed-form start -> refinement -> assessment. `effort` says what the fit may
+// leave out (fit/candidate.h).
+FitResult Fit(const std::vector<Eigen::Vector3d>& points_in_world,
+              const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
+              const FitOptions& options, const internal::FitEffort& effort) {
   const internal::Clock::time_point start_time = internal::Clock::now();
   options.Check();
   image_size.Check();
@@ -96,7 +100,7 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
       inlier_points.push_back(points_in_world[i]);
       inlier_pixels.push_back(observed_pixels[i]);
     }
-    FitResult result = FitCamera(inlier_points, inlier_pixels, image_size, inner);
+    FitResult result = Fit(inlier_points, inlier_pixels, image_size, inner, effort);
     result.residuals_px = internal::ResidualsAgainst(result.camera, points_in_world,
                                                      observed_pixels, options.pixel_origin);
     for (int i = 0; i < scene.NumPoints(); ++i) {
@@ -110,10 +114,35 @@ FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
   }
 
   const internal::Start start = internal::ClosedFormStart(scene, options, start_time);
-  internal::RefinedCamera refined = internal::RefineCamera(scene, start, options, start_time);
-  FitResult result = internal::AssessFit(scene, start.method, std::move(refined), options);
+  internal::RefinedCamera refined =
+      internal::RefineCamera(scene, start, options, effort, start_time);
+  FitResult result = internal::AssessFit(scene, start.method, std::move(refined), options, effort);
   result.time_ms = internal::MicrosecondsSince(start_time) / 1000.0;
   return result;
 }
+
+}  // namespace
+
+FitResult FitCamera(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options) {
+  return Fit(points_in_world, observed_pixels, image_size, options, internal::FitEffort{});
+}
+
+namespace internal {
+
+FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
+                       const std::vector<Eigen::Vector2d>& observed_pixels,
+                       const ImageSize& image_size, const FitOptions& options,
+                       double consistent_at_px) {
+  Require(std::isfinite(consistent_at_px) && consistent_at_px > 0.0,
+          "a candidate's noise must be positive (px), got ", consistent_at_px);
+  FitEffort effort;
+  effort.skip_restarts_when_consistent_at_px = consistent_at_px;
+  effort.check_linearity = false;
+  return Fit(points_in_world, observed_pixels, image_size, options, effort);
+}
+
+}  // namespace internal
 
 }  // namespace camproj

@@ -59,8 +59,23 @@ FitRecord FitRecordOf(const FitResult& fit) {
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
   record.jacobian_condition = fit.jacobian_condition;
+  record.linearity = fit.linearity;
   record.time_ms = fit.time_ms;
   return record;
+}
+
+std::string LinearityText(const LinearityCheck& check) {
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers,
+                "the sum of squares at the edge of the %g %% region departs from the quadratic "
+                "model by %.3g of its rise (bound %.3g), along ",
+                100.0 * check.level, check.worst_deviation, check.bound);
+  const std::string measured = numbers + check.worst_direction;
+  return check.linear
+             ? "the sigmas hold (" + measured + ")"
+             : "the model is curved within the noise's reach: the sigmas and the covariance "
+               "understate or misdescribe the error (" + measured + "); add points, spread them "
+               "in depth, or fix intrinsics";
 }
 
 std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {
@@ -179,6 +194,7 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   }
   if (fit.consistency.checked) out << "check: " << fit.consistency.summary << "\n";
   if (fit.determination.checked) out << "determination: " << fit.determination.summary << "\n";
+  if (fit.linearity.checked) out << "linearity: " << LinearityText(fit.linearity) << "\n";
   out << "worst points:";
   for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {
     const int index = order[i];

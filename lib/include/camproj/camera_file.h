@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "camproj/camera.h"
+#include "camproj/fit.h"  // LinearityCheck
 #include "camproj/conventions.h"
 #include "camproj/gl.h"
 
@@ -58,6 +59,7 @@ struct FitRecord {
   bool pixel_sigma_estimated = true;   // from the residuals (else given)
   int iterations = 0;
   double jacobian_condition = 0.0;     // of the column-scaled Jacobian at the solution
+  LinearityCheck linearity;            // written when checked (fit.h)
   double time_ms = 0.0;
 };
 

@@ -234,6 +234,34 @@ struct DeterminationCheck {
   std::string summary;        // one line in words
 };
 
+// Whether the covariance's linearization holds where it is read (docs/stability.md): the sum of
+// squares along each principal direction of the covariance, both ways, at the edge of the
+// kLinearityLevel confidence region (where the quadratic model puts it up by
+// sigma^2 chi^2_p(kLinearityLevel)), against what the quadratic model predicts there. A curved
+// valley of near-equivalent cameras (narrow fields of view, near-planar scenes, large noise)
+// shows as a rise far above the prediction: the straight line leaves the valley's curved floor.
+// Where it departs by more than kMaxLinearityDeviation, the sigmas and the covariance are not a
+// trustworthy Gaussian description of the error.
+struct LinearityCheck {
+  bool checked = false;  // false: no covariance, or a candidate of FitCameraAuto's selection
+  double level = 0.0;    // of the confidence region probed (kLinearityLevel)
+  // max over directions and signs of |actual - predicted| / predicted rise of the sum of
+  // squares: 0 for an exactly linear model; infinite where a point crosses behind the camera.
+  double worst_deviation = 0.0;
+  std::string worst_direction;  // the parameter that moves most (in its sigmas) along that direction
+  double bound = 0.0;           // kMaxLinearityDeviation
+  bool linear = false;          // worst_deviation <= bound
+};
+
+// The confidence level whose region the linearity check probes, and the largest deviation that
+// still counts as linear. With the valley's floor a parabola in the error, a deviation d at the
+// region's edge (radius c in sigmas) means the floor sits sqrt(d) r^2 / c sigmas off the straight
+// line at radius r, so the linearized NEES of an error on the floor within the region is at most
+// (1 + d) times its true chi-square: with d <= 1 the sigmas hold to a factor sqrt(2) out to the
+// 99.99 % region.
+inline constexpr double kLinearityLevel = 0.9999;
+inline constexpr double kMaxLinearityDeviation = 1.0;
+
 struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
@@ -289,6 +317,7 @@ struct FitResult {
   Eigen::MatrixXd covariance;
   std::vector<ParameterSigma> sigmas;
   std::vector<Correlation> strong_correlations;
+  LinearityCheck linearity;
 };
 
 // Fits a camera to points_in_world[i] observed at observed_pixels[i] (in options.pixel_origin).

@@ -13,9 +13,14 @@ namespace camproj {
 
 FitRecord FitRecordOf(const FitResult& fit);
 
+// FitResult::linearity in words: "the sigmas hold (...)" or what the curvature means and what to
+// do about it.
+std::string LinearityText(const LinearityCheck& check);
+
 // A few lines: the model (free and fixed parameters and why), each parameter +- sigma in its
-// unit, fovy in degrees, eye and look-at, RMS / median / max residual, the `worst` largest
-// residuals by id (ids[i] names point i; numbers from 1 when empty), and the fit time.
+// unit, fovy in degrees, eye and look-at, RMS / median / max residual, the linearity check, the
+// `worst` largest residuals by id (ids[i] names point i; numbers from 1 when empty), and the fit
+// time.
 std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids,
                            int worst = 5);
 

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/QR>
 
 #include "camproj/camera.h"
 #include "camproj/pose.h"
@@ -135,10 +138,141 @@ void SetCovariance(const JacobiScaledNormal<ParamMatrix>& scaled_normal,
       StrongCorrelations(result->covariance, names, options.strong_correlation);
 }
 
+// The camera at `u` (ComputeNormalEquations' parameters: omega with R = exp(omega) rotation,
+// center, the free slots in slot order) from (rotation, center, model).
+struct MovedCamera {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d center;
+  Model model;
+};
+
+MovedCamera MoveCamera(const RefinedCamera& at, const ParamVector& u) {
+  const Eigen::Vector3d omega = u.head<3>();
+  const double angle = omega.norm();
+  MovedCamera moved{angle > 0.0 ? Eigen::Matrix3d(Eigen::AngleAxisd(angle, omega / angle) *
+                                                  at.rotation)
+                                : at.rotation,
+                    at.center + u.segment<3>(3), at.model};
+  int index = 6;
+  for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+    if (moved.model.free[slot]) moved.model.value[slot] += u(index++);
+  }
+  return moved;
+}
+
+// Sum of squared residuals of the scene at `u` from `at`; infinite when a point is not in front.
+double SumOfSquaresAt(const Scene& scene, const RefinedCamera& at, const ParamVector& u) {
+  const MovedCamera moved = MoveCamera(at, u);
+  double sum = 0.0;
+  for (int i = 0; i < scene.NumPoints(); ++i) {
+    const std::optional<Eigen::Vector2d> pixel =
+        PixelOfCamPoint(moved.model, moved.rotation * (scene.points[i] - moved.center));
+    if (!pixel) return std::numeric_limits<double>::infinity();
+    sum += (*pixel - scene.pixels[i]).squaredNorm();
+  }
+  return sum;
+}
+
+// The profile of the sum of squares at `u`: its minimum over the hyperplane through u orthogonal
+// to `normal` (kProfileSteps Gauss-Newton steps, each kept only if it lowers the sum; the steps'
+// rotation part, in the chart at the moved camera, is added to u's: first order, and only
+// accepted where it helps). Starts from `at_u`, the sum at u.
+double ProfileAt(const Scene& scene, const RefinedCamera& at, ParamVector u, double at_u,
+                 const ParamVector& normal) {
+  constexpr int kProfileSteps = 4;
+  const int p = static_cast<int>(u.size());
+  // An orthonormal basis of the hyperplane: the last p - 1 columns of the Householder Q of the
+  // normal.
+  const ParamMatrix q = Eigen::HouseholderQR<ParamMatrix>(ParamMatrix(normal)).householderQ();
+  const ParamMatrix basis = q.rightCols(p - 1);
+  double best = at_u;
+  for (int step = 0; step < kProfileSteps && std::isfinite(best); ++step) {
+    const MovedCamera moved = MoveCamera(at, u);
+    NormalEquations normal_equations;
+    if (!ComputeNormalEquations(scene.points, scene.pixels, moved.rotation, moved.center,
+                                moved.model, &normal_equations)) {
+      break;
+    }
+    const ParamMatrix reduced = basis.transpose() * normal_equations.jtj * basis;
+    const ParamVector zeta = reduced.ldlt().solve(-(basis.transpose() * normal_equations.jtr));
+    const ParamVector candidate = u + basis * zeta;
+    const double sum = SumOfSquaresAt(scene, at, candidate);
+    if (!(sum < best)) break;
+    best = sum;
+    u = candidate;
+  }
+  return best;
+}
+
+// FitResult::linearity. Along each eigenvector w of the Jacobi-scaled J^T J (eigenvalue mu),
+// the step delta = c sigma D w / sqrt(mu) (D the scaling) reaches the quadratic model's
+// kLinearityLevel region, delta^T J^T J delta = c^2 sigma^2 with c^2 = chi^2_p(level): there the
+// model predicts the sum of squares up by P = c^2 sigma^2 (+- 2 delta^T J^T r). The straight line
+// gives L; where L departs from P by more than kProfileTrigger, the profile across the line
+// (re-minimized over the hyperplane J^T J-orthogonal to delta) gives F <= L. The true region's
+// edge along the valley is then at radius c sqrt(P / F) (the profile quadratic), where the
+// floor sits (L - F) / sigma^2 off the line: the linearized NEES of an error there is
+// (P / F) (1 + (L - F) / P) = (P + L - F) / F times its true chi-square. The deviation reported
+// is that factor minus 1 (0 for a linear model; negative where the walls are steeper than the
+// quadratic model, i.e. the sigmas overstate the error).
+LinearityCheck CheckLinearity(const Scene& scene, const RefinedCamera& refined,
+                              const JacobiScaledNormal<ParamMatrix>& scaled_normal,
+                              const std::vector<std::string>& names, double pixel_sigma) {
+  // Below this relative departure of the straight line from the prediction, the profile (a few
+  // Gauss-Newton solves) is not computed: F = L.
+  constexpr double kProfileTrigger = 0.1;
+  LinearityCheck check;
+  check.checked = true;
+  check.level = kLinearityLevel;
+  check.bound = kMaxLinearityDeviation;
+  check.worst_deviation = -std::numeric_limits<double>::infinity();
+  const int p = static_cast<int>(names.size());
+  const double c2 = ChiSquareQuantile(p, kLinearityLevel);
+  const double cost = refined.normal.cost;
+  const ParamMatrix covariance = scaled_normal.Inverse();
+  for (int d = 0; d < p; ++d) {
+    const double mu = scaled_normal.eigen.eigenvalues()(d);
+    const ParamVector w = scaled_normal.eigen.eigenvectors().col(d);
+    const ParamVector delta =
+        (std::sqrt(c2) * pixel_sigma / std::sqrt(mu)) * scaled_normal.column_scale.cwiseProduct(w);
+    const double slope = 2.0 * delta.dot(refined.normal.jtr);
+    for (const double sign : {1.0, -1.0}) {
+      const double predicted = c2 * pixel_sigma * pixel_sigma + sign * slope;
+      const double at_line = SumOfSquaresAt(scene, refined, sign * delta);
+      const double line = at_line - cost;
+      double profile = line;
+      if (!(std::abs(line - predicted) <= kProfileTrigger * predicted)) {
+        profile = ProfileAt(scene, refined, sign * delta, at_line,
+                            ParamVector(refined.normal.jtj * delta)) -
+                  cost;
+      }
+      // A point behind the camera within the region, or a profile at or below the minimum's
+      // cost (the region has no edge along this valley): not linear at all.
+      const double deviation = std::isfinite(line) && profile > 0.0
+                                   ? (predicted + line - profile) / profile - 1.0
+                                   : std::numeric_limits<double>::infinity();
+      if (!(deviation <= check.worst_deviation)) {
+        check.worst_deviation = deviation;
+        // The parameter that moves most in units of its own sigma: |delta_j| / sqrt(cov_jj).
+        int most = 0;
+        for (int j = 1; j < p; ++j) {
+          if (std::abs(delta(j)) / std::sqrt(covariance(j, j)) >
+              std::abs(delta(most)) / std::sqrt(covariance(most, most))) {
+            most = j;
+          }
+        }
+        check.worst_direction = names[most];
+      }
+    }
+  }
+  check.linear = check.worst_deviation <= check.bound;
+  return check;
+}
+
 }  // namespace
 
 FitResult AssessFit(const Scene& scene, const std::string& start_method, RefinedCamera refined,
-                    const FitOptions& options) {
+                    const FitOptions& options, const FitEffort& effort) {
   const int n = scene.NumPoints();
   const Model& model = refined.model;
   const int num_params = 6 + model.NumFree();
@@ -205,6 +339,10 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
   if (options.compute_uncertainty && have_sigma) {
     SetCovariance(scaled_normal, names, model, scene.scale, options, &result);
+    if (effort.check_linearity && refined.normal.jtr.size() == refined.normal.jtj.rows()) {
+      result.linearity =
+          CheckLinearity(scene, refined, scaled_normal, names, result.pixel_sigma);
+    }
   }
   return result;
 }

@@ -20,9 +20,10 @@ namespace internal {
 // start_method: FitResult::start_method. Throws SceneError kPointsBehindCamera (a point behind
 // the camera), kDegenerate (reciprocal condition of the Jacobi-scaled normal equations at most
 // 1e-12, naming the parameters along the undetermined direction and the intrinsic to fix), and
-// std::invalid_argument when the given near / far leave no depth range.
+// std::invalid_argument when the given near / far leave no depth range. FitResult::linearity
+// is checked where there is a covariance and `effort` asks for it.
 FitResult AssessFit(const Scene& scene, const std::string& start_method, RefinedCamera refined,
-                    const FitOptions& options);
+                    const FitOptions& options, const FitEffort& effort);
 
 }  // namespace internal
 }  // namespace camproj

@@ -297,43 +297,72 @@ bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
   constexpr int kSteps = 48;
   constexpr double kMinFovDeg = 0.5;
   constexpr double kMaxFovDeg = 175.0;
+  // Each coarse valley is looked at again on a grid this many times finer between its
+  // neighbours: two valleys can lie within one coarse step (a factor 1.2 in focal length; seen:
+  // 4 noise-free points with valleys at fx 2911 and 3132 px, LM from the coarse minimum ending
+  // in the wrong one at RMS 0.04 px).
+  constexpr int kFine = 4;
   const double f_min = 0.5 * image_width / std::tan(0.5 * kMaxFovDeg * kPi / 180.0);
   const double f_max = 0.5 * image_width / std::tan(0.5 * kMinFovDeg * kPi / 180.0);
   const double kNone = std::numeric_limits<double>::infinity();
-  std::vector<double> rms(kSteps, kNone);
-  std::vector<StartCamera> candidates(kSteps);
-  int best = -1;
-  for (int i = 0; i < kSteps; ++i) {
+  // The RMS of the SQPnP pose at focal length f_min (f_max / f_min)^(step / (kSteps - 1)).
+  auto evaluate = [&](double step, StartCamera* candidate) {
     Intrinsics k = guess;
-    k.fx = f_min * std::pow(f_max / f_min, i / (kSteps - 1.0));
+    k.fx = f_min * std::pow(f_max / f_min, step / (kSteps - 1.0));
     k.fy = aspect * k.fx;
-    StartCamera& candidate = candidates[i];
-    if (!PnpStart(points, pixels, k, &candidate)) continue;
+    if (!PnpStart(points, pixels, k, candidate)) return kNone;
     double sum = 0.0;
-    bool all_in_front = true;
     for (size_t j = 0; j < points.size(); ++j) {
-      const Eigen::Vector3d p = candidate.rotation * (points[j] - candidate.center);
-      if (!(p.z() > 0.0)) {
-        all_in_front = false;
-        break;
-      }
+      const Eigen::Vector3d p = candidate->rotation * (points[j] - candidate->center);
+      if (!(p.z() > 0.0)) return kNone;
       sum += (PixelFromCam(k, p) - pixels[j]).squaredNorm();
     }
-    if (!all_in_front) continue;
-    rms[i] = std::sqrt(sum / static_cast<double>(points.size()));
-    if (best < 0 || rms[i] < rms[best]) best = i;
-  }
-  if (best < 0) return false;
-  *start = candidates[best];
-  if (other_minima != nullptr) {
+    return std::sqrt(sum / static_cast<double>(points.size()));
+  };
+  // The local minima of `rms` (ascending): each one's index.
+  auto local_minima = [](const std::vector<double>& rms) {
     std::vector<int> minima;
-    for (int i = 0; i < kSteps; ++i) {
+    const int size = static_cast<int>(rms.size());
+    for (int i = 0; i < size; ++i) {
       const bool below_left = i == 0 || rms[i] < rms[i - 1];
-      const bool below_right = i == kSteps - 1 || rms[i] <= rms[i + 1];
-      if (i != best && std::isfinite(rms[i]) && below_left && below_right) minima.push_back(i);
+      const bool below_right = i == size - 1 || rms[i] <= rms[i + 1];
+      if (std::isfinite(rms[i]) && below_left && below_right) minima.push_back(i);
     }
     std::sort(minima.begin(), minima.end(), [&](int a, int b) { return rms[a] < rms[b]; });
-    for (const int i : minima) other_minima->push_back(candidates[i]);
+    return minima;
+  };
+  std::vector<double> rms(kSteps, kNone);
+  std::vector<StartCamera> candidates(kSteps);
+  for (int i = 0; i < kSteps; ++i) rms[i] = evaluate(i, &candidates[i]);
+  // Every valley's starts: the minima of the fine grid around each coarse minimum.
+  std::vector<double> valley_rms;
+  std::vector<StartCamera> valley_starts;
+  for (const int i : local_minima(rms)) {
+    const int size = 2 * kFine + 1;
+    std::vector<double> fine_rms(size, kNone);
+    std::vector<StartCamera> fine(size);
+    for (int j = 0; j < size; ++j) {
+      const int offset = j - kFine;  // in 1 / kFine of a coarse step
+      if (offset == 0) {
+        fine_rms[j] = rms[i];
+        fine[j] = candidates[i];
+      } else if (i + static_cast<double>(offset) / kFine >= 0.0 &&
+                 i + static_cast<double>(offset) / kFine <= kSteps - 1.0) {
+        fine_rms[j] = evaluate(i + static_cast<double>(offset) / kFine, &fine[j]);
+      }
+    }
+    for (const int j : local_minima(fine_rms)) {
+      valley_rms.push_back(fine_rms[j]);
+      valley_starts.push_back(fine[j]);
+    }
+  }
+  if (valley_starts.empty()) return false;
+  std::vector<int> order(valley_starts.size());
+  for (size_t v = 0; v < order.size(); ++v) order[v] = static_cast<int>(v);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return valley_rms[a] < valley_rms[b]; });
+  *start = valley_starts[order[0]];
+  if (other_minima != nullptr) {
+    for (size_t v = 1; v < order.size(); ++v) other_minima->push_back(valley_starts[order[v]]);
   }
   return true;
 }

@@ -63,6 +63,17 @@ inline double RmsRowLength(const Eigen::MatrixXd& centred) {
   return std::sqrt((unit * centred).squaredNorm() / static_cast<double>(centred.rows())) / unit;
 }
 
+// What a fit may leave out when the model selection only scores it (fit/candidate.h). The
+// default leaves out nothing: every FitCamera call.
+struct FitEffort {
+  // Skip the refinement's restarts from beyond the image's edges (radial distortion with the
+  // principal point free; refine.cc) when the best fit's sum of squares is within the
+  // chi-square quantile at this pixel sigma.
+  std::optional<double> skip_restarts_when_consistent_at_px;
+  // Check the covariance's linearization (FitResult::linearity; assess.cc).
+  bool check_linearity = true;
+};
+
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest
 // eigenvalue is the reciprocal condition the fitters refuse on (kDegenerate), and its inverse
 // gives the covariance. `Matrix` is Eigen::MatrixXd or a fixed-capacity type.

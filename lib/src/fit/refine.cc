@@ -81,17 +81,18 @@ void RefineAlsoFrom(const Scene& scene, const Model& model, const FitOptions& op
                best);
 }
 
-// True unless `outcome` fits as well as `options.pixel_sigma` says it can: its sum of squares
-// within the chi-square quantile kConsistentQuantile of its residual degrees of freedom. Without
-// a pixel sigma nothing says so.
+// True unless `effort` may skip the restarts and `outcome` fits as well as its pixel sigma
+// says it can: the sum of squares within the chi-square quantile kConsistentQuantile of its
+// residual degrees of freedom.
 bool MayBeAboveTheMinimum(const LeastSquaresOutcome& outcome, const Scene& scene,
-                          const FitOptions& options) {
-  // Refitting a fit this consistent cannot find a better one that the noise could tell apart.
+                          const FitEffort& effort) {
+  // Refitting a fit this consistent cannot find one whose criterion the noise could tell apart.
   constexpr double kConsistentQuantile = 0.999;
-  if (!outcome.ok || !options.pixel_sigma) return true;
+  if (!outcome.ok || !effort.skip_restarts_when_consistent_at_px) return true;
   const double dof = 2.0 * scene.NumPoints() - 6 - outcome.model.NumFree();
   if (dof < 1.0) return true;
-  const double chi_square = outcome.normal.cost / (*options.pixel_sigma * *options.pixel_sigma);
+  const double sigma = *effort.skip_restarts_when_consistent_at_px;
+  const double chi_square = outcome.normal.cost / (sigma * sigma);
   // The quantile is above the mean dof: most consistent fits need no quantile (a bisection).
   return chi_square > dof && chi_square > ChiSquareQuantile(dof, kConsistentQuantile);
 }
@@ -101,7 +102,8 @@ bool MayBeAboveTheMinimum(const LeastSquaresOutcome& outcome, const Scene& scene
 // valleys; with radial distortion and the principal point free, also from beyond each edge of
 // the image: the lowest cost.
 LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
-                                     const FitOptions& options, Clock::time_point start_time) {
+                                     const FitOptions& options, const FitEffort& effort,
+                                     Clock::time_point start_time) {
   LeastSquaresOutcome best = RefineLeastSquares(scene.points, scene.pixels, start.camera.rotation,
                                                 start.camera.center, start.model, options,
                                                 start_time);
@@ -125,7 +127,7 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
                  &best);
   }
   const bool distortion_free = scene.model.free[5] || scene.model.free[6];
-  if (distortion_free && scene.model.free[2] && MayBeAboveTheMinimum(best, scene, options)) {
+  if (distortion_free && scene.model.free[2] && MayBeAboveTheMinimum(best, scene, effort)) {
     // A principal point far off centre (a projector's lens shift, a cropped image) makes the
     // radial distortion one-sided across the image, and LM from a principal point on the other
     // side can stop in a minimum where k2 bends to make up for it (seen noise-free: cx 260 px
@@ -151,8 +153,8 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
 // (MinimizeLevenbergMarquardt: TinySolver's algorithm) on the chart R = exp(omega) R_start, then
 // the Gauss-Newton polish; refused unless it reached the minimum.
 RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const FitOptions& options,
-                                Clock::time_point start_time) {
-  LeastSquaresOutcome best = RefineFromStarts(scene, start, options, start_time);
+                                const FitEffort& effort, Clock::time_point start_time) {
+  LeastSquaresOutcome best = RefineFromStarts(scene, start, options, effort, start_time);
   if (!best.ok) {
     if (best.normal.jtj.size() > 0 && best.model.value[1] <= 0.0) {
       throw SceneError(SceneError::Reason::kMirroredWorld,
@@ -258,9 +260,9 @@ RefinedCamera RefineRobust(const Scene& scene, const Start& start, const FitOpti
 }  // namespace
 
 RefinedCamera RefineCamera(const Scene& scene, const Start& start, const FitOptions& options,
-                           Clock::time_point start_time) {
+                           const FitEffort& effort, Clock::time_point start_time) {
   if (options.refine && options.loss == LossType::kNone) {
-    return RefineWithoutLoss(scene, start, options, start_time);
+    return RefineWithoutLoss(scene, start, options, effort, start_time);
   }
   RefinedCamera refined;
   if (options.refine) {

@@ -36,12 +36,13 @@ struct RefinedCamera {
   std::vector<TraceEntry> trace;
 };
 
+
 // Throws SceneError kMirroredWorld (least squares found only a negative aspect),
 // kPointsBehindCamera (least squares put points behind the camera or made the focal length
 // negative), kDegenerate (the refinement failed, or did not reach the minimum). The trace's times
 // count from start_time.
 RefinedCamera RefineCamera(const Scene& scene, const Start& start, const FitOptions& options,
-                           Clock::time_point start_time);
+                           const FitEffort& effort, Clock::time_point start_time);
 
 }  // namespace internal
 }  // namespace camproj

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "fit/candidate.h"
 #include "fit/common.h"
 
 namespace camproj {
@@ -42,14 +43,16 @@ struct Evaluation {
   int num_params = 0;
 };
 
+// `consistent_at_px`: the noise at which the candidate's fit may skip its restarts
+// (fit/candidate.h).
 Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
-                    const FitOptions& options) {
+                    const FitOptions& options, double consistent_at_px) {
   Evaluation e;
   e.options = options;
   e.num_params = NumParameters(options);
   try {
-    e.fit = FitCamera(points, pixels, size, options);
+    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px);
     e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
   } catch (const SceneError& error) {
@@ -127,10 +130,13 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
 Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
                       const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
                       const AutoFitOptions& options, const Prefit* prefit) {
+  // The noise at which a candidate's fit is consistent enough to skip its restarts: the given
+  // one, else the prior until the selection's own noise is known.
+  double candidate_sigma = options.fit.pixel_sigma.value_or(options.prior_sigma_px);
   // One model fitted: the prefit's fit where it is that model.
   auto evaluate = [&](const FitOptions& model) {
     if (prefit == nullptr || !SameModel(prefit->model, model)) {
-      return Evaluate(points, pixels, image_size, model);
+      return Evaluate(points, pixels, image_size, model, candidate_sigma);
     }
     Evaluation e;
     e.options = model;
@@ -192,10 +198,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     for (int top = static_cast<int>(candidates.size()); top >= 0 && !found; --top) {
       FitOptions richest = base;
       for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
-      // Only its sum of squares is used. The prior tells its refinement when the fit is already
-      // consistent with the noise, so that it need not restart from other principal points
-      // (refine.cc, radial distortion).
-      richest.pixel_sigma = options.prior_sigma_px;
+      // Only its sum of squares is used.
       if (num_equations - NumParameters(richest) < 1) continue;
       const Evaluation e = top == 0 ? base_fit : evaluate(richest);
       if (e.fit && num_equations > e.num_params) {
@@ -239,6 +242,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
 
   // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
   base.pixel_sigma = sigma;
+  candidate_sigma = sigma;
   base.compute_uncertainty = true;
 
   // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
@@ -389,7 +393,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     // orthographic one, the world frame is left-handed.
     FitOptions mirrored = base;
     mirrored.compute_uncertainty = false;
-    const Evaluation e = Evaluate(MirroredZ(points), pixels, image_size, mirrored);
+    const Evaluation e = Evaluate(MirroredZ(points), pixels, image_size, mirrored, sigma);
     if (e.fit && criterion_of(e) < criterion_of(chosen.final)) {
       throw SceneError(SceneError::Reason::kMirroredWorld,
                        "the points fit a perspective camera only with one world axis flipped "
