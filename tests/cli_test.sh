@@ -28,6 +28,9 @@ case $case in
     expect_in out "fixed aspect = 1 (left out: BIC "
     grep -q '"left_out"' "$work/cam.json" || fail "camera file lacks left_out"
     grep -q '"selection"' "$work/cam.json" || fail "camera file lacks the model selection"
+    # The covariance's linearity check, in words and in the file (fit.h LinearityCheck).
+    expect_in out "^linearity: "
+    grep -q '"worst_deviation"' "$work/cam.json" || fail "camera file lacks the linearity check"
     expect_in out "residuals: rms"
     expect_in out "worst points:"
     expect_in out "iteration  elapsed_us  rms_px"

@@ -65,17 +65,16 @@ FitRecord FitRecordOf(const FitResult& fit) {
 }
 
 std::string LinearityText(const LinearityCheck& check) {
-  char numbers[160];
+  char numbers[200];
   std::snprintf(numbers, sizeof numbers,
-                "the sum of squares at the edge of the %g %% region departs from the quadratic "
-                "model by %.3g of its rise (bound %.3g), along ",
-                100.0 * check.level, check.worst_deviation, check.bound);
+                "an error at the edge of the %g %% region can read up to %.3g times its "
+                "chi-square in the covariance (bound %.3g), along ",
+                100.0 * check.level, 1.0 + check.worst_deviation, 1.0 + check.bound);
   const std::string measured = numbers + check.worst_direction;
-  return check.linear
-             ? "the sigmas hold (" + measured + ")"
-             : "the model is curved within the noise's reach: the sigmas and the covariance "
-               "understate or misdescribe the error (" + measured + "); add points, spread them "
-               "in depth, or fix intrinsics";
+  return check.linear ? "the sigmas hold (" + measured + ")"
+                      : "curved within the noise's reach: the sigmas are first-order only (" +
+                            measured + "); more points, spread in depth, or fewer free "
+                            "intrinsics make them hold";
 }
 
 std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {

@@ -234,19 +234,20 @@ struct DeterminationCheck {
   std::string summary;        // one line in words
 };
 
-// Whether the covariance's linearization holds where it is read (docs/stability.md): the sum of
-// squares along each principal direction of the covariance, both ways, at the edge of the
-// kLinearityLevel confidence region (where the quadratic model puts it up by
-// sigma^2 chi^2_p(kLinearityLevel)), against what the quadratic model predicts there. A curved
-// valley of near-equivalent cameras (narrow fields of view, near-planar scenes, large noise)
-// shows as a rise far above the prediction: the straight line leaves the valley's curved floor.
-// Where it departs by more than kMaxLinearityDeviation, the sigmas and the covariance are not a
-// trustworthy Gaussian description of the error.
+// Whether the covariance's linearization holds where it is read (docs/stability.md). Along each
+// principal direction of the covariance, both ways, at the edge of the kLinearityLevel confidence
+// region (radius c sigmas, c^2 = chi^2_p(level)), where the quadratic model puts the sum of
+// squares up by P = c^2 sigma^2: the straight line's rise L and, where L departs from P, the
+// profile's F (the sum re-minimized across the line). A curved valley of near-equivalent cameras
+// (narrow fields of view, near-planar scenes, large noise, few points) has its floor
+// (L - F) / sigma^2 off the straight line there, and the region's true edge at c sqrt(P / F):
+// the linearized NEES of an error on that edge is (P + L - F) / F times its true chi-square.
 struct LinearityCheck {
   bool checked = false;  // false: no covariance, or a candidate of FitCameraAuto's selection
   double level = 0.0;    // of the confidence region probed (kLinearityLevel)
-  // max over directions and signs of |actual - predicted| / predicted rise of the sum of
-  // squares: 0 for an exactly linear model; infinite where a point crosses behind the camera.
+  // The largest (P + L - F) / F - 1 over directions and signs: 0 for a linear model, negative
+  // where the walls are steeper than the quadratic model's (the sigmas overstate the error),
+  // infinite where a point crosses behind the camera within the region.
   double worst_deviation = 0.0;
   std::string worst_direction;  // the parameter that moves most (in its sigmas) along that direction
   double bound = 0.0;           // kMaxLinearityDeviation
@@ -254,11 +255,9 @@ struct LinearityCheck {
 };
 
 // The confidence level whose region the linearity check probes, and the largest deviation that
-// still counts as linear. With the valley's floor a parabola in the error, a deviation d at the
-// region's edge (radius c in sigmas) means the floor sits sqrt(d) r^2 / c sigmas off the straight
-// line at radius r, so the linearized NEES of an error on the floor within the region is at most
-// (1 + d) times its true chi-square: with d <= 1 the sigmas hold to a factor sqrt(2) out to the
-// 99.99 % region.
+// still counts as linear: the sigmas then hold to a factor sqrt(2) out to the 99.99 % region.
+// A local check: it sees the valley within the region around the estimate, not beyond it
+// (docs/stability.md says where that misses).
 inline constexpr double kLinearityLevel = 0.9999;
 inline constexpr double kMaxLinearityDeviation = 1.0;
 
