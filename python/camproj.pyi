@@ -226,6 +226,10 @@ def points_to_csv(points_in_world: ArrayLike, pixels: ArrayLike,
 def write_points(path: str, points_in_world: ArrayLike, pixels: ArrayLike,
                  ids: Optional[Sequence[str]] = None) -> None: ...
 
+def write_file_atomically(path: str, contents: str) -> None:
+    """Writes text as `camproj fit -o` does: readers see the old file or the new one, never a
+    partial one; flushed to disk before the rename (file_io.h)."""
+
 def gl_projection_from_K(K: ArrayLike, image_size: ImageSize, near: float, far: float,
                          depth: str = "no", reversed_z: bool = False,
                          pixel_origin: str = "center") -> Mat:
