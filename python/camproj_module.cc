@@ -354,10 +354,10 @@ PYBIND11_MODULE(camproj, m) {
       // R and t are views into the camera (no copy; read-only); they keep it alive.
       .def_property_readonly(
           "R", [](const PyCamera& c) -> const Eigen::Matrix3d& { return c.camera.cam_from_world.rotation; },
-          py::return_value_policy::reference_internal)
+          py::return_value_policy::reference_internal, "cam_from_world rotation (3x3), a read-only view")
       .def_property_readonly(
           "t", [](const PyCamera& c) -> const Eigen::Vector3d& { return c.camera.cam_from_world.translation; },
-          py::return_value_policy::reference_internal)
+          py::return_value_policy::reference_internal, "cam_from_world translation (3,), world units, a read-only view")
       .def_property_readonly("near", [](const PyCamera& c) { return c.camera.z_near; })
       .def_property_readonly("far", [](const PyCamera& c) { return c.camera.z_far; })
       .def_property_readonly("projection", [](const PyCamera& c) {
@@ -391,9 +391,11 @@ PYBIND11_MODULE(camproj, m) {
                         ? ClipFromGlEye(k, c.camera.image_size, n, f, d)
                         : ClipFromGlEyeOrthographic(k, c.camera.image_size, n, f, d);
            },
+           "clip_from_gl_eye (4x4): the GL projection matrix of the pinhole part (k1, k2 dropped); near/far default to the camera's (far=math.inf: infinite), depth \"no\" ([-1, 1]) or \"zo\" ([0, 1]), reversed_z.",
            py::arg("near") = py::none(), py::arg("far") = py::none(), py::arg("depth") = "no",
            py::arg("reversed_z") = false)
-      .def("gl_view", [](const PyCamera& c) { return GlEyeFromWorld(c.camera.cam_from_world); })
+      .def("gl_view", [](const PyCamera& c) { return GlEyeFromWorld(c.camera.cam_from_world); },
+           "gl_eye_from_world (4x4): the GL view matrix (docs/conventions.md).")
       .def("project",
            [](const PyCamera& c, const Array& points) {
              const auto rows = Rows<3>(points, "points_in_world");
@@ -404,6 +406,7 @@ PYBIND11_MODULE(camproj, m) {
              }
              return ToArray<2>(pixels);
            },
+           "Pixels (N, 2; OpenCV origin, px, distortion included) of points_in_world (N, 3); NaN rows for points not in front of the camera.",
            py::arg("points_in_world"))
       .def("summary", [](const PyCamera& c) {
         if (!c.fit) throw std::invalid_argument("summary: this camera was not fitted");
@@ -418,6 +421,7 @@ PYBIND11_MODULE(camproj, m) {
              options.target_distance = c.target_distance;
              return CameraToJsonText(c.camera, options);
            },
+           "The camera file text (docs/camera-file.md); for a fitted camera what `camproj fit -o` writes.",
            py::arg("pixel_origin") = py::none())
       .def("export",
            [](const PyCamera& c, const std::string& format, const std::string& depth,
@@ -432,6 +436,7 @@ PYBIND11_MODULE(camproj, m) {
              camera.z_far = z_far.value_or(camera.z_far);
              return ExportCamera(camera, ExportFormatFromString(format), options);
            },
+           "`camproj export --to FORMAT` as a string: format in EXPORT_FORMATS (docs/exports.md).",
            py::arg("format"), py::arg("depth") = "no", py::arg("reversed_z") = false,
            py::arg("row_major") = false, py::arg("pixel_origin") = "center",
            py::arg("near") = py::none(), py::arg("far") = py::none())
@@ -443,6 +448,7 @@ PYBIND11_MODULE(camproj, m) {
              options.target_distance = c.target_distance;
              WriteFileAtomically(path, c.fit ? FitCameraFileText(*c.fit, o) : CameraToJsonText(c.camera, options));
            },
+           "to_json() written atomically to path.",
            py::arg("path"), py::arg("pixel_origin") = py::none())
       .def("__repr__", [](const PyCamera& c) {
         const Intrinsics& k = c.camera.intrinsics;
@@ -458,6 +464,7 @@ PYBIND11_MODULE(camproj, m) {
           const auto q = Rows<2>(pixels, "pixels");
           return Fit(p, q, IdsOf(ids, q.size()), SizeOf(size), ArgumentsOf(kwargs));
         },
+        "fit(points_in_world, pixels, image_size, *, ids=None, **options) -> Camera\n\n`camproj fit` on arrays: points_in_world (N, 3) in world units seen at pixels (N, 2) in px (OpenCV origin unless pixel_origin=\"corner\"); image_size (width, height) px. Options are the command line's with '-' as '_' (model, criterion, free, fix, focal [px], fovy_deg, aspect, principal_point, skew, k1, k2, intrinsics, pixel_origin, loss, keep_all, ransac_px, sigma [px], max_uncertainty [px], object_points_in_world, near, far, max_iterations). Raises a SceneError subclass with the command line's message when the points cannot determine the camera, ValueError for a bad argument. Conventions: docs/conventions.md.",
         py::arg("points_in_world"), py::arg("pixels"), py::arg("image_size"), py::kw_only(),
         py::arg("ids") = py::none());
   m.def("fit_file",
@@ -466,6 +473,7 @@ PYBIND11_MODULE(camproj, m) {
           const Correspondences data = ReadCorrespondencesFile(path);
           return Fit(data.points_in_world, data.pixels, data.ids, SizeOf(size), arguments);
         },
+        "fit_file(path, image_size, **options) -> Camera: fit() on a points CSV (ids from its id column).",
         py::arg("path"), py::arg("image_size"));
 
   m.def("read_camera", [](const std::string& path) {
@@ -510,12 +518,14 @@ PYBIND11_MODULE(camproj, m) {
           return ClipFromGlEye(IntrinsicsFromK(K), SizeOf(size), n, f, DepthOf(depth, reversed_z),
                                PixelOriginFromString(origin));
         },
+        "clip_from_gl_eye (4x4) of pinhole K (px, skew included) for image_size; depth \"no\"|\"zo\", reversed_z, far=math.inf for an infinite far plane; pixel_origin of cx, cy.",
         py::arg("K"), py::arg("image_size"), py::arg("near"), py::arg("far"),
         py::arg("depth") = "no", py::arg("reversed_z") = false, py::arg("pixel_origin") = "center");
   m.def("K_from_gl_projection",
         [](const Eigen::Matrix4d& P, std::pair<int, int> size, const std::string& origin) {
           return IntrinsicsFromClipFromGlEye(P, SizeOf(size), PixelOriginFromString(origin)).K();
         },
+        "K (3x3, px) of a perspective clip_from_gl_eye for image_size (cx, cy in pixel_origin).",
         py::arg("clip_from_gl_eye"), py::arg("image_size"), py::arg("pixel_origin") = "center");
   m.def("depth_range_from_gl_projection",
         [](const Eigen::Matrix4d& P, const std::string& depth, bool reversed_z) {
@@ -556,12 +566,14 @@ PYBIND11_MODULE(camproj, m) {
           const Rigid3 pose = CamFromWorldFromLookAt(LookAt{eye, target, up});
           return py::make_tuple(pose.rotation, pose.translation);
         },
+        "(R, t) of gluLookAt(eye, target, up), world units.",
         py::arg("eye"), py::arg("target"), py::arg("up"));
   m.def("look_at_from_cam_from_world",
         [](const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double target_distance) {
           const LookAt l = LookAtFromCamFromWorld(PoseOf(R, t), target_distance);
           return py::make_tuple(l.eye, l.target, l.up);
         },
+        "(eye, target, up): target at target_distance along the gaze.",
         py::arg("R"), py::arg("t"), py::arg("target_distance") = 1.0);
   m.def("gl_view_from_cam_from_world",
         [](const Eigen::Matrix3d& R, const Eigen::Vector3d& t) { return GlEyeFromWorld(PoseOf(R, t)); },

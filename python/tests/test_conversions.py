@@ -187,3 +187,20 @@ def test_arrays_outlive_the_camera(data_dir):
     for got, want in zip([R, t, K0, residuals], expected):
         assert np.array_equal(got, want)
     assert report.rms_px > 0  # the report keeps its fit alive too
+
+
+def test_the_stub_declares_every_public_name_of_the_module():
+    import ast
+    stub = os.path.join(os.path.dirname(__file__), "..", "camproj.pyi")
+    tree = ast.parse(open(stub).read())
+    declared = {node.name for node in tree.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
+    declared |= {t.id for node in tree.body if isinstance(node, ast.AnnAssign) for t in [node.target]}
+    public = {name for name in dir(camproj) if not name.startswith("_")}
+    assert public - declared == set(), "in the module, not in camproj.pyi"
+    assert {"fit", "Camera", "SceneError"} <= declared
+    for cls in [camproj.Camera, camproj.FitReport, camproj.Intrinsics]:
+        node = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == cls.__name__)
+        members = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        members |= {n.target.id for n in node.body if isinstance(n, ast.AnnAssign)}
+        missing = {m for m in dir(cls) if not m.startswith("_")} - members
+        assert missing == set(), f"{cls.__name__}: {missing} not in camproj.pyi"
