@@ -8,6 +8,8 @@ import pytest
 import camproj
 from conftest import assert_same_json, load_json, run_cli
 
+DATA = os.environ.get("CAMPROJ_DATA_DIR", "/nonexistent")
+
 # (file under data/, image size, CLI options, the same as fit() keywords)
 CASES = [
     ("projector/points.csv", (1920, 1080), [], {}),
@@ -17,6 +19,13 @@ CASES = [
     ("projector/points.csv", (1920, 1080), ["--fovy", "40", "--pixel-origin", "corner", "--near", "0.5", "--far", "20"],
      {"fovy_deg": 40, "pixel_origin": "corner", "near": 0.5, "far": 20}),
     ("synthetic/points.csv", (1280, 800), [], {}),
+    ("synthetic/points.csv", (1280, 800), ["--ransac", "4", "--keep-all", "--max-uncertainty", "3"],
+     {"ransac_px": 4, "keep_all": True, "max_uncertainty": 3}),
+    ("projector/points.csv", (1920, 1080), ["--intrinsics", os.path.join(DATA, "projector/truth.json")],
+     {"intrinsics": os.path.join(DATA, "projector/truth.json")}),
+    ("projector/points.csv", (1920, 1080), ["--object-points", os.path.join(DATA, "synthetic/points.csv")],
+     {"object_points_in_world": camproj.read_points(os.path.join(DATA, "synthetic/points.csv"))[0]}
+     if os.path.isdir(DATA) else {}),
     ("synthetic/points.csv", (1280, 800), ["--criterion", "aic", "--sigma", "0.5"], {"criterion": "aic", "sigma": 0.5}),
     ("plane/points.csv", (1280, 720), ["--fix", "aspect,principal-point"], {"fix": ["aspect", "principal-point"]}),
     # Refused: a plane with every intrinsic free.
