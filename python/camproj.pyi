@@ -1,13 +1,11 @@
 """camproj: fit OpenGL/OpenCV cameras to 2D-3D correspondences, and convert between
 intrinsics, pose, look-at, frustum and OpenGL matrices.
 
-Conventions (frames, pixel origin, clip depth, matrix layout) are those of the C++ library,
-stated once in docs/conventions.md. In short: pixels are OpenCV's ((0, 0) is the centre of the
-top-left pixel) unless ``pixel_origin="corner"``; ``R, t`` are cam_from_world (x_cam = R x_world + t,
-camera x right, y down, z forward); GL matrices are 4x4 numpy arrays in the usual math layout
-(upload ``M.T`` or ``np.asfortranarray(M)`` for glUniformMatrix4fv with transpose=GL_FALSE);
-depth ``"no"`` is OpenGL's [-1, 1], ``"zo"`` is [0, 1]; ``far=math.inf`` is an infinite far plane.
-Intrinsics are in pixels; world units are the caller's.
+Conventions (frames, pixel origin, clip depth, units) are the C++ library's, stated once in
+docs/conventions.md; names carry them (cam_from_world, points_in_world, fovy_deg,
+clip_from_gl_eye). Python specifics: image sizes are (width, height) tuples; matrices are numpy
+arrays indexed M[row, column] (upload a GL matrix M as M.T with transpose=GL_FALSE, or M with
+GL_TRUE); pixel_origin and depth are the strings "center" | "corner" and "no" | "zo".
 
 Errors: ``ValueError`` for a bad argument (the message names it), ``InputError`` (a ValueError)
 for a malformed file (names the file, line and column), ``SceneError`` (one subclass per reason)
