@@ -27,6 +27,18 @@ for command in fit export project convert synth overlay; do
   grep -q "^\.SS camproj $command$" "$prefix/share/man/man1/camproj.1" || fail "the man page has no section for camproj $command"
 done
 
+# The Python module, when the build has it (not in a sanitizer build): installed with its stub and
+# importable from the prefix alone.
+python_note="no Python module in this build"
+if compgen -G "$build/python/camproj*.so" >/dev/null; then
+  site=$(cd "$prefix" && find lib -name 'camproj*.so' -path '*dist-packages*' | head -1)
+  [[ -n "$site" && -f "$prefix/$(dirname "$site")/camproj.pyi" ]] || fail "the Python module or its stub is not installed"
+  module_dir="$prefix/$(dirname "$site")"
+  PYTHONPATH="$module_dir" /usr/bin/python3 -c 'import camproj, sys; assert camproj.__file__.startswith(sys.argv[1]), camproj.__file__' "$module_dir" ||
+    fail "the installed Python module does not import from $module_dir"
+  python_note="the Python module imports from ${module_dir#"$prefix"/}"
+fi
+
 # The consumer sees only the prefix (no camproj source or build directory).
 cmake -S "$consumer" -B "$work/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$prefix" "$@" >"$work/configure.log" 2>&1 ||
@@ -35,4 +47,4 @@ cmake --build "$work/consumer" >"$work/build.log" 2>&1 || { cat "$work/build.log
 out=$("$work/consumer/consumer")
 # 12 exact points of a 500 px camera: the fit returns it to rounding; 2 fx / W = 1.5625.
 [[ "$out" == "fx 500.000000, projection(0,0) 1.562500000" ]] || fail "the consumer printed \"$out\""
-echo "install_test: installed into a fresh prefix, $version; the consumer built and printed: $out"
+echo "install_test: installed into a fresh prefix, $version; $python_note; the consumer built and printed: $out"
