@@ -9,7 +9,9 @@ build=$1
 caller=$2
 target=$3
 if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCAMPROJ_PYTHON=ON >/dev/null
+elif ! grep -q "^CAMPROJ_PYTHON:" "$build/CMakeCache.txt"; then
+  cmake "$build" -DCAMPROJ_PYTHON=ON >/dev/null
 fi
 build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt")
 if [[ "$build_type" != "Release" ]]; then

@@ -9,6 +9,10 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   clang libclang-rt-dev llvm  # scripts/fuzz.sh: clang, libFuzzer runtime, llvm-symbolizer
   python3-matplotlib  # scripts/plot_bench.py: the benchmark's plots (docs/bench/)
+  pybind11-dev python3-pybind11 python3-numpy  # python/: the camproj Python module
+  python3-pytest python3-opencv  # python/tests: the module's tests (cross-check with cv2)
+  python3-distributed  # python/examples/dask_fit.py: scale-out on Dask
+  help2man  # the man page installed with the CLI (apps/CMakeLists.txt)
 )
 missing=()
 for p in "${packages[@]}"; do

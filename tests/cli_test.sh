@@ -497,7 +497,9 @@ json.dump(d, open(sys.argv[2], "w"))' "$data/projector/truth.json" "$work/wide.j
     ;;
   messages_and_version)
     expect_exit 0 "$bin" --version
-    expect_in out "^camproj [0-9]*\.[0-9]*\.[0-9]*$"
+    # The version and the commit it was built from (12 hex digits, "+dirty" with local changes;
+    # "unknown" outside a git checkout).
+    expect_in out "^camproj [0-9]*\.[0-9]*\.[0-9]* (git \([0-9a-f]\{12\}\(+dirty\)\{0,1\}\|unknown\))$"
     # Only camproj's own message on stderr (main: OpenCV's "[ WARN:...] imread_" line too).
     expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
     [[ $(wc -l <"$work/err") -eq 1 ]] || fail "stderr has more than camproj's message:\n$(cat "$work/err")"

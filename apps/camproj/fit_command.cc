@@ -21,6 +21,7 @@
 #include "camproj/file_io.h"
 #include "camproj/fit.h"
 #include "camproj/fit_report.h"
+#include "camproj/fit_request.h"
 #include "camproj/model_select.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
@@ -64,29 +65,8 @@ struct FitArgs {
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
 
-ParameterMode* ModeOf(FitOptions& options, const std::string& name) {
-  if (name == "focal") return &options.focal;
-  if (name == "aspect") return &options.aspect;
-  if (name == "principal-point") return &options.principal_point;
-  if (name == "skew") return &options.skew;
-  if (name == "k1") return &options.k1;
-  if (name == "k2") return &options.k2;
-  throw UsageError("unknown parameter \"" + name +
-                   "\": expected focal, aspect, principal-point, skew, k1 or k2");
-}
-
-// What `camproj fit` runs: FitCameraAuto (--model auto) or FitCamera with the given model.
-struct FitRequest {
-  bool automatic = true;
-  AutoFitOptions auto_options;  // its `fit` is the options in both cases
-  const FitOptions& options() const { return auto_options.fit; }
-};
-
 FitResult RunFit(const Correspondences& data, const ImageSize& size, const FitRequest& request) {
-  if (!request.automatic) return FitCamera(data.points_in_world, data.pixels, size, request.options());
-  AutoFitOptions options = request.auto_options;
-  if (data.ids.size() == data.pixels.size()) options.point_names = data.ids;
-  return FitCameraAuto(data.points_in_world, data.pixels, size, options);
+  return RunFitRequest(data.points_in_world, data.pixels, data.ids, size, request);
 }
 
 // A file's correspondences and their fit. Running out of memory (a file with more rows than the
@@ -111,165 +91,54 @@ FileFit FitFile(const std::string& path, const ImageSize& size, const FitRequest
   return result;
 }
 
-// Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none),
-// optionally after "pose+" as the summary prints models ("pose+focal+principal-point").
-std::vector<std::string> ModelNames(const std::string& model) {
-  std::vector<std::string> names;
-  if (model == "pose") return names;
-  size_t begin = model.rfind("pose+", 0) == 0 ? 5 : 0;
-  for (;;) {
-    const size_t end = model.find('+', begin);
-    const std::string name = model.substr(begin, end == std::string::npos ? end : end - begin);
-    if (std::find(kParameterNames.begin(), kParameterNames.end(), name) == kParameterNames.end()) {
-      throw UsageError("--model: unknown parameter \"" + name + "\" in \"" + model +
-                       "\": expected auto, pose, or parameters joined by '+' among focal, aspect, "
-                       "principal-point, skew, k1, k2 (e.g. focal+principal-point)");
-    }
-    names.push_back(name);
-    if (end == std::string::npos) return names;
-    begin = end + 1;
-  }
-}
-
-// The value "fixed at its default" means for an intrinsic of `options`' model: in the automatic
-// path a default-mode intrinsic is a candidate, so a model or --fix given on the command line
-// holds it at its default value (in the input's pixel origin).
-ParameterMode DefaultValueOf(const std::string& name, const ImageSize& size, PixelOrigin origin) {
-  const double shift = PixelOriginShift(PixelOrigin::kCenter, origin);
-  if (name == "aspect") return ParameterMode::Fixed(1.0);
-  if (name == "principal-point") {
-    return ParameterMode::Fixed(0.5 * (size.width - 1) + shift, 0.5 * (size.height - 1) + shift);
-  }
-  return ParameterMode::Fixed(0.0);
-}
-
+// The library's request (fit_request.h) for the parsed options; the files they name are read
+// here, and a value the library refuses is a usage error.
 FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
-  FitRequest request;
-  // Every fit runs the default path (outlier stage, consistency gate), a forced model as a
-  // ladder of one; only a robust loss, which the selection cannot compare, runs FitCamera alone.
-  request.automatic = args.loss == "none";
-  const bool forced = args.model != "auto";
-  FitOptions& options = request.auto_options.fit;
-  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
-  const std::string orthographic = "orthographic";
-  if (args.model.rfind(orthographic, 0) == 0) {
-    // "orthographic[+aspect][+skew]": the scale (focal) is always free.
-    options.projection = Projection::kOrthographic;
-    for (const std::string& name : kParameterNames) {
-      *ModeOf(options, name) = name == "focal" || name == "principal-point"
-                                   ? ParameterMode::Default()
-                                   : DefaultValueOf(name, size, PixelOrigin::kCenter);
-    }
-    options.focal = ParameterMode::Free();
-    if (args.model.size() > orthographic.size()) {
-      if (args.model[orthographic.size()] != '+') throw UsageError("--model: unknown model \"" + args.model + "\"");
-      for (const std::string& name : ModelNames(args.model.substr(orthographic.size() + 1))) {
-        if (name != "aspect" && name != "skew") {
-          throw UsageError("--model: an orthographic camera has aspect and skew, not " + name);
-        }
-        *ModeOf(options, name) = ParameterMode::Free();
-      }
-    }
-  } else if (args.model != "auto") {
-    // Exactly the listed intrinsics are free; the rest stay at their defaults (fixed there, so
-    // that the automatic path does not free them).
-    for (const std::string& name : kParameterNames) {
-      *ModeOf(options, name) =
-          name == "focal" ? ParameterMode::Default() : DefaultValueOf(name, size, options.pixel_origin);
-    }
-    for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
-  }
-  if (args.criterion != "aic" && args.criterion != "bic") {
-    throw UsageError("--criterion: expected aic or bic, got \"" + args.criterion + "\"");
-  }
-  request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
-  for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
-  for (const std::string& name : args.fix) {
-    if (name == "focal") throw UsageError("--fix focal needs a value: use --focal PX or --fovy DEG");
-    *ModeOf(options, name) = request.automatic ? DefaultValueOf(name, size, options.pixel_origin)
-                                               : ParameterMode::Default();
-  }
-  if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
-  if (args.focal > 0.0 && args.fovy_deg > 0.0) throw UsageError("give --focal or --fovy, not both");
-  if (args.focal > 0.0) options.focal = ParameterMode::Fixed(args.focal);
-  if (args.fovy_deg > 0.0) {
-    if (!(args.fovy_deg < 180.0)) throw UsageError("--fovy must be in (0, 180) degrees");
-    // fovy fixes fy = H / (2 tan(fovy / 2)); fx = fy / aspect (1 unless --aspect).
-    const double fy = 0.5 * size.height / std::tan(0.5 * args.fovy_deg * M_PI / 180.0);
-    const double aspect = args.aspect > 0.0 ? args.aspect : 1.0;
-    options.focal = ParameterMode::Fixed(fy / aspect);
-    if (options.aspect.IsFree()) options.aspect = ParameterMode::Default();
-  }
+  FitArguments arguments;
+  arguments.model = args.model;
+  arguments.criterion = args.criterion;
+  arguments.free = args.free;
+  arguments.fix = args.fix;
+  arguments.focal = args.focal;
+  arguments.fovy_deg = args.fovy_deg;
+  arguments.aspect = args.aspect;
   if (!args.principal_point.empty()) {
     const std::vector<double> c = ParseNumbers(args.principal_point, 2, "--principal-point");
-    options.principal_point = ParameterMode::Fixed(c[0], c[1]);
+    arguments.principal_point = Eigen::Vector2d(c[0], c[1]);
   }
-  if (!std::isnan(args.skew)) options.skew = ParameterMode::Fixed(args.skew);
-  if (!std::isnan(args.k1)) options.k1 = ParameterMode::Fixed(args.k1);
-  if (!std::isnan(args.k2)) options.k2 = ParameterMode::Fixed(args.k2);
-  if (!args.intrinsics_path.empty()) {
-    // The file's intrinsics come back in kCenter; the fitter reads known_intrinsics in
-    // options.pixel_origin.
-    options.known_intrinsics = ConvertPixelOrigin(ReadIntrinsicsFile(args.intrinsics_path),
-                                                  PixelOrigin::kCenter, options.pixel_origin);
-  }
-  if (args.loss != "none") {
-    const size_t colon = args.loss.find(':');
-    const std::string kind = args.loss.substr(0, colon);
-    if (kind != "huber" && kind != "cauchy") {
-      throw UsageError("--loss: expected none, huber:SCALE or cauchy:SCALE (px), got \"" + args.loss + "\"");
-    }
-    options.loss = kind == "huber" ? LossType::kHuber : LossType::kCauchy;
-    options.loss_scale_px =
-        colon == std::string::npos ? 1.0 : ParseNumbers(args.loss.substr(colon + 1), 1, "--loss scale")[0];
-  }
-  if (args.ransac_px > 0.0) {
-    options.ransac = true;
-    options.ransac_threshold_px = args.ransac_px;
-  }
-  if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
-  if (args.z_near > 0.0) options.z_near = args.z_near;
-  if (args.z_far > 0.0) options.z_far = args.z_far;
-  options.max_iterations = args.max_iterations;
-  if (!forced && options.loss != LossType::kNone) {
-    throw UsageError("--loss needs an explicit --model (automatic selection compares "
-                     "least-squares fits): e.g. --model focal+aspect+principal-point; "
-                     "mis-clicked points are found and left out by default");
-  }
-  if (!request.automatic && options.focal.kind == ParameterMode::Kind::kDefault) {
-    options.focal = ParameterMode::Free();
-  }
-  request.auto_options.find_outliers = !args.keep_all;
-  if (args.max_uncertainty > 0.0) request.auto_options.max_uncertainty_px = args.max_uncertainty;
-  if (!args.object_points_path.empty()) {
-    if (!request.automatic) {
-      throw UsageError("--object-points is for the default path's determination check, which a "
-                       "robust --loss does not run");
-    }
-    CorrespondencesLimits limits;
-    limits.require_pixels = false;
-    request.auto_options.object_points_in_world =
-        ReadCorrespondencesFile(args.object_points_path, limits).points_in_world;
-  }
+  arguments.skew = args.skew;
+  arguments.k1 = args.k1;
+  arguments.k2 = args.k2;
+  if (!args.intrinsics_path.empty()) arguments.known_intrinsics = ReadIntrinsicsFile(args.intrinsics_path);
+  arguments.pixel_origin = args.pixel_origin;
+  arguments.loss = args.loss;
+  arguments.keep_all = args.keep_all;
+  arguments.ransac_px = args.ransac_px;
+  arguments.sigma = args.sigma;
+  arguments.max_uncertainty = args.max_uncertainty;
+  arguments.z_near = args.z_near;
+  arguments.z_far = args.z_far;
+  arguments.max_iterations = args.max_iterations;
   try {
-    if (request.automatic) {
-      request.auto_options.Check();
-    } else {
-      options.Check();
+    if (!args.object_points_path.empty()) {
+      // Every other option is checked before the file is read (with one placeholder point:
+      // a robust loss refuses object points whatever they are).
+      arguments.object_points_in_world = {Eigen::Vector3d::Zero()};
+      FitRequestFrom(arguments, size);
+      CorrespondencesLimits limits;
+      limits.require_pixels = false;
+      arguments.object_points_in_world =
+          ReadCorrespondencesFile(args.object_points_path, limits).points_in_world;
     }
+    return FitRequestFrom(arguments, size);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  return request;
 }
 
 // The camera file of a fit: its look-at target at the fit's distance, and the `fit` record.
 std::string CameraFileTextOf(const FitResult& fit, PixelOrigin pixel_origin) {
-  CameraFileOptions file_options;
-  file_options.pixel_origin = pixel_origin;
-  file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
-  const FitRecord record = FitRecordOf(fit);
-  return CameraToJsonText(fit.camera, file_options, &record);
+  return FitCameraFileText(fit, pixel_origin);
 }
 
 // Files named on the command line, a folder standing for its *.csv files (sorted).

@@ -8,6 +8,7 @@
 #include "camproj/fit.h"
 #include "camproj/library_logging.h"
 #include "camproj/terminal_text.h"
+#include "camproj_git_revision.h"
 #include "cli.h"
 
 int main(int argc, char** argv) {
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   // Root options (--verbose) may also follow the subcommand.
   app.fallthrough(true);
-  app.set_version_flag("--version", "camproj " CAMPROJ_VERSION);
+  app.set_version_flag("--version", "camproj " CAMPROJ_VERSION " (git " CAMPROJ_GIT_REVISION ")");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "also show the log lines of the libraries camproj calls (Ceres/glog, OpenCV)");

@@ -1,0 +1,74 @@
+// The options of `camproj fit` as one struct, and the one mapping from them to the fitter's
+// options (FitOptions / AutoFitOptions), shared by the command line and the Python module so
+// that both give the same camera and the same messages for the same options.
+#ifndef CAMPROJ_FIT_REQUEST_H_
+#define CAMPROJ_FIT_REQUEST_H_
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/camera_file.h"
+#include "camproj/conventions.h"
+#include "camproj/fit.h"
+#include "camproj/intrinsics.h"
+#include "camproj/model_select.h"
+
+namespace camproj {
+
+// One field per option of `camproj fit` (its --help describes each); messages name the option
+// as the command line spells it ("--model", "--fovy"). Unset numbers (0 or NaN) mean "not given".
+struct FitArguments {
+  std::string model = "auto";  // auto | pose | a '+' list of intrinsics | orthographic[+aspect][+skew]
+  std::string criterion = "bic";  // aic | bic
+  std::vector<std::string> free;  // among focal, aspect, principal-point, skew, k1, k2
+  std::vector<std::string> fix;
+  double focal = 0.0;     // px, fixes fx when > 0
+  double fovy_deg = 0.0;  // degrees, fixes fy = H / (2 tan(fovy / 2)) when > 0
+  double aspect = 0.0;    // fy / fx, fixed when > 0
+  std::optional<Eigen::Vector2d> principal_point;  // fixed cx, cy (px, in pixel_origin)
+  double skew = NAN;      // px, fixed when not NaN
+  double k1 = NAN;
+  double k2 = NAN;
+  std::optional<Intrinsics> known_intrinsics;  // in kCenter (as ReadIntrinsicsFile returns them)
+  std::string pixel_origin = "center";         // of the pixels and of the values above
+  std::string loss = "none";                   // none | huber:SCALE | cauchy:SCALE (px)
+  bool keep_all = false;
+  double ransac_px = 0.0;        // RANSAC inlier threshold (px) when > 0
+  double sigma = 0.0;            // pixel noise per axis (px) when > 0
+  double max_uncertainty = 0.0;  // px; 0: AutoFitOptions' default
+  std::vector<Eigen::Vector3d> object_points_in_world;
+  double z_near = 0.0;  // GL depth range when > 0
+  double z_far = 0.0;
+  int max_iterations = 100;
+};
+
+// What `camproj fit` runs: FitCameraAuto (automatic) or FitCamera with the given model (a robust
+// loss, which the selection cannot compare).
+struct FitRequest {
+  bool automatic = true;
+  AutoFitOptions auto_options;  // its `fit` is the options in both cases
+  const FitOptions& options() const { return auto_options.fit; }
+};
+
+// The request for `arguments` and an image of `size`. Throws std::invalid_argument naming the
+// option (the command line reports it as a usage error).
+FitRequest FitRequestFrom(const FitArguments& arguments, const ImageSize& size);
+
+// Runs the request: FitCameraAuto with `ids` as the point names (when one per point), or
+// FitCamera. Throws like them (SceneError for a refusal, std::invalid_argument for bad input).
+FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
+                        const std::vector<Eigen::Vector2d>& pixels,
+                        const std::vector<std::string>& ids, const ImageSize& size,
+                        const FitRequest& request);
+
+// The camera file `camproj fit -o` writes for a fit: cx, cy in `pixel_origin`, the look-at target
+// at the fit's distance, and the `fit` record (fit_report.h).
+std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin);
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_FIT_REQUEST_H_

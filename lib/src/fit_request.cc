@@ -1,0 +1,212 @@
+#include "camproj/fit_request.h"
+
+#include <algorithm>
+#include <charconv>
+#include <stdexcept>
+
+#include "camproj/fit_report.h"
+
+namespace camproj {
+
+namespace {
+
+const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
+                                                  "skew",  "k1",     "k2"};
+
+ParameterMode* ModeOf(FitOptions& options, const std::string& name) {
+  if (name == "focal") return &options.focal;
+  if (name == "aspect") return &options.aspect;
+  if (name == "principal-point") return &options.principal_point;
+  if (name == "skew") return &options.skew;
+  if (name == "k1") return &options.k1;
+  if (name == "k2") return &options.k2;
+  throw std::invalid_argument("unknown parameter \"" + name +
+                              "\": expected focal, aspect, principal-point, skew, k1 or k2");
+}
+
+// Parses --model: "auto", or intrinsics joined by '+' ("focal+principal-point"; "pose": none),
+// optionally after "pose+" as the summary prints models ("pose+focal+principal-point").
+std::vector<std::string> ModelNames(const std::string& model) {
+  std::vector<std::string> names;
+  if (model == "pose") return names;
+  size_t begin = model.rfind("pose+", 0) == 0 ? 5 : 0;
+  for (;;) {
+    const size_t end = model.find('+', begin);
+    const std::string name = model.substr(begin, end == std::string::npos ? end : end - begin);
+    if (std::find(kParameterNames.begin(), kParameterNames.end(), name) == kParameterNames.end()) {
+      throw std::invalid_argument(
+          "--model: unknown parameter \"" + name + "\" in \"" + model +
+          "\": expected auto, pose, or parameters joined by '+' among focal, aspect, "
+          "principal-point, skew, k1, k2 (e.g. focal+principal-point)");
+    }
+    names.push_back(name);
+    if (end == std::string::npos) return names;
+    begin = end + 1;
+  }
+}
+
+// The value "fixed at its default" means for an intrinsic of `options`' model: in the automatic
+// path a default-mode intrinsic is a candidate, so a model or --fix given on the command line
+// holds it at its default value (in the input's pixel origin).
+ParameterMode DefaultValueOf(const std::string& name, const ImageSize& size, PixelOrigin origin) {
+  const double shift = PixelOriginShift(PixelOrigin::kCenter, origin);
+  if (name == "aspect") return ParameterMode::Fixed(1.0);
+  if (name == "principal-point") {
+    return ParameterMode::Fixed(0.5 * (size.width - 1) + shift, 0.5 * (size.height - 1) + shift);
+  }
+  return ParameterMode::Fixed(0.0);
+}
+
+// The SCALE of --loss KIND:SCALE: a finite number (as the command line's ParseNumbers reads it).
+double LossScale(const std::string& text) {
+  const char* begin = text.data();
+  const char* end = text.data() + text.size();
+  if (begin != end && *begin == '+') ++begin;
+  double value = 0.0;
+  const auto [ptr, error] = std::from_chars(begin, end, value);
+  if (error != std::errc() || ptr != end || !std::isfinite(value)) {
+    throw std::invalid_argument("--loss scale: \"" + text + "\" is not a finite number (in \"" +
+                                text + "\")");
+  }
+  return value;
+}
+
+}  // namespace
+
+FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
+  size.Check();
+  FitRequest request;
+  // Every fit runs the default path (outlier stage, consistency gate), a forced model as a
+  // ladder of one; only a robust loss, which the selection cannot compare, runs FitCamera alone.
+  request.automatic = args.loss == "none";
+  const bool forced = args.model != "auto";
+  FitOptions& options = request.auto_options.fit;
+  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+  const std::string orthographic = "orthographic";
+  if (args.model.rfind(orthographic, 0) == 0) {
+    // "orthographic[+aspect][+skew]": the scale (focal) is always free.
+    options.projection = Projection::kOrthographic;
+    for (const std::string& name : kParameterNames) {
+      *ModeOf(options, name) = name == "focal" || name == "principal-point"
+                                   ? ParameterMode::Default()
+                                   : DefaultValueOf(name, size, PixelOrigin::kCenter);
+    }
+    options.focal = ParameterMode::Free();
+    if (args.model.size() > orthographic.size()) {
+      if (args.model[orthographic.size()] != '+') {
+        throw std::invalid_argument("--model: unknown model \"" + args.model + "\"");
+      }
+      for (const std::string& name : ModelNames(args.model.substr(orthographic.size() + 1))) {
+        if (name != "aspect" && name != "skew") {
+          throw std::invalid_argument("--model: an orthographic camera has aspect and skew, not " + name);
+        }
+        *ModeOf(options, name) = ParameterMode::Free();
+      }
+    }
+  } else if (args.model != "auto") {
+    // Exactly the listed intrinsics are free; the rest stay at their defaults (fixed there, so
+    // that the automatic path does not free them).
+    for (const std::string& name : kParameterNames) {
+      *ModeOf(options, name) =
+          name == "focal" ? ParameterMode::Default() : DefaultValueOf(name, size, options.pixel_origin);
+    }
+    for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
+  }
+  if (args.criterion != "aic" && args.criterion != "bic") {
+    throw std::invalid_argument("--criterion: expected aic or bic, got \"" + args.criterion + "\"");
+  }
+  request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
+  for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
+  for (const std::string& name : args.fix) {
+    if (name == "focal") {
+      throw std::invalid_argument("--fix focal needs a value: use --focal PX or --fovy DEG");
+    }
+    *ModeOf(options, name) = request.automatic ? DefaultValueOf(name, size, options.pixel_origin)
+                                               : ParameterMode::Default();
+  }
+  if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
+  if (args.focal > 0.0 && args.fovy_deg > 0.0) throw std::invalid_argument("give --focal or --fovy, not both");
+  if (args.focal > 0.0) options.focal = ParameterMode::Fixed(args.focal);
+  if (args.fovy_deg > 0.0) {
+    if (!(args.fovy_deg < 180.0)) throw std::invalid_argument("--fovy must be in (0, 180) degrees");
+    // fovy fixes fy = H / (2 tan(fovy / 2)); fx = fy / aspect (1 unless --aspect).
+    const double fy = 0.5 * size.height / std::tan(0.5 * args.fovy_deg * M_PI / 180.0);
+    const double aspect = args.aspect > 0.0 ? args.aspect : 1.0;
+    options.focal = ParameterMode::Fixed(fy / aspect);
+    if (options.aspect.IsFree()) options.aspect = ParameterMode::Default();
+  }
+  if (args.principal_point) {
+    options.principal_point = ParameterMode::Fixed(args.principal_point->x(), args.principal_point->y());
+  }
+  if (!std::isnan(args.skew)) options.skew = ParameterMode::Fixed(args.skew);
+  if (!std::isnan(args.k1)) options.k1 = ParameterMode::Fixed(args.k1);
+  if (!std::isnan(args.k2)) options.k2 = ParameterMode::Fixed(args.k2);
+  if (args.known_intrinsics) {
+    // The intrinsics come in kCenter; the fitter reads known_intrinsics in options.pixel_origin.
+    options.known_intrinsics =
+        ConvertPixelOrigin(*args.known_intrinsics, PixelOrigin::kCenter, options.pixel_origin);
+  }
+  if (args.loss != "none") {
+    const size_t colon = args.loss.find(':');
+    const std::string kind = args.loss.substr(0, colon);
+    if (kind != "huber" && kind != "cauchy") {
+      throw std::invalid_argument("--loss: expected none, huber:SCALE or cauchy:SCALE (px), got \"" +
+                                  args.loss + "\"");
+    }
+    options.loss = kind == "huber" ? LossType::kHuber : LossType::kCauchy;
+    options.loss_scale_px = colon == std::string::npos ? 1.0 : LossScale(args.loss.substr(colon + 1));
+  }
+  if (args.ransac_px > 0.0) {
+    options.ransac = true;
+    options.ransac_threshold_px = args.ransac_px;
+  }
+  if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
+  if (args.z_near > 0.0) options.z_near = args.z_near;
+  if (args.z_far > 0.0) options.z_far = args.z_far;
+  options.max_iterations = args.max_iterations;
+  if (!forced && options.loss != LossType::kNone) {
+    throw std::invalid_argument(
+        "--loss needs an explicit --model (automatic selection compares "
+        "least-squares fits): e.g. --model focal+aspect+principal-point; "
+        "mis-clicked points are found and left out by default");
+  }
+  if (!request.automatic && options.focal.kind == ParameterMode::Kind::kDefault) {
+    options.focal = ParameterMode::Free();
+  }
+  request.auto_options.find_outliers = !args.keep_all;
+  if (args.max_uncertainty > 0.0) request.auto_options.max_uncertainty_px = args.max_uncertainty;
+  if (!args.object_points_in_world.empty()) {
+    if (!request.automatic) {
+      throw std::invalid_argument(
+          "--object-points is for the default path's determination check, which a "
+          "robust --loss does not run");
+    }
+    request.auto_options.object_points_in_world = args.object_points_in_world;
+  }
+  if (request.automatic) {
+    request.auto_options.Check();
+  } else {
+    options.Check();
+  }
+  return request;
+}
+
+FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
+                        const std::vector<Eigen::Vector2d>& pixels,
+                        const std::vector<std::string>& ids, const ImageSize& size,
+                        const FitRequest& request) {
+  if (!request.automatic) return FitCamera(points_in_world, pixels, size, request.options());
+  AutoFitOptions options = request.auto_options;
+  if (ids.size() == pixels.size()) options.point_names = ids;
+  return FitCameraAuto(points_in_world, pixels, size, options);
+}
+
+std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin) {
+  CameraFileOptions file_options;
+  file_options.pixel_origin = pixel_origin;
+  file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
+  const FitRecord record = FitRecordOf(fit);
+  return CameraToJsonText(fit.camera, file_options, &record);
+}
+
+}  // namespace camproj
