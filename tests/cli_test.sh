@@ -239,6 +239,42 @@ EOF
     expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
     [[ ! -e "$work/p.png" ]] || fail "partial output"
     ;;
+  view_page)
+    # camproj view: one self-contained page (nothing fetched: no src= or href= to anything), the
+    # camera alone or with points, a photo and a model; bad inputs named, nothing written.
+    expect_exit 0 "$bin" view "$data/projector/truth.json" -o "$work/camera_only.html"
+    expect_in out "wrote $work/camera_only.html (0 points"
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/photo.jpg"
+    printf 'o box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf -4/1 -3/2 -2/3\n' >"$work/box.obj"
+    expect_exit 0 "$bin" view "$data/projector/truth.json" "$data/projector/points.csv" \
+      --image "$work/photo.jpg" --mesh "$work/box.obj" -o "$work/v.html"
+    expect_in out "(20 points, 3 triangles"
+    grep -q '<pre id="camproj-test-result">' "$work/v.html" || fail "no test element"
+    grep -q '"data_url":"data:image/jpeg;base64,' "$work/v.html" || fail "photo not inlined"
+    if grep -Eiq '<(script|img|link|iframe)[^>]*(src|href)=' "$work/v.html"; then
+      fail "the page refers to another file"
+    fi
+    # Bad model: the file, the line, what is wrong; the old page stays.
+    cp "$work/v.html" "$work/v.orig.html"
+    printf 'v 0 0 0\nv 1 0 x\n' >"$work/bad.obj"
+    expect_exit 2 "$bin" view "$data/projector/truth.json" --mesh "$work/bad.obj" -o "$work/v.html"
+    expect_in err "bad.obj: line 2: vertex coordinate 3 is not a finite number"
+    printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\n' >"$work/bad.obj"
+    expect_exit 2 "$bin" view "$data/projector/truth.json" --mesh "$work/bad.obj" -o "$work/v.html"
+    expect_in err "bad.obj: line 3: face vertex 3 refers to vertex 3 but 2 are defined so far"
+    cmp -s "$work/v.html" "$work/v.orig.html" || fail "a failed view replaced the page"
+    # A photo of another size; an output that is an input; not .html.
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/photo.png"
+    py -c "import json,sys; c=json.load(open(sys.argv[1])); c['image_size']=[960,540]; json.dump(c, open(sys.argv[2],'w'))" \
+      "$data/projector/truth.json" "$work/small.json"
+    expect_exit 2 "$bin" view "$work/small.json" --image "$work/photo.png" -o "$work/s.html"
+    expect_in err "photo.png: image is 1920x1080 but the camera's image size is 960x540"
+    [[ ! -e "$work/s.html" ]] || fail "wrote a page for a photo of the wrong size"
+    cp "$data/projector/truth.json" "$work/cam.html"
+    expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
+    expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"
+    expect_in err "must end in .html"
+    ;;
   deep_json_refused)
     # 100000 nested arrays inside a checked key (200 KB, under the 1 MiB limit): main crashed in
     # nlohmann's recursive dump() building the message (SIGSEGV, exit 139).
