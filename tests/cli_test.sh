@@ -239,6 +239,34 @@ EOF
     expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
     [[ ! -e "$work/p.png" ]] || fail "partial output"
     ;;
+  overlay_which_click)
+    # Two clicks moved by 180 px and 120 px: the fit leaves them out, and the overlay names them
+    # (kind outlier in the label table, how far off), ids for every point, a JPEG for .jpg.
+    py -c "
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+out, header, row = [], None, 0
+for line in lines:
+    if line.startswith('#') or header is None:
+        if not line.startswith('#'): header = line.split(',')
+        out.append(line); continue
+    f = line.split(','); row += 1
+    if row == 3: f[header.index('u')] = str(float(f[header.index('u')]) + 180)
+    if row == 7: f[header.index('v')] = str(float(f[header.index('v')]) - 120)
+    out.append(','.join(f))
+open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.csv" "$work/mis.csv"
+    expect_exit 0 "$bin" fit "$work/mis.csv" --image-size 1920x1080 -o "$work/cam.json"
+    expect_exit 0 "$bin" overlay "$work/cam.json" "$work/mis.csv" -o "$work/o.jpg" --labels "$work/labels.csv"
+    expect_in out "18 points, 2 outliers; residuals x "
+    [[ $(head -c 3 "$work/o.jpg" | od -An -tx1 | tr -d ' \n') == ffd8ff ]] || fail "not a JPEG"
+    [[ $(grep -c ',outlier,' "$work/labels.csv") -eq 2 ]] || fail "outliers not labelled: $(cat "$work/labels.csv")"
+    grep -q '^3,outlier,' "$work/labels.csv" || fail "point 3 not an outlier"
+    grep -q '^7,outlier,' "$work/labels.csv" || fail "point 7 not an outlier"
+    [[ $(tail -n +2 "$work/labels.csv" | wc -l) -eq 20 ]] || fail "not one label per point"
+    # The label table is an output too: it may not replace an input.
+    expect_exit 2 "$bin" overlay "$work/cam.json" "$work/mis.csv" -o "$work/o2.png" --labels "$work/mis.csv"
+    [[ ! -e "$work/o2.png" ]] || fail "wrote the picture although the labels would replace an input"
+    ;;
   view_page)
     # camproj view: one self-contained page (nothing fetched: no src= or href= to anything), the
     # camera alone or with points, a photo and a model; bad inputs named, nothing written.
