@@ -267,6 +267,25 @@ open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.c
     expect_exit 2 "$bin" overlay "$work/cam.json" "$work/mis.csv" -o "$work/o2.png" --labels "$work/mis.csv"
     [[ ! -e "$work/o2.png" ]] || fail "wrote the picture although the labels would replace an input"
     ;;
+  fit_report)
+    # camproj fit --report: an SVG (well-formed XML) with a bar per point, an arrow per kept point,
+    # the models tried; .html wraps it with the summary; other extensions refused before fitting.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.svg"
+    py -c "import sys, xml.dom.minidom as m; d = m.parse(sys.argv[1]); n = len(d.getElementsByTagName('rect')); sys.exit(0 if n >= 21 else 1)" "$work/r.svg" \
+      || fail "the report is not well-formed SVG with a bar per point"
+    [[ $(grep -c "marker-end='url(#head)'" "$work/r.svg") -eq 20 ]] || fail "not an arrow per point"
+    expect_in_file() { grep -q -- "$2" "$1" || fail "$1 lacks '$2'"; }
+    expect_in_file "$work/r.svg" "Models tried, in order: BIC"
+    expect_in_file "$work/r.svg" "pose+focal+principal-point"
+    expect_in_file "$work/r.svg" "Residuals over the image (1920x1080 px): arrows x "
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.html"
+    expect_in_file "$work/r.html" "<svg"
+    expect_in_file "$work/r.html" "model: pose+focal+principal-point"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.png"
+    expect_in err "a report is .svg or .html"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" "$data/plane/points.csv" --image-size 1920x1080 -o "$work/batch" --report "$work/b.svg"
+    expect_in err "--report is for one points file"
+    ;;
   view_page)
     # camproj view: one self-contained page (nothing fetched: no src= or href= to anything), the
     # camera alone or with points, a photo and a model; bad inputs named, nothing written.
