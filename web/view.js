@@ -156,7 +156,7 @@ if (data.mesh) {
     color: 0x8c96a8, transparent: true, opacity: 0.22, side: THREE.DoubleSide,
     depthWrite: false })));
   if (data.mesh.triangles.length / 3 <= 200000) {
-    scene.add(new THREE.LineSegments(new THREE.WireframeGeometry(geometry),
+    scene.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 1),
                                      new THREE.LineBasicMaterial({ color: 0xb8c0cc,
                                                                    transparent: true,
                                                                    opacity: 0.45 })));
@@ -326,7 +326,9 @@ function SetMode(next) {
   markerUniforms.cross.value = mode === 'through' ? 1 : 0;
   markerUniforms.size.value = mode === 'through' ? 15 : 11;
   if (photo) photo.style.display = mode === 'through' ? 'block' : 'none';
-  renderer.setClearColor(0x1b1d21, mode === 'through' && photo ? 0 : 1);
+  // Through the camera the image's own area is a shade lighter than the page, and outlined.
+  renderer.setClearColor(mode === 'through' ? 0x2a2d33 : 0x1b1d21, mode === 'through' && photo ? 0 : 1);
+  frame.style.outline = mode === 'through' ? '1px solid #5a5f69' : 'none';
   Layout();
   Render();
 }
@@ -491,6 +493,7 @@ if (kTestMode) {
   Render();
   document.getElementById('camproj-test-result').textContent = JSON.stringify(result);
 } else {
+  if (location.hash === '#through') SetMode('through');
   (function Loop() {
     if (mode === 'orbit') controls.update();
     Render();
