@@ -1,7 +1,7 @@
 // camproj view's page in a real browser (headless Chromium, WebGL2 on SwiftShader, no GPU): the
 // page's view through the camera renders each point where `camproj project` puts it, and its
 // orbit view draws something. The artifacts (camera, page, screenshots, the page's measurements)
-// stay in the build's tests/view_artifacts/ folder.
+// stay in the build's tests/view_artifacts/CASE/ folders.
 //
 // Without Chromium each case is skipped with the reason, unless CAMPROJ_REQUIRE_BROWSER=1 (.ci/run
 // sets it), which makes it fail instead. CAMPROJ_CHROMIUM names the browser to use.
@@ -109,7 +109,9 @@ class ViewBrowserTest : public ::testing::Test {
       }
       GTEST_SKIP() << reason;
     }
-    artifacts_ = fs::path(CAMPROJ_TEST_OUTPUT_DIR) / "view_artifacts";
+    // A folder per case: ctest runs the cases in parallel.
+    artifacts_ = fs::path(CAMPROJ_TEST_OUTPUT_DIR) / "view_artifacts" /
+                 ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::create_directories(artifacts_);
   }
 
@@ -148,6 +150,7 @@ TEST_F(ViewBrowserTest, ThroughTheCameraPointsLandWhereCamprojProjectPutsThem) {
   ASSERT_FALSE(HasFailure());
   const CommandRun dom = RunCommand(Browser("test") + " --dump-dom " +
                              Quote("file://" + page.string() + "#camproj-test"));
+  fs::remove_all(artifacts_ / "profile-test");
   ASSERT_EQ(dom.status, 0) << "chromium --dump-dom failed";
   {
     std::ofstream(artifacts_ / "view_test_dom.html") << dom.out;
@@ -210,6 +213,7 @@ TEST_F(ViewBrowserTest, OrbitViewScreenshotShowsTheScene) {
   fs::remove(shot);
   const CommandRun run = RunCommand(Browser("orbit") + " --screenshot=" + Quote(shot.string()) + " " +
                              Quote("file://" + page.string()));
+  fs::remove_all(artifacts_ / "profile-orbit");
   ASSERT_EQ(run.status, 0) << "chromium --screenshot failed";
   const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_COLOR);
   ASSERT_FALSE(image.empty()) << "no screenshot at " << shot;
