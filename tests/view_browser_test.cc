@@ -70,8 +70,14 @@ CommandRun RunCommand(const std::string& command) {
   return run;
 }
 
-std::string FindChromium() {
-  if (const char* given = std::getenv("CAMPROJ_CHROMIUM"); given && *given) return given;
+// The browser, or "" with `why` set.
+std::string FindChromium(std::string& why) {
+  if (const char* given = std::getenv("CAMPROJ_CHROMIUM"); given && *given) {
+    if (access(given, X_OK) == 0) return given;
+    why = std::string("CAMPROJ_CHROMIUM=") + given + " is not an executable";
+    return "";
+  }
+  why = "chromium, chromium-browser or google-chrome on PATH, or CAMPROJ_CHROMIUM";
   const char* path = std::getenv("PATH");
   std::stringstream folders(path ? path : "");
   std::string folder;
@@ -98,12 +104,12 @@ std::string Unescape(std::string text) {
 class ViewBrowserTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    chromium_ = FindChromium();
+    std::string why;
+    chromium_ = FindChromium(why);
     if (chromium_.empty()) {
       const char* require = std::getenv("CAMPROJ_REQUIRE_BROWSER");
       const std::string reason =
-          "no Chromium (chromium, chromium-browser or google-chrome on PATH, or "
-          "CAMPROJ_CHROMIUM): bash scripts/install-deps.sh installs Debian's chromium";
+          "no Chromium (" + why + "): bash scripts/install-deps.sh installs Debian's chromium";
       if (require && std::string(require) == "1") {
         FAIL() << "CAMPROJ_REQUIRE_BROWSER=1 but there is " << reason;
       }
@@ -134,8 +140,14 @@ class ViewBrowserTest : public ::testing::Test {
     CommandRun fit = RunCommand(cli + " fit " + points + " --image-size 1920x1080 -o " +
                          Quote(camera_.string()));
     EXPECT_EQ(fit.status, 0) << fit.out;
-    CommandRun view = RunCommand(cli + " view " + Quote(camera_.string()) + " " + points + " -o " +
-                          Quote(page.string()));
+    // A photo of the camera's size: the overlay of the fit (its markers sit where the page's
+    // must; the page draws the photo behind the view through the camera).
+    const fs::path photo = artifacts_ / "photo.png";
+    CommandRun overlay = RunCommand(cli + " overlay " + Quote(camera_.string()) + " " + points +
+                                    " -o " + Quote(photo.string()));
+    EXPECT_EQ(overlay.status, 0) << overlay.out;
+    CommandRun view = RunCommand(cli + " view " + Quote(camera_.string()) + " " + points +
+                                 " --image " + Quote(photo.string()) + " -o " + Quote(page.string()));
     EXPECT_EQ(view.status, 0) << view.out;
     return page;
   }
