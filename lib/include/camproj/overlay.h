@@ -42,7 +42,7 @@ struct OverlayLabel {
 };
 
 struct OverlayStats {
-  int drawn = 0;     // points drawn with a reprojection
+  int drawn = 0;     // points the fit kept that are in front of the camera (outside ones included)
   int behind = 0;    // points behind the camera (ring and id, no reprojection)
   int outliers = 0;  // points drawn as outliers
   int outside = 0;   // observed pixels outside the image (arrows at the border)
