@@ -119,6 +119,11 @@ class FitReport:
     def consistency(self) -> str: ...
     @property
     def determination(self) -> str: ...
+    @property
+    def linearity(self) -> Optional[dict[str, Any]]:
+        """Whether the covariance's linearization holds out to the 99.99 % region (fit.h
+        LinearityCheck): linear, level, worst_deviation, bound, worst_direction, summary; None
+        without a covariance."""
 
 class Camera:
     """A camera: image size, intrinsics (cx, cy in OpenCV's origin), the cam_from_world pose and

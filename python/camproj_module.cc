@@ -308,7 +308,18 @@ PYBIND11_MODULE(camproj, m) {
       .def_property_readonly("left_out_parameters", [](const FitResult& f) { return FitRecordOf(f).left_out; })
       .def_property_readonly("fixed_parameters", [](const FitResult& f) { return FitRecordOf(f).fixed; })
       .def_property_readonly("consistency", [](const FitResult& f) { return f.consistency.summary; })
-      .def_property_readonly("determination", [](const FitResult& f) { return f.determination.summary; });
+      .def_property_readonly("determination", [](const FitResult& f) { return f.determination.summary; })
+      .def_property_readonly("linearity", [](const FitResult& f) -> py::object {
+        if (!f.linearity.checked) return py::none();
+        py::dict d;
+        d["linear"] = f.linearity.linear;
+        d["level"] = f.linearity.level;
+        d["worst_deviation"] = f.linearity.worst_deviation;
+        d["bound"] = f.linearity.bound;
+        d["worst_direction"] = f.linearity.worst_direction;
+        d["summary"] = LinearityText(f.linearity);
+        return d;
+      });
 
   py::class_<PyCamera>(m, "Camera", "A camera: image size, intrinsics (cx, cy in OpenCV's pixel "
                                     "origin), cam_from_world pose, GL depth range.")

@@ -242,6 +242,89 @@ EOF
     expect_exit 2 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/missing.jpg" -o "$work/p.png"
     [[ ! -e "$work/p.png" ]] || fail "partial output"
     ;;
+  overlay_which_click)
+    # Two clicks moved by 180 px and 120 px: the fit leaves them out, and the overlay names them
+    # (kind outlier in the label table, how far off), ids for every point, a JPEG for .jpg.
+    py -c "
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+out, header, row = [], None, 0
+for line in lines:
+    if line.startswith('#') or header is None:
+        if not line.startswith('#'): header = line.split(',')
+        out.append(line); continue
+    f = line.split(','); row += 1
+    if row == 3: f[header.index('u')] = str(float(f[header.index('u')]) + 180)
+    if row == 7: f[header.index('v')] = str(float(f[header.index('v')]) - 120)
+    out.append(','.join(f))
+open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.csv" "$work/mis.csv"
+    expect_exit 0 "$bin" fit "$work/mis.csv" --image-size 1920x1080 -o "$work/cam.json"
+    expect_exit 0 "$bin" overlay "$work/cam.json" "$work/mis.csv" -o "$work/o.jpg" --labels "$work/labels.csv"
+    expect_in out "18 points, 2 outliers; residuals x "
+    [[ $(head -c 3 "$work/o.jpg" | od -An -tx1 | tr -d ' \n') == ffd8ff ]] || fail "not a JPEG"
+    [[ $(grep -c ',outlier,' "$work/labels.csv") -eq 2 ]] || fail "outliers not labelled: $(cat "$work/labels.csv")"
+    grep -q '^3,outlier,' "$work/labels.csv" || fail "point 3 not an outlier"
+    grep -q '^7,outlier,' "$work/labels.csv" || fail "point 7 not an outlier"
+    [[ $(tail -n +2 "$work/labels.csv" | wc -l) -eq 20 ]] || fail "not one label per point"
+    # The label table is an output too: it may not replace an input.
+    expect_exit 2 "$bin" overlay "$work/cam.json" "$work/mis.csv" -o "$work/o2.png" --labels "$work/mis.csv"
+    [[ ! -e "$work/o2.png" ]] || fail "wrote the picture although the labels would replace an input"
+    ;;
+  fit_report)
+    # camproj fit --report: an SVG (well-formed XML) with a bar per point, an arrow per kept point,
+    # the models tried; .html wraps it with the summary; other extensions refused before fitting.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.svg"
+    py -c "import sys, xml.dom.minidom as m; d = m.parse(sys.argv[1]); n = len(d.getElementsByTagName('rect')); sys.exit(0 if n >= 21 else 1)" "$work/r.svg" \
+      || fail "the report is not well-formed SVG with a bar per point"
+    [[ $(grep -c "marker-end='url(#head)'" "$work/r.svg") -eq 20 ]] || fail "not an arrow per point"
+    expect_in_file() { grep -q -- "$2" "$1" || fail "$1 lacks '$2'"; }
+    expect_in_file "$work/r.svg" "Models tried, in order: BIC"
+    expect_in_file "$work/r.svg" "pose+focal+principal-point"
+    expect_in_file "$work/r.svg" "Residuals over the image (1920x1080 px): arrows x "
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.html"
+    expect_in_file "$work/r.html" "<svg"
+    expect_in_file "$work/r.html" "model: pose+focal+principal-point"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.png"
+    expect_in err "a report is .svg or .html"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" "$data/plane/points.csv" --image-size 1920x1080 -o "$work/batch" --report "$work/b.svg"
+    expect_in err "--report is for one points file"
+    ;;
+  view_page)
+    # camproj view: one self-contained page (nothing fetched: no src= or href= to anything), the
+    # camera alone or with points, a photo and a model; bad inputs named, nothing written.
+    expect_exit 0 "$bin" view "$data/projector/truth.json" -o "$work/camera_only.html"
+    expect_in out "wrote $work/camera_only.html (0 points"
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/photo.jpg"
+    printf 'o box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf -4/1 -3/2 -2/3\n' >"$work/box.obj"
+    expect_exit 0 "$bin" view "$data/projector/truth.json" "$data/projector/points.csv" \
+      --image "$work/photo.jpg" --mesh "$work/box.obj" -o "$work/v.html"
+    expect_in out "(20 points, 3 triangles"
+    grep -q '<pre id="camproj-test-result">' "$work/v.html" || fail "no test element"
+    grep -q '"data_url":"data:image/jpeg;base64,' "$work/v.html" || fail "photo not inlined"
+    if grep -Eiq '<(script|img|link|iframe)[^>]*(src|href)=' "$work/v.html"; then
+      fail "the page refers to another file"
+    fi
+    # Bad model: the file, the line, what is wrong; the old page stays.
+    cp "$work/v.html" "$work/v.orig.html"
+    printf 'v 0 0 0\nv 1 0 x\n' >"$work/bad.obj"
+    expect_exit 2 "$bin" view "$data/projector/truth.json" --mesh "$work/bad.obj" -o "$work/v.html"
+    expect_in err "bad.obj: line 2: vertex coordinate 3 is not a finite number"
+    printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\n' >"$work/bad.obj"
+    expect_exit 2 "$bin" view "$data/projector/truth.json" --mesh "$work/bad.obj" -o "$work/v.html"
+    expect_in err "bad.obj: line 3: face vertex 3 refers to vertex 3 but 2 are defined so far"
+    cmp -s "$work/v.html" "$work/v.orig.html" || fail "a failed view replaced the page"
+    # A photo of another size; an output that is an input; not .html.
+    expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/photo.png"
+    py -c "import json,sys; c=json.load(open(sys.argv[1])); c['image_size']=[960,540]; json.dump(c, open(sys.argv[2],'w'))" \
+      "$data/projector/truth.json" "$work/small.json"
+    expect_exit 2 "$bin" view "$work/small.json" --image "$work/photo.png" -o "$work/s.html"
+    expect_in err "photo.png: image is 1920x1080 but the camera's image size is 960x540"
+    [[ ! -e "$work/s.html" ]] || fail "wrote a page for a photo of the wrong size"
+    cp "$data/projector/truth.json" "$work/cam.html"
+    expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
+    expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"
+    expect_in err "must end in .html"
+    ;;
   deep_json_refused)
     # 100000 nested arrays inside a checked key (200 KB, under the 1 MiB limit): main crashed in
     # nlohmann's recursive dump() building the message (SIGSEGV, exit 139).

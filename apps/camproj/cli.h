@@ -42,6 +42,7 @@ Command AddProjectCommand(CLI::App& root);
 Command AddConvertCommand(CLI::App& root);
 Command AddSynthCommand(CLI::App& root);
 Command AddOverlayCommand(CLI::App& root);
+Command AddViewCommand(CLI::App& root);
 
 }  // namespace camproj::cli
 

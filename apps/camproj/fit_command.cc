@@ -20,6 +20,7 @@
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/fit.h"
+#include "camproj/fit_plots.h"
 #include "camproj/fit_report.h"
 #include "camproj/fit_request.h"
 #include "camproj/model_select.h"
@@ -38,6 +39,7 @@ struct FitArgs {
   std::string output_path;
   bool json = false;
   bool trace = false;
+  std::string report_path;
   std::string model = "auto";
   std::string criterion = "bic";
   std::vector<std::string> free;
@@ -319,6 +321,10 @@ Command AddFitCommand(CLI::App& root) {
                 "print the camera file to stdout instead of the summary; in batch mode one JSON "
                 "object per input and line (file, status, exit_code, detail, camera_file)");
   app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
+  app->add_option("--report", args->report_path,
+                  "also write plots of the fit, drawn by camproj: .svg (residual per point, "
+                  "residuals over the image, the models tried with their criterion) or .html "
+                  "(the same with the summary)");
   app->add_option("--model", args->model,
                   "auto (default): the simplest model the data support; or the free intrinsics "
                   "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
@@ -375,6 +381,10 @@ Command AddFitCommand(CLI::App& root) {
             const FitRequest request = RequestFrom(*args, size);
             const std::vector<std::string> inputs = ExpandInputs(args->points_paths);
             if (inputs.size() > 1 || std::filesystem::is_directory(args->points_paths.front())) {
+              if (!args->report_path.empty()) {
+                throw UsageError("--report is for one points file (a batch writes one camera "
+                                 "file per input; fit a file alone for its report)");
+              }
               return FitBatch(inputs, size, request, *args);
             }
             const auto begin = std::chrono::steady_clock::now();
@@ -382,9 +392,31 @@ Command AddFitCommand(CLI::App& root) {
               RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path,
                                                             args->object_points_path});
             }
+            if (!args->report_path.empty()) {
+              try {
+                FitReportFormatOfPath(args->report_path);
+              } catch (const std::invalid_argument& e) {
+                throw UsageError(std::string("--report: ") + e.what());
+              }
+              RequireOutputIsNotAnInput(args->report_path,
+                                        {inputs.front(), args->intrinsics_path,
+                                         args->object_points_path, args->output_path});
+            }
             const auto [data, fit] = FitFile(inputs.front(), size, request);
             const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
             if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
+            if (!args->report_path.empty()) {
+              std::vector<Eigen::Vector2d> observed = data.pixels;
+              for (auto& p : observed) {
+                p = ConvertPixelOrigin(p, request.options().pixel_origin, PixelOrigin::kCenter);
+              }
+              WriteFileAtomically(
+                  args->report_path,
+                  FitReportFormatOfPath(args->report_path) == "svg"
+                      ? FitReportSvg(fit, observed, data.ids)
+                      : FitReportHtml(fit, observed, data.ids, FitSummaryText(fit, data.ids),
+                                      "camproj fit " + inputs.front()));
+            }
             if (args->json) {
               std::cout << text;
             } else {

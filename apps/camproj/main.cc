@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
       "camproj: make an OpenGL camera see exactly what a real camera or projector sees.\n\n"
       "Fit a camera to 2D-3D correspondences, export it as OpenGL / glm / OpenCV / COLMAP /\n"
       "three.js matrices, project points, convert between intrinsics, frustum and projection\n"
-      "matrices. Pixels follow OpenCV's convention ((0,0) is the centre of the top-left pixel)\n"
+      "matrices, draw a fit over its image (overlay) or as a 3D page (view). Pixels follow\n"
+      "OpenCV's convention ((0,0) is the centre of the top-left pixel)\n"
       "unless --pixel-origin corner; every convention is in docs/conventions.md.\n\n"
       "Exit codes: 0 ok, 1 usage, 2 bad input (names the file, line and field), 3 the points\n"
       "cannot determine the requested camera (says why and what to fix).\n\n"
@@ -34,7 +35,8 @@ int main(int argc, char** argv) {
                "also show the log lines of the libraries camproj calls (Ceres/glog, OpenCV)");
   const std::vector<Command> commands = {AddFitCommand(app),     AddExportCommand(app),
                                          AddProjectCommand(app), AddConvertCommand(app),
-                                         AddSynthCommand(app),   AddOverlayCommand(app)};
+                                         AddSynthCommand(app),   AddOverlayCommand(app),
+                                         AddViewCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

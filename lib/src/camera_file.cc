@@ -247,6 +247,26 @@ Intrinsics ReadIntrinsicsFile(const std::string& path) {
   return IntrinsicsFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
 }
 
+std::vector<int> OutlierIndicesFromJsonText(const std::string& text, const std::string& source) {
+  const auto document = ParseJson(text, source);
+  std::vector<int> outliers;
+  if (!document.is_object() || !document.contains("fit") || !document["fit"].is_object() ||
+      !document["fit"].contains("outliers")) {
+    return outliers;
+  }
+  const auto& list = document["fit"]["outliers"];
+  if (!list.is_array()) throw InputError(source + ": fit.outliers must be an array of indices");
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (!list[i].is_number_integer() || list[i].get<int64_t>() < 0 ||
+        list[i].get<int64_t>() > std::numeric_limits<int>::max()) {
+      throw InputError(internal::Concat(source, ": fit.outliers[", i,
+                                        "] must be a non-negative integer index"));
+    }
+    outliers.push_back(list[i].get<int>());
+  }
+  return outliers;
+}
+
 Camera ReadCameraFile(const std::string& path) {
   // A camera file is a few kilobytes; a megabyte bound refuses a wrong file early.
   return CameraFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);

@@ -1,7 +1,11 @@
 #include "camproj/overlay.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
+#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -25,8 +29,10 @@ cv::Point Fixed(const Eigen::Vector2d& p) {
 }  // namespace
 
 void OverlayOptions::Check() const {
-  internal::Require(std::isfinite(magnify) && magnify > 0.0, "magnify must be positive, got ",
-                    magnify);
+  internal::Require(std::isfinite(magnify) && magnify >= 0.0,
+                    "magnify must be positive (or 0: automatic), got ", magnify);
+  internal::Require(residual_fraction > 0.0 && residual_fraction <= 1.0,
+                    "residual_fraction must be in (0, 1], got ", residual_fraction);
 }
 
 namespace {
@@ -63,6 +69,240 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
 
 }  // namespace
 
+namespace {
+
+// Viridis (matplotlib's colour-blind-safe, perceptually uniform scale) from OpenCV, as BGR.
+cv::Scalar Viridis(double t) {
+  static const cv::Mat lut = [] {
+    cv::Mat ramp(1, 256, CV_8UC1);
+    for (int i = 0; i < 256; ++i) ramp.at<uchar>(0, i) = static_cast<uchar>(i);
+    cv::Mat coloured;
+    cv::applyColorMap(ramp, coloured, cv::COLORMAP_VIRIDIS);
+    return coloured;
+  }();
+  const int i = static_cast<int>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0));
+  const cv::Vec3b c = lut.at<cv::Vec3b>(0, i);
+  return cv::Scalar(c[0], c[1], c[2]);
+}
+const cv::Scalar kOutlierColour(31, 90, 255);  // vermillion (BGR), away from viridis's hues
+const cv::Scalar kBehindColour(170, 170, 170);
+const cv::Scalar kInk(0, 0, 0);
+const cv::Scalar kWhite(255, 255, 255);
+
+// 1, 2 or 5 times a power of ten, at most `x`, at least 1.
+double NiceFloor(double x) {
+  if (!(x > 1.0)) return 1.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(x)));
+  for (double m : {5.0, 2.0, 1.0}) {
+    if (m * decade <= x) return m * decade;
+  }
+  return decade;
+}
+
+std::string FormatPx(double px) {
+  char text[32];
+  std::snprintf(text, sizeof text, px < 10 ? "%.2f" : px < 100 ? "%.1f" : "%.0f", px);
+  return text;
+}
+
+struct Style {
+  double unit;  // px per "design pixel": 1 at 480 px and below, 2 at 1080, 4 at 2160 (4K)
+  int line;
+  int text_thickness;
+  double font_scale;
+  double ring;  // radius
+};
+
+Style StyleFor(int w, int h) {
+  Style s;
+  s.unit = std::max(1.0, std::min(w, h) / 540.0);
+  s.line = std::max(1, static_cast<int>(std::lround(s.unit)));
+  s.text_thickness = std::max(1, static_cast<int>(std::lround(0.8 * s.unit)));
+  s.font_scale = 0.45 * s.unit;  // Hershey simplex: digits ~10 px high at 480p, ~20 at 1080p
+  s.ring = 6.0 * s.unit;
+  return s;
+}
+
+// Text with a dark halo, legible on any photo.
+void HaloText(cv::Mat& image, const std::string& text, cv::Point origin, const Style& s,
+              const cv::Scalar& colour) {
+  cv::putText(image, text, origin, cv::FONT_HERSHEY_SIMPLEX, s.font_scale, kInk,
+              s.text_thickness + 2 * s.line, cv::LINE_AA);
+  cv::putText(image, text, origin, cv::FONT_HERSHEY_SIMPLEX, s.font_scale, colour,
+              s.text_thickness, cv::LINE_AA);
+}
+
+void HaloLine(cv::Mat& image, const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Style& s,
+              const cv::Scalar& colour) {
+  cv::line(image, Fixed(a), Fixed(b), kInk, s.line + 2, cv::LINE_AA, kShift);
+  cv::line(image, Fixed(a), Fixed(b), colour, s.line, cv::LINE_AA, kShift);
+}
+
+void Ring(cv::Mat& image, const Eigen::Vector2d& c, const Style& s, const cv::Scalar& colour) {
+  const int r = static_cast<int>(std::lround(s.ring * 16));
+  cv::circle(image, Fixed(c), r, kInk, s.line + 2, cv::LINE_AA, kShift);
+  cv::circle(image, Fixed(c), r, colour, s.line, cv::LINE_AA, kShift);
+}
+
+void Cross(cv::Mat& image, const Eigen::Vector2d& c, double half, const Style& s,
+           const cv::Scalar& colour, bool diagonal) {
+  const Eigen::Vector2d a = diagonal ? Eigen::Vector2d(half, half) : Eigen::Vector2d(half, 0);
+  const Eigen::Vector2d b = diagonal ? Eigen::Vector2d(half, -half) : Eigen::Vector2d(0, half);
+  HaloLine(image, c - a, c + a, s, colour);
+  HaloLine(image, c - b, c + b, s, colour);
+}
+
+// An arrow inside the image's border pointing at `target` (outside the image): tail, tip.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> BorderArrow(const Eigen::Vector2d& target, int w, int h,
+                                                        const Style& s) {
+  const double margin = 4.0 * s.ring;
+  const Eigen::Vector2d tip(std::clamp(target.x(), margin, w - 1 - margin),
+                            std::clamp(target.y(), margin, h - 1 - margin));
+  Eigen::Vector2d direction = target - tip;
+  direction.normalize();
+  return {tip - 4.0 * s.ring * direction, tip};
+}
+
+void DrawArrow(cv::Mat& image, const std::pair<Eigen::Vector2d, Eigen::Vector2d>& arrow,
+               const Style& s, const cv::Scalar& colour) {
+  const auto& [tail, tip] = arrow;
+  cv::arrowedLine(image, Fixed(tail), Fixed(tip), kInk, 2 * s.line + 3, cv::LINE_AA, kShift, 0.35);
+  cv::arrowedLine(image, Fixed(tail), Fixed(tip), colour, 2 * s.line, cv::LINE_AA, kShift, 0.35);
+}
+
+struct Box {
+  double x0, y0, x1, y1;
+  double Overlap(const Box& o) const {
+    const double w = std::min(x1, o.x1) - std::max(x0, o.x0);
+    const double h = std::min(y1, o.y1) - std::max(y0, o.y0);
+    return w > 0 && h > 0 ? w * h : 0.0;
+  }
+};
+
+// Puts each label at the first of eight places around its marker that covers no marker and no
+// label placed before it and stays inside the image; where none does, at the place that covers
+// least. Labels are placed in `order` (the largest residuals first: their ids matter most).
+std::vector<Box> PlaceLabels(const std::vector<Eigen::Vector2d>& anchors,
+                             const std::vector<cv::Size>& sizes, const std::vector<size_t>& order,
+                             int w, int h, const Style& s, std::vector<Box> obstacles) {
+  for (const Eigen::Vector2d& a : anchors) {
+    obstacles.push_back({a.x() - s.ring, a.y() - s.ring, a.x() + s.ring, a.y() + s.ring});
+  }
+  std::vector<Box> placed(anchors.size());
+  const double gap = s.ring + 2.0 * s.unit;
+  for (size_t i : order) {
+    const double tw = sizes[i].width, th = sizes[i].height;
+    const Eigen::Vector2d a = anchors[i];
+    const Box candidates[8] = {
+        {a.x() + gap, a.y() - gap - th, a.x() + gap + tw, a.y() - gap},          // upper right
+        {a.x() + gap, a.y() - th / 2, a.x() + gap + tw, a.y() + th / 2},         // right
+        {a.x() + gap, a.y() + gap, a.x() + gap + tw, a.y() + gap + th},          // lower right
+        {a.x() - gap - tw, a.y() - gap - th, a.x() - gap, a.y() - gap},          // upper left
+        {a.x() - gap - tw, a.y() - th / 2, a.x() - gap, a.y() + th / 2},         // left
+        {a.x() - gap - tw, a.y() + gap, a.x() - gap, a.y() + gap + th},          // lower left
+        {a.x() - tw / 2, a.y() - gap - th, a.x() + tw / 2, a.y() - gap},         // above
+        {a.x() - tw / 2, a.y() + gap, a.x() + tw / 2, a.y() + gap + th}};        // below
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (const Box& c : candidates) {
+      double cost = 0.0;
+      // Outside the image costs as much as covering a label of its size.
+      const Box inside{std::max(c.x0, 0.0), std::max(c.y0, 0.0), std::min(c.x1, w - 1.0),
+                       std::min(c.y1, h - 1.0)};
+      cost += tw * th - std::max(0.0, inside.x1 - inside.x0) * std::max(0.0, inside.y1 - inside.y0);
+      for (const Box& o : obstacles) cost += c.Overlap(o);
+      if (cost < best_cost) {
+        best_cost = cost;
+        placed[i] = c;
+        if (cost == 0.0) break;
+      }
+    }
+    obstacles.push_back(placed[i]);
+  }
+  return placed;
+}
+
+// The legend: symbols, the magnification and what it makes of the largest residual, the colour
+// scale, the counts of outliers, points outside the image and behind the camera. Returns its box.
+Box DrawLegend(cv::Mat& image, const OverlayStats& stats, const std::vector<Eigen::Vector2d>& anchors,
+               const Style& s) {
+  std::vector<std::string> lines;
+  char magnify_text[32];
+  std::snprintf(magnify_text, sizeof magnify_text, "%g", stats.magnify);
+  lines.push_back(std::string("o observed    + reprojected    line: residual x ") + magnify_text);
+  lines.push_back("(the largest, " + FormatPx(stats.largest_residual_px) + " px, drawn " +
+                  FormatPx(stats.largest_residual_px * stats.magnify) + " px long)");
+  lines.push_back("colour: residual 0 px                    " + FormatPx(stats.largest_residual_px) +
+                  " px");
+  if (stats.outliers > 0) {
+    lines.push_back("x " + std::to_string(stats.outliers) + " left out by the fit (outliers)");
+  }
+  if (stats.outside > 0) {
+    lines.push_back("-> " + std::to_string(stats.outside) + " observed outside the image");
+  }
+  if (stats.behind > 0) {
+    lines.push_back(std::to_string(stats.behind) + " behind the camera (no reprojection)");
+  }
+  int baseline = 0;
+  const int line_height =
+      cv::getTextSize("Ag", cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline)
+          .height + baseline + static_cast<int>(4 * s.unit);
+  const int pad = static_cast<int>(6 * s.unit);
+  int legend_w = 0;
+  for (const std::string& line : lines) {
+    legend_w = std::max(legend_w, cv::getTextSize(line, cv::FONT_HERSHEY_SIMPLEX, s.font_scale,
+                                                  s.text_thickness, &baseline).width);
+  }
+  legend_w += 2 * pad;
+  const int legend_h = static_cast<int>(lines.size()) * line_height + 2 * pad;
+  const int w = image.cols, h = image.rows;
+  // In the corner that holds the fewest points; darkened, not opaque.
+  cv::Point corner(0, 0);
+  int fewest = std::numeric_limits<int>::max();
+  for (const cv::Point c : {cv::Point(0, 0), cv::Point(w - legend_w, 0), cv::Point(0, h - legend_h),
+                            cv::Point(w - legend_w, h - legend_h)}) {
+    int covered = 0;
+    for (const Eigen::Vector2d& a : anchors) {
+      if (a.x() >= c.x - s.ring && a.x() <= c.x + legend_w + s.ring && a.y() >= c.y - s.ring &&
+          a.y() <= c.y + legend_h + s.ring) {
+        ++covered;
+      }
+    }
+    if (covered < fewest) {
+      fewest = covered;
+      corner = c;
+    }
+  }
+  {
+    cv::Mat region = image(cv::Rect(corner, cv::Size(legend_w, legend_h)) & cv::Rect(0, 0, w, h));
+    cv::Mat dark(region.size(), region.type(), cv::Scalar(20, 20, 20));
+    cv::addWeighted(region, 0.3, dark, 0.7, 0.0, region);
+  }
+  for (size_t k = 0; k < lines.size(); ++k) {
+    const cv::Point origin(corner.x + pad,
+                           corner.y + pad + static_cast<int>(k + 1) * line_height - baseline -
+                               static_cast<int>(2 * s.unit));
+    HaloText(image, lines[k], origin, s, lines[k][0] == 'x' ? kOutlierColour : kWhite);
+    if (lines[k].rfind("colour:", 0) == 0) {
+      // The scale between "0 px" and the top value.
+      const int x0 = origin.x + cv::getTextSize("colour: residual 0 px ", cv::FONT_HERSHEY_SIMPLEX,
+                                                s.font_scale, s.text_thickness, &baseline).width;
+      const int x1 = origin.x + cv::getTextSize("colour: residual 0 px                   ",
+                                                cv::FONT_HERSHEY_SIMPLEX, s.font_scale,
+                                                s.text_thickness, &baseline).width;
+      const int y1 = origin.y, y0 = origin.y - line_height + static_cast<int>(6 * s.unit);
+      for (int x = x0; x < x1; ++x) {
+        cv::line(image, cv::Point(x, y0), cv::Point(x, y1),
+                 Viridis(static_cast<double>(x - x0) / std::max(1, x1 - x0 - 1)), 1);
+      }
+    }
+  }
+
+  return Box{static_cast<double>(corner.x), static_cast<double>(corner.y),
+             static_cast<double>(corner.x + legend_w), static_cast<double>(corner.y + legend_h)};
+}
+
+}  // namespace
+
 OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
                                const OverlayOptions& options, const std::string& output_path) {
   options.Check();
@@ -75,43 +315,135 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
         "the camera's image size ", w, "x", h, " is beyond the ", kMaxImagePixels,
         " pixels an overlay may have (8192 x 8192)"));
   }
+  const size_t n = correspondences.pixels.size();
+  std::vector<bool> outlier(n, false);
+  for (int i : options.outliers) {
+    internal::Require(i >= 0 && static_cast<size_t>(i) < n, "outlier index ", i,
+                      " is beyond the ", n, " points (are they the points the camera was fitted to?)");
+    outlier[i] = true;
+  }
   cv::Mat image;
   if (options.background_path.empty()) {
     image = cv::Mat(h, w, CV_8UC3, cv::Scalar(40, 40, 40));
   } else {
     image = ReadBackground(options.background_path, w, h);
   }
-  const double scale = std::max(1.0, std::max(w, h) / 1000.0);
-  const int thickness = static_cast<int>(std::lround(scale));
-  const int radius = static_cast<int>(std::lround(4 * scale * 16));
-  const cv::Scalar observed_colour(0, 220, 255);   // yellow: observed
-  const cv::Scalar predicted_colour(255, 160, 0);  // blue: reprojected
-  const cv::Scalar residual_colour(60, 60, 255);   // red: residual x magnify
+  const Style s = StyleFor(w, h);
   OverlayStats stats;
-  for (size_t i = 0; i < correspondences.pixels.size(); ++i) {
-    const Eigen::Vector2d& observed = correspondences.pixels[i];
-    const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, correspondences.points_in_world[i]);
-    cv::circle(image, Fixed(observed), radius, observed_colour, thickness, cv::LINE_AA, kShift);
-    if (!predicted) {
-      ++stats.behind;
-      continue;
+
+  std::vector<std::optional<Eigen::Vector2d>> predicted(n);
+  std::vector<double> residual(n, -1.0);
+  for (size_t i = 0; i < n; ++i) {
+    predicted[i] = PixelFromWorld(camera, correspondences.points_in_world[i]);
+    if (predicted[i]) residual[i] = (*predicted[i] - correspondences.pixels[i]).norm();
+    const Eigen::Vector2d& o = correspondences.pixels[i];
+    const bool observed_inside = o.x() >= -0.5 && o.x() <= w - 0.5 && o.y() >= -0.5 && o.y() <= h - 0.5;
+    if (predicted[i] && !outlier[i] && observed_inside) {
+      stats.largest_residual_px = std::max(stats.largest_residual_px, residual[i]);
     }
-    const Eigen::Vector2d tip = observed + options.magnify * (*predicted - observed);
-    cv::line(image, Fixed(observed), Fixed(tip), residual_colour, thickness, cv::LINE_AA, kShift);
-    cv::drawMarker(image, cv::Point(static_cast<int>(std::lround(predicted->x())),
-                                    static_cast<int>(std::lround(predicted->y()))),
-                   predicted_colour, cv::MARKER_CROSS, static_cast<int>(8 * scale), thickness);
-    ++stats.drawn;
   }
-  char legend[160];
-  std::snprintf(legend, sizeof legend,
-                "o observed   + reprojected   line: residual x %g%s", options.magnify,
-                stats.behind > 0 ? "   (some points behind the camera)" : "");
-  const double font = 0.5 * scale;
-  cv::putText(image, legend, cv::Point(10, static_cast<int>(20 * scale)), cv::FONT_HERSHEY_SIMPLEX,
-              font, cv::Scalar(0, 0, 0), 3 * thickness, cv::LINE_AA);
-  cv::putText(image, legend, cv::Point(10, static_cast<int>(20 * scale)), cv::FONT_HERSHEY_SIMPLEX,
-              font, cv::Scalar(255, 255, 255), thickness, cv::LINE_AA);
+  stats.magnify = options.magnify > 0.0
+                      ? options.magnify
+                      : NiceFloor(stats.largest_residual_px > 0.0
+                                      ? options.residual_fraction * std::min(w, h) /
+                                            stats.largest_residual_px
+                                      : 1.0);
+  const double colour_top = std::max(stats.largest_residual_px, 1e-12);
+  const auto inside = [&](const Eigen::Vector2d& p) {
+    return p.x() >= -0.5 && p.x() <= w - 0.5 && p.y() >= -0.5 && p.y() <= h - 0.5;
+  };
+
+  // What each point is; then the legend (first, so that markers and ids stay on top of it),
+  // the markers, and the ids placed around them.
+  std::vector<Eigen::Vector2d> anchors(n);
+  std::vector<std::string> kinds(n);
+  std::vector<cv::Scalar> colours(n);
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& observed = correspondences.pixels[i];
+    anchors[i] = observed;
+    if (!predicted[i]) {
+      kinds[i] = "behind";
+      colours[i] = kBehindColour;
+      ++stats.behind;
+    } else if (outlier[i]) {
+      kinds[i] = "outlier";
+      colours[i] = kOutlierColour;
+      ++stats.outliers;
+    } else {
+      kinds[i] = "point";
+      colours[i] = Viridis(residual[i] / colour_top);
+      ++stats.drawn;
+    }
+    if (!inside(observed)) {
+      kinds[i] = "outside";
+      ++stats.outside;
+      arrows[i] = BorderArrow(observed, w, h, s);
+      anchors[i] = arrows[i].first;
+    }
+  }
+  const Box legend_box = DrawLegend(image, stats, anchors, s);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& observed = correspondences.pixels[i];
+    if (kinds[i] == "outside") {
+      DrawArrow(image, arrows[i], s, colours[i]);
+    } else if (kinds[i] == "point") {
+      HaloLine(image, observed, observed + stats.magnify * (*predicted[i] - observed), s,
+               colours[i]);
+      Cross(image, *predicted[i], 0.8 * s.ring, s, kWhite, false);
+      Ring(image, observed, s, colours[i]);
+    } else if (kinds[i] == "outlier") {
+      Ring(image, observed, s, colours[i]);
+      Cross(image, observed, 0.7 * s.ring, s, colours[i], true);
+    } else {
+      Ring(image, observed, s, colours[i]);
+    }
+  }
+  std::vector<std::string> texts(n);
+  std::vector<cv::Size> sizes(n);
+  for (size_t i = 0; i < n; ++i) {
+    texts[i] = correspondences.ids[i];
+    if (texts[i].size() > 24) texts[i] = texts[i].substr(0, 23) + "~";
+    for (char& c : texts[i]) {
+      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+    }
+    if (kinds[i] == "outlier") texts[i] += " (" + FormatPx(residual[i]) + " px off)";
+    if (kinds[i] == "behind") texts[i] += " (behind)";
+    if (kinds[i] == "outside") {
+      char at[64];
+      std::snprintf(at, sizeof at, " (at %.0f, %.0f)", correspondences.pixels[i].x(),
+                    correspondences.pixels[i].y());
+      texts[i] += at;
+    }
+    int baseline = 0;
+    const cv::Size size =
+        cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
+    sizes[i] = cv::Size(size.width + 2 * s.line, size.height + baseline + 2 * s.line);
+  }
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = i;
+  const auto rank = [&](size_t i) {
+    return kinds[i] == "outlier" ? 2e300 : kinds[i] == "outside" ? 1e300 : residual[i];
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(a) > rank(b); });
+  const std::vector<Box> boxes = PlaceLabels(anchors, sizes, order, w, h, s, {legend_box});
+  for (size_t i = 0; i < n; ++i) {
+    const Box& b = boxes[i];
+    int baseline = 0;
+    cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
+    HaloText(image, texts[i],
+             cv::Point(static_cast<int>(std::lround(b.x0 + s.line)),
+                       static_cast<int>(std::lround(b.y1 - baseline - s.line))),
+             s, kinds[i] == "point" ? kWhite : colours[i]);
+    OverlayLabel label;
+    label.id = correspondences.ids[i];
+    label.kind = kinds[i];
+    label.anchor = kinds[i] == "outside" ? correspondences.pixels[i] : anchors[i];
+    label.box = Eigen::Vector4d(b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
+    label.residual_px = residual[i];
+    stats.labels.push_back(label);
+  }
+
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
   if (!cv::imencode(extension, image, encoded)) {
@@ -119,6 +451,23 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
   }
   WriteFileAtomically(output_path, std::string(encoded.begin(), encoded.end()));
   return stats;
+}
+
+std::string OverlayLabelsCsv(const OverlayStats& stats) {
+  std::ostringstream out;
+  out.precision(10);
+  out << "id,kind,u,v,left,top,width,height,residual_px\n";
+  for (const OverlayLabel& l : stats.labels) {
+    std::string id = l.id;
+    if (id.find_first_of(",\"\n\r") != std::string::npos) {
+      std::string quoted = "\"";
+      for (char c : id) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+      id = quoted + "\"";
+    }
+    out << id << ',' << l.kind << ',' << l.anchor.x() << ',' << l.anchor.y() << ',' << l.box[0]
+        << ',' << l.box[1] << ',' << l.box[2] << ',' << l.box[3] << ',' << l.residual_px << '\n';
+  }
+  return out.str();
 }
 
 }  // namespace camproj

@@ -1,6 +1,7 @@
 """camproj.fit against `camproj fit` on every bundled data file: the same camera file (to 1e-12
 relative, fit time aside) or the same refusal, with the same message, as a SceneError subclass."""
 import glob
+import json
 import os
 
 import pytest
@@ -13,6 +14,7 @@ DATA = os.environ.get("CAMPROJ_DATA_DIR", "/nonexistent")
 # (file under data/, image size, CLI options, the same as fit() keywords)
 CASES = [
     ("projector/points.csv", (1920, 1080), [], {}),
+    ("projector/misclicked.csv", (1920, 1080), [], {}),
     ("projector/points.csv", (1920, 1080), ["--model", "focal+principal-point"], {"model": "focal+principal-point"}),
     ("projector/points.csv", (1920, 1080), ["--model", "focal+aspect+principal-point", "--loss", "huber:2"],
      {"model": "focal+aspect+principal-point", "loss": "huber:2"}),
@@ -104,6 +106,12 @@ def test_report_fields(data_dir):
     assert value == camera.intrinsics.fx and sigma > 0 and unit == "px"
     assert report.covariance.shape == (len(report.free_parameters),) * 2
     assert "consistent" in report.consistency
+    # The linearity check, as the camera file has it (fit.h LinearityCheck).
+    linearity = report.linearity
+    fit_record = json.loads(camera.to_json())["fit"]["linearity"]
+    assert linearity["linear"] == fit_record["linear"] == (linearity["worst_deviation"] <= linearity["bound"])
+    assert linearity["worst_deviation"] == fit_record["worst_deviation"]
+    assert linearity["level"] == 0.9999 and linearity["summary"]
 
 
 @pytest.mark.parametrize("points,options,error", [

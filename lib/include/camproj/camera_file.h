@@ -78,6 +78,11 @@ Camera ReadCameraFile(const std::string& path);
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source);
 Intrinsics ReadIntrinsicsFile(const std::string& path);
 
+// The `fit.outliers` of camera-file text (0-based indices of the points the fit left out), empty
+// when there is no fit record or no outliers. Throws InputError naming `source` and the key when
+// fit.outliers is not an array of non-negative integers.
+std::vector<int> OutlierIndicesFromJsonText(const std::string& text, const std::string& source);
+
 // The camera file text: all keys of docs/camera-file.md, `fit` only when given, doubles at full
 // precision (they round-trip exactly).
 std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options = {},

@@ -1,0 +1,293 @@
+#include "camproj/view.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "camproj/camera_file.h"
+#include "camproj/errors.h"
+#include "camproj/export.h"
+#include "camproj/file_io.h"
+#include "camproj/image_header.h"
+#include "check.h"
+#include "view/assets.h"
+#include "view/obj_mesh.h"
+
+namespace camproj {
+
+void ViewOptions::Check() const {}
+
+namespace {
+
+using nlohmann::json;
+using internal::Concat;
+
+// A photo is a few MB; the same bound as the overlay's background.
+constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
+constexpr size_t kMaxMeshFileBytes = size_t{1} << 30;
+
+std::string Base64(std::string_view bytes) {
+  static constexpr char kDigits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const uint32_t n = (uint32_t{static_cast<uint8_t>(bytes[i])} << 16) |
+                       (uint32_t{static_cast<uint8_t>(bytes[i + 1])} << 8) |
+                       uint32_t{static_cast<uint8_t>(bytes[i + 2])};
+    out += kDigits[n >> 18];
+    out += kDigits[(n >> 12) & 63];
+    out += kDigits[(n >> 6) & 63];
+    out += kDigits[n & 63];
+  }
+  if (i < bytes.size()) {
+    uint32_t n = uint32_t{static_cast<uint8_t>(bytes[i])} << 16;
+    if (i + 1 < bytes.size()) n |= uint32_t{static_cast<uint8_t>(bytes[i + 1])} << 8;
+    out += kDigits[n >> 18];
+    out += kDigits[(n >> 12) & 63];
+    out += i + 1 < bytes.size() ? kDigits[(n >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+json Vec(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
+
+// The cam-frame point at `depth` (z_cam) whose pixel is `pixel` (kCenter), through `intrinsics`
+// (distortion inverted when present); for an orthographic camera the parallel ray's point.
+Eigen::Vector3d PointInCamAtDepth(const Camera& camera, const Intrinsics& intrinsics,
+                                  const Eigen::Vector2d& pixel, double depth) {
+  if (camera.projection == Projection::kOrthographic) {
+    const double y = (pixel.y() - intrinsics.cy) / intrinsics.fy;
+    const double x = (pixel.x() - intrinsics.cx - intrinsics.skew * y) / intrinsics.fx;
+    return {x, y, depth};
+  }
+  return CamRayFromPixel(intrinsics, pixel) * depth;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The page's data: everything the script draws, computed here so that the script holds no
+// geometry beyond three.js's rendering (and the pixel-origin shift).
+json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
+               const Correspondences* correspondences, ViewStats& stats) {
+  const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
+  const int w = camera.image_size.width;
+  const int h = camera.image_size.height;
+  const Intrinsics pinhole = camera.intrinsics.Pinhole();
+  std::vector<bool> outlier(correspondences ? correspondences->pixels.size() : 0, false);
+  json notes = json::array();
+  for (const int i : outlier_indices) {
+    if (static_cast<size_t>(i) < outlier.size()) {
+      outlier[i] = true;
+      ++stats.outliers;
+    } else {
+      notes.push_back(Concat("the fit's outlier index ", i, " is beyond the ", outlier.size(),
+                             " points given: are they the points it was fitted to?"));
+    }
+  }
+  // Depths of the points in front, for the image plane and the far plane drawn.
+  std::vector<double> depths;
+  json points = json::array();
+  double max_distortion_px = 0.0;
+  if (correspondences) {
+    for (const Eigen::Vector3d& x : correspondences->points_in_world) {
+      const double z = (camera.cam_from_world * x).z();
+      if (z > 0.0) depths.push_back(z);
+    }
+  }
+  const double median_depth = depths.empty() ? std::clamp(1.0, camera.z_near, camera.z_far)
+                                             : Median(depths);
+  const double max_depth = depths.empty() ? median_depth
+                                          : *std::max_element(depths.begin(), depths.end());
+  if (correspondences) {
+    for (size_t i = 0; i < correspondences->pixels.size(); ++i) {
+      const Eigen::Vector3d& x = correspondences->points_in_world[i];
+      const Eigen::Vector2d& observed = correspondences->pixels[i];
+      const double depth = (camera.cam_from_world * x).z();
+      const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, x);
+      json point = {{"id", correspondences->ids[i]},
+                    {"point_in_world", Vec(x)},
+                    {"observed_px", Vec(observed)},
+                    {"outlier", outlier[i]}};
+      ++stats.points;
+      // The observed pixel's ray, drawn from the eye to the point's depth (the median depth for a
+      // point behind the camera); beyond the distortion's fold there is no ray.
+      try {
+        const double ray_depth = depth > 0.0 ? depth : median_depth;
+        point["ray_end_in_world"] =
+            Vec(world_from_cam * PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
+      } catch (const std::domain_error&) {
+        point["ray_end_in_world"] = nullptr;
+      }
+      if (predicted) {
+        const Eigen::Vector2d linear = *PixelFromWorld(Camera{camera.image_size, pinhole,
+                                                              camera.cam_from_world, camera.z_near,
+                                                              camera.z_far, camera.projection},
+                                                       x);
+        max_distortion_px = std::max(max_distortion_px, (linear - *predicted).norm());
+        point["predicted_px"] = Vec(*predicted);
+        point["predicted_linear_px"] = Vec(linear);
+        point["residual_px"] = (*predicted - observed).norm();
+        const bool inside = predicted->x() >= -0.5 && predicted->x() <= w - 0.5 &&
+                            predicted->y() >= -0.5 && predicted->y() <= h - 0.5;
+        point["inside_image"] = inside;
+        if (!inside) ++stats.outside_image;
+      } else {
+        point["predicted_px"] = nullptr;
+        point["residual_px"] = nullptr;
+        ++stats.behind;
+      }
+      points.push_back(point);
+    }
+  }
+  if (max_distortion_px > 0.0) {
+    notes.push_back(Concat(
+        "three.js cameras are linear: k1, k2 are left out of the view through the camera, which "
+        "moves the points there by up to ",
+        std::round(max_distortion_px * 100) / 100, " px against camproj project"));
+  }
+  // The frustum drawn: near plane, the image plane at the points' median depth, a far plane just
+  // beyond the farthest point (the camera's own far plane is often far beyond the scene).
+  const double far_drawn = std::min(camera.z_far, std::max(1.25 * max_depth, 2.0 * camera.z_near));
+  const double image_depth = std::clamp(median_depth, camera.z_near, far_drawn);
+  const auto corners_at = [&](double depth) {
+    json corners = json::array();
+    const Eigen::Vector2d image_corners[4] = {
+        {-0.5, -0.5}, {w - 0.5, -0.5}, {w - 0.5, h - 0.5}, {-0.5, h - 0.5}};
+    for (const Eigen::Vector2d& c : image_corners) {
+      corners.push_back(Vec(world_from_cam * PointInCamAtDepth(camera, pinhole, c, depth)));
+    }
+    return corners;
+  };
+  json frustum = {{"near", camera.z_near},
+                  {"far", std::isfinite(camera.z_far) ? json(camera.z_far) : json("inf")},
+                  {"far_drawn", far_drawn},
+                  {"image_depth", image_depth},
+                  {"near_corners_in_world", corners_at(camera.z_near)},
+                  {"image_corners_in_world", corners_at(image_depth)},
+                  {"far_corners_in_world", corners_at(far_drawn)}};
+  json scene = {{"image_size", {w, h}},
+                {"projection", camera.projection == Projection::kOrthographic ? "orthographic"
+                                                                               : "perspective"},
+                {"eye_in_world", Vec(world_from_cam.translation)},
+                {"frustum", frustum},
+                {"points", points},
+                {"notes", notes}};
+  ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
+  scene["three"] = json::parse(ExportCamera(camera, ExportFormat::kThree, export_options));
+  return scene;
+}
+
+json ImageJson(const std::string& path, const Camera& camera) {
+  const std::string bytes = ReadWholeFile(path, kMaxImageFileBytes);
+  const ImageHeader header = ReadImageHeader(bytes, path);
+  if (header.width != camera.image_size.width || header.height != camera.image_size.height) {
+    throw InputError(Concat(path, ": image is ", header.width, "x", header.height,
+                            " but the camera's image size is ", camera.image_size.width, "x",
+                            camera.image_size.height));
+  }
+  const char* mime = header.format == ImageFormat::kPng ? "image/png" : "image/jpeg";
+  return {{"name", path}, {"data_url", std::string("data:") + mime + ";base64," + Base64(bytes)}};
+}
+
+json MeshJson(const std::string& path, ViewStats& stats) {
+  const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path, kMaxMeshFileBytes), path);
+  stats.mesh_triangles = static_cast<int>(mesh.triangles.size() / 3);
+  return {{"name", path}, {"positions", mesh.positions}, {"triangles", mesh.triangles}};
+}
+
+// JSON inside a <script> element: '<' escaped so that no "</script" or "<!--" can end or change
+// the element (it occurs only inside strings, where \u003c reads back as '<').
+std::string ScriptSafeJson(const json& value) {
+  const std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    if (c == '<') {
+      out += "\\u003c";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string HtmlEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+void ReplaceOnce(std::string& text, const std::string& key, const std::string& value) {
+  const size_t at = text.find(key);
+  if (at == std::string::npos) throw std::logic_error("web/view.html lacks " + key);
+  text.replace(at, key.size(), value);
+}
+
+}  // namespace
+
+std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_text,
+                         const std::string& camera_name, const Correspondences* correspondences,
+                         const ViewOptions& options, ViewStats* stats_out) {
+  options.Check();
+  camera.Check();
+  ViewStats stats;
+  json fit = nullptr;
+  {
+    // The camera file was read and checked by the caller; here only its `fit` record is wanted.
+    const json document = json::parse(camera_file_text, nullptr, false);
+    if (document.is_object() && document.contains("fit") && document["fit"].is_object()) {
+      fit = document["fit"];
+    }
+  }
+  json data = SceneJson(camera, OutlierIndicesFromJsonText(camera_file_text, camera_name),
+                        correspondences, stats);
+  data["fit"] = fit;
+  data["camera_name"] = camera_name;
+  data["image"] = options.image_path.empty() ? json(nullptr) : ImageJson(options.image_path, camera);
+  data["mesh"] = options.mesh_path.empty() ? json(nullptr) : MeshJson(options.mesh_path, stats);
+  const internal::ViewAssets& assets = internal::EmbeddedViewAssets();
+  data["three_version"] = std::string(assets.three_version);
+
+  std::string page(assets.page_template);
+  const std::string title =
+      options.title.empty() ? "camproj view: " + camera_name : options.title;
+  ReplaceOnce(page, "@CAMPROJ_TITLE@", HtmlEscape(title));
+  ReplaceOnce(page, "@CAMPROJ_DATA@", ScriptSafeJson(data));
+  ReplaceOnce(page, "@CAMPROJ_THREE_CORE@", Base64(assets.three_core));
+  ReplaceOnce(page, "@CAMPROJ_THREE_MODULE@", Base64(assets.three_module));
+  ReplaceOnce(page, "@CAMPROJ_ORBIT_CONTROLS@", Base64(assets.orbit_controls));
+  ReplaceOnce(page, "@CAMPROJ_PAGE_SCRIPT@", Base64(assets.page_script));
+  stats.page_bytes = page.size();
+  if (stats_out) *stats_out = stats;
+  return page;
+}
+
+ViewStats WriteViewPage(const Camera& camera, const std::string& camera_file_text,
+                        const std::string& camera_name, const Correspondences* correspondences,
+                        const ViewOptions& options, const std::string& output_path) {
+  ViewStats stats;
+  const std::string page =
+      ViewPageHtml(camera, camera_file_text, camera_name, correspondences, options, &stats);
+  WriteFileAtomically(output_path, page);
+  return stats;
+}
+
+}  // namespace camproj

@@ -1,0 +1,141 @@
+// The overlay picture, decoded and checked where its markers must be (camproj/overlay.h).
+#include "camproj/overlay.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "camproj/camera_file.h"
+#include "camproj/points_file.h"
+
+namespace camproj {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Scene {
+  Camera camera;
+  Correspondences points;
+};
+
+Scene Projector() {
+  return {ReadCameraFile(std::string(CAMPROJ_DATA_DIR) + "/projector/truth.json"),
+          ReadCorrespondencesFile(std::string(CAMPROJ_DATA_DIR) + "/projector/points.csv")};
+}
+
+fs::path Output(const std::string& name) {
+  const fs::path folder = fs::temp_directory_path() / ("camproj_overlay_test_" + std::to_string(getpid()));
+  fs::create_directories(folder);
+  return folder / name;
+}
+
+// The largest channel difference between `pixel` and the closest of the pixels within `reach`
+// of `at` (antialiased markers are a couple of pixels wide).
+int ClosestColourDistance(const cv::Mat& image, const Eigen::Vector2d& at, const cv::Vec3b& pixel,
+                          int reach) {
+  int best = 1 << 30;
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const int x = static_cast<int>(std::lround(at.x())) + dx;
+      const int y = static_cast<int>(std::lround(at.y())) + dy;
+      if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) continue;
+      const cv::Vec3b c = image.at<cv::Vec3b>(y, x);
+      int d = 0;
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(c[k] - pixel[k]));
+      best = std::min(best, d);
+    }
+  }
+  return best;
+}
+
+TEST(OverlayTest, MarkersWhereThePointsProjectIdsThatDoNotOverlapOutliersInVermillion) {
+  const Scene scene = Projector();
+  OverlayOptions options;
+  options.outliers = {2};  // the third point drawn as an outlier
+  const fs::path path = Output("overlay.png");
+  const OverlayStats stats = WriteOverlayImage(scene.camera, scene.points, options, path.string());
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  const int w = scene.camera.image_size.width, h = scene.camera.image_size.height;
+  EXPECT_EQ(image.cols, w);
+  EXPECT_EQ(image.rows, h);
+  EXPECT_EQ(stats.outliers, 1);
+  EXPECT_EQ(stats.drawn, 19);
+  // The magnification: the largest kept residual drawn residual_fraction of the image's smaller
+  // side or less, but more than 2/5 of it (1, 2, 5 steps round down by at most 5/2).
+  const double drawn_px = stats.magnify * stats.largest_residual_px;
+  EXPECT_LE(drawn_px, options.residual_fraction * h + 1e-9);
+  EXPECT_GT(drawn_px, 0.4 * options.residual_fraction * h);
+
+  ASSERT_EQ(stats.labels.size(), scene.points.pixels.size());
+  for (size_t i = 0; i < scene.points.pixels.size(); ++i) {
+    const OverlayLabel& label = stats.labels[i];
+    EXPECT_EQ(label.id, scene.points.ids[i]);
+    const std::optional<Eigen::Vector2d> predicted =
+        PixelFromWorld(scene.camera, scene.points.points_in_world[i]);
+    ASSERT_TRUE(predicted);
+    if (i == 2) {
+      EXPECT_EQ(label.kind, "outlier");
+      // A crossed vermillion ring at the observed pixel (BGR 31, 90, 255).
+      EXPECT_LE(ClosestColourDistance(image, scene.points.pixels[i], cv::Vec3b(31, 90, 255), 1), 40);
+    } else {
+      EXPECT_EQ(label.kind, "point");
+      // The reprojection's cross is white at its centre (at most a pixel of antialiasing off).
+      EXPECT_LE(ClosestColourDistance(image, *predicted, cv::Vec3b(255, 255, 255), 1), 40)
+          << "id " << label.id;
+    }
+    // Ids inside the image, and apart: no two boxes overlap.
+    EXPECT_GE(label.box[0], 0.0);
+    EXPECT_GE(label.box[1], 0.0);
+    EXPECT_LE(label.box[0] + label.box[2], w);
+    EXPECT_LE(label.box[1] + label.box[3], h);
+    for (size_t j = 0; j < i; ++j) {
+      const Eigen::Vector4d& a = label.box;
+      const Eigen::Vector4d& b = stats.labels[j].box;
+      const bool apart = a[0] + a[2] <= b[0] || b[0] + b[2] <= a[0] || a[1] + a[3] <= b[1] ||
+                         b[1] + b[3] <= a[1];
+      EXPECT_TRUE(apart) << "ids " << label.id << " and " << stats.labels[j].id << " overlap";
+    }
+  }
+  // Text pixels where the labels are: each box holds light (id) pixels (the ground is 40, the
+  // halo black; white text is 255, vermillion 133 in grey).
+  for (const OverlayLabel& label : stats.labels) {
+    const cv::Rect box(static_cast<int>(label.box[0]), static_cast<int>(label.box[1]),
+                       static_cast<int>(label.box[2]), static_cast<int>(label.box[3]));
+    cv::Mat grey;
+    cv::cvtColor(image(box & cv::Rect(0, 0, w, h)), grey, cv::COLOR_BGR2GRAY);
+    EXPECT_GT(cv::countNonZero(grey > 100), 10) << "no text in the box of id " << label.id;
+  }
+  fs::remove_all(path.parent_path());
+}
+
+TEST(OverlayTest, ObservedPixelsOutsideTheImageBecomeArrowsAtTheBorder) {
+  Scene scene = Projector();
+  scene.points.pixels[0] = Eigen::Vector2d(-300.0, 500.0);
+  const fs::path path = Output("outside.jpg");
+  const OverlayStats stats = WriteOverlayImage(scene.camera, scene.points, {}, path.string());
+  EXPECT_EQ(stats.outside, 1);
+  EXPECT_EQ(stats.labels[0].kind, "outside");
+  EXPECT_GE(stats.labels[0].box[0], 0.0);  // its id is inside the image
+  // The far-off point does not set the scale: the others' residuals (~1 px) do.
+  EXPECT_LT(stats.largest_residual_px, 10.0);
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  EXPECT_FALSE(image.empty());
+  fs::remove_all(path.parent_path());
+}
+
+TEST(OverlayTest, OutlierIndexBeyondThePointsIsRefused) {
+  const Scene scene = Projector();
+  OverlayOptions options;
+  options.outliers = {20};
+  EXPECT_THROW(WriteOverlayImage(scene.camera, scene.points, options, Output("x.png").string()),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace camproj
