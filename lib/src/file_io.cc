@@ -150,8 +150,8 @@ struct TemporaryGuard {
 };
 
 // Removes this tool's temporaries in `folder` (".camproj-XXXXXX.tmp", regular files) last modified
-// over kStaleTemporarySeconds ago: left by a kill at the instant between linkat and rename, or
-// during a write on a file system without O_TMPFILE. A write in progress touches its temporary
+// over kStaleTemporarySeconds ago: left by a kill at the instant between linkat and rename when
+// replacing a file, or during a write on a file system without O_TMPFILE. A write in progress touches its temporary
 // within milliseconds, so an hour-old one belongs to no running camproj. Best effort: errors are
 // ignored.
 constexpr time_t kStaleTemporarySeconds = 3600;
@@ -249,8 +249,21 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   }
   if (fsync(temporary.fd) != 0) throw InputError("cannot write " + path + ": fsync: " + ErrnoText(errno));
   if (unnamed) {
-    // Give it a name only now, for the instant before rename (linkat cannot replace a file).
     const std::string fd_path = "/proc/self/fd/" + std::to_string(temporary.fd);
+    // A new file gets its final name at once: no instant with a named temporary, which a kill
+    // there would leave behind (a batch writing into a fresh folder; seen under load).
+    if (!replacing) {
+      if (linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, target.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+        const int fd = temporary.fd;
+        temporary.fd = -1;
+        if (close(fd) != 0) throw InputError("cannot write " + path + ": close: " + ErrnoText(errno));
+        SweepStaleTemporaries(folder);
+        return;
+      }
+      if (errno != EEXIST) throw InputError("cannot write " + path + ": link: " + ErrnoText(errno));
+      // Created meanwhile: replace it as below.
+    }
+    // Give it a name only now, for the instant before rename (linkat cannot replace a file).
     for (int attempt = 0; attempt < 100; ++attempt) {
       name = TemporaryName(folder);
       cleanup.Set(name);
