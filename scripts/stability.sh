@@ -107,8 +107,8 @@ case's expectation is a measured rate of a known weakness, the test says so with
   minimum) are a stated rate.
 - **RANSAC: exact outlier set.** Outliers are moved at least 20 px from their pixel; the fitted
   camera predicts an inlier to well under 1 px, and an inlier with 0.5 px noise leaves the 4 px
-  threshold with probability exp(-32), so the outlier set must come back exactly; the camera is
-  then judged by the noisy-fit checks above.
+  threshold with probability exp(-32), so the outlier set must come back exactly, in every one of
+  the 20 noise draws; the camera is then judged by the noisy-fit checks above.
 - **GL export.** For points from the near plane (1e-6) to the far plane (1e9, or up to 1e300 with an
   infinite far plane) on five pixels of an off-axis, skewed projector: everything finite; the
   GL pipeline's pixel (`GlPixelFromWorld`) and the pinhole pixel (`PixelFromWorld`) within float64
