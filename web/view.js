@@ -391,6 +391,13 @@ function Report() {
     if (fit.outliers && fit.outliers.length) {
       summary.push(['outliers', `${fit.outliers.length} left out (${Escape(fit.outlier_method || '')})`]);
     }
+    if (fit.linearity) {
+      // The camera file's linearity check (docs/camera-file.md).
+      const l = fit.linearity;
+      const factor = typeof l.worst_deviation === 'number' ? Fixed(1 + l.worst_deviation, 2) : 'unbounded';
+      summary.push(['σ', l.linear ? `hold out to the ${l.level * 100} % region (error inflation ≤ ${factor})`
+                                  : `first-order only: curved within the noise's reach (inflation ${factor} along ${Escape(l.worst_direction)})`]);
+    }
   }
   html += `<h2>Camera</h2><table>${rows(summary)}</table>`;
   if (fit && fit.sigma) {
