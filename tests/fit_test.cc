@@ -204,30 +204,10 @@ RandomCamera ProjectorLikeCamera(std::mt19937_64& rng) {
   return camera;
 }
 
-// The estimation error in the fit's user parameterization (fit.h: rotation as the small angle
-// omega with R = exp(omega) R_hat, degrees; eye in world units; free intrinsics in px).
+// The estimation error in the fit's user parameterization (truth_condition.h).
 Eigen::VectorXd EstimationError(const FitResult& fit, const RandomCamera& truth) {
-  const int p = static_cast<int>(fit.free_parameters.size());
-  Eigen::VectorXd error(p);
-  const Eigen::AngleAxisd omega_true(truth.cam_from_world.rotation *
-                                     fit.camera.cam_from_world.rotation.transpose());
-  // u_hat = 0, u_true = omega_true: error = -omega_true.
-  error.head<3>() = -omega_true.angle() * omega_true.axis() * 180.0 / M_PI;
-  error.segment<3>(3) = CameraCenterInWorld(fit.camera.cam_from_world) -
-                        CameraCenterInWorld(truth.cam_from_world);
-  const Intrinsics& k = fit.camera.intrinsics;
-  const Intrinsics& t = truth.intrinsics;
-  for (int j = 6; j < p; ++j) {
-    const std::string& name = fit.free_parameters[j];
-    if (name == "fx") error(j) = k.fx - t.fx;
-    if (name == "fy") error(j) = k.fy - t.fy;
-    if (name == "cx") error(j) = k.cx - t.cx;
-    if (name == "cy") error(j) = k.cy - t.cy;
-    if (name == "skew") error(j) = k.skew - t.skew;
-    if (name == "k1") error(j) = k.k1 - t.k1;
-    if (name == "k2") error(j) = k.k2 - t.k2;
-  }
-  return error;
+  return testing::EstimationError(fit, truth.cam_from_world.rotation,
+                                  CameraCenterInWorld(truth.cam_from_world), truth.intrinsics);
 }
 
 struct NoisyCase {
@@ -738,7 +718,9 @@ TEST(FitTest, LinearityCheckFollowsTheProbedRadius) {
         // Ten times the radius: at least the same relative deviation (a 1e-9 rounding floor).
         EXPECT_GE(deviation, previous - 1e-9) << "scene " << i << " sigma " << sigma;
       }
-      if (sigma == 1e2) EXPECT_FALSE(fit.linearity.linear) << "scene " << i;
+      if (sigma == 1e2) {
+        EXPECT_FALSE(fit.linearity.linear) << "scene " << i;
+      }
       previous = deviation;
       ++checked;
     }

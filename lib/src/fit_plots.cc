@@ -8,8 +8,12 @@
 #include <sstream>
 
 #include "check.h"
+#include "drawing.h"
 
 namespace camproj {
+
+using internal::MarkupEscape;
+using internal::NiceFloor;
 
 namespace {
 
@@ -32,21 +36,6 @@ std::string Viridis(double t) {
   return text;
 }
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default:
-        out += (static_cast<unsigned char>(c) < 32 && c != '\n' && c != '\t') ? '?' : c;
-    }
-  }
-  return out;
-}
-
 std::string Num(double x, int digits = 2) {
   char text[32];
   std::snprintf(text, sizeof text, "%.*f", digits, x);
@@ -60,15 +49,6 @@ double NiceStep(double range, int ticks) {
     if (m * decade >= raw) return m * decade;
   }
   return 10.0 * decade;
-}
-
-double NiceFloor(double x) {
-  if (!(x > 1.0)) return 1.0;
-  const double decade = std::pow(10.0, std::floor(std::log10(x)));
-  for (double m : {5.0, 2.0, 1.0}) {
-    if (m * decade <= x) return m * decade;
-  }
-  return decade;
 }
 
 constexpr double kWidth = 960;
@@ -131,7 +111,7 @@ std::string FitReportSvg(const FitResult& fit, const std::vector<Eigen::Vector2d
       const std::string colour = outlier[i] ? kOutlier : Viridis(length[i] / colour_top);
       body << "<rect x='" << x + slot * 0.15 << "' y='" << top + h - bar_h << "' width='"
            << slot * 0.7 << "' height='" << bar_h << "' fill='" << colour << "'><title>"
-           << Escape(ids[i]) << ": " << Num(length[i], 3) << " px" << (outlier[i] ? " (outlier)" : "")
+           << MarkupEscape(ids[i]) << ": " << Num(length[i], 3) << " px" << (outlier[i] ? " (outlier)" : "")
            << "</title></rect>\n";
       if (beyond) {
         body << "<text x='" << x + slot / 2 << "' y='" << top - 2
@@ -140,7 +120,7 @@ std::string FitReportSvg(const FitResult& fit, const std::vector<Eigen::Vector2d
       }
       if (show_ids) {
         body << "<text transform='translate(" << x + slot / 2 + 3 << "," << top + h + 8
-             << ") rotate(-90)' class='tick' text-anchor='end'>" << Escape(ids[i].substr(0, 12))
+             << ") rotate(-90)' class='tick' text-anchor='end'>" << MarkupEscape(ids[i].substr(0, 12))
              << "</text>\n";
       }
     }
@@ -170,7 +150,7 @@ std::string FitReportSvg(const FitResult& fit, const std::vector<Eigen::Vector2d
     const auto sy = [&](double v) { return y0 + (v + 0.5) * scale; };
     for (size_t i = 0; i < n; ++i) {
       const Eigen::Vector2d& o = observed_pixels[i];
-      const std::string id = Escape(ids[i]);
+      const std::string id = MarkupEscape(ids[i]);
       if (outlier[i] || !std::isfinite(length[i])) {
         const double r = 4;
         body << "<g stroke='" << kOutlier << "' stroke-width='2'><line x1='" << sx(o.x()) - r
@@ -211,24 +191,24 @@ std::string FitReportSvg(const FitResult& fit, const std::vector<Eigen::Vector2d
     }
     const double label_w = 300, bar_x = kMargin + label_w, bar_w = plot_w - label_w - 150;
     body << "<text x='" << kMargin << "' y='" << top - 12 << "' class='title'>Models tried, in order: "
-         << Escape(fit.criterion) << " (lower is better; chosen: " << Escape(fit.model)
+         << MarkupEscape(fit.criterion) << " (lower is better; chosen: " << MarkupEscape(fit.model)
          << ")</text>\n";
     for (size_t k = 0; k < fit.candidates.size(); ++k) {
       const ModelCandidate& c = fit.candidates[k];
       const double yy = top + k * row;
       const bool chosen = c.name == fit.model;
       body << "<text x='" << kMargin << "' y='" << yy + 14 << "' class='" << (chosen ? "chosen" : "model")
-           << "'>" << Escape(c.name) << "</text>\n";
+           << "'>" << MarkupEscape(c.name) << "</text>\n";
       if (c.fitted && std::isfinite(c.criterion)) {
         const double x = bar_x + (c.criterion - lo) / (hi - lo) * bar_w;
         body << "<line x1='" << bar_x << "' x2='" << x << "' y1='" << yy + 10 << "' y2='" << yy + 10
              << "' class='ladder'/><circle cx='" << x << "' cy='" << yy + 10 << "' r='5' fill='"
-             << (chosen ? "#2f6fb0" : "#888") << "'><title>" << Escape(c.verdict)
+             << (chosen ? "#2f6fb0" : "#888") << "'><title>" << MarkupEscape(c.verdict)
              << "</title></circle><text x='" << x + 9 << "' y='" << yy + 14 << "' class='tick'>"
              << Num(c.criterion, 1) << ", RMS " << Num(c.rms_px, 2) << " px</text>\n";
       } else {
         body << "<text x='" << bar_x << "' y='" << yy + 14 << "' class='refused'>"
-             << Escape(c.verdict.substr(0, 90)) << "</text>\n";
+             << MarkupEscape(c.verdict.substr(0, 90)) << "</text>\n";
       }
     }
     y = top + fit.candidates.size() * row + 10;
@@ -254,11 +234,11 @@ std::string FitReportHtml(const FitResult& fit, const std::vector<Eigen::Vector2
                           const std::vector<std::string>& ids, const std::string& summary_text,
                           const std::string& title) {
   std::ostringstream html;
-  html << "<!doctype html>\n<html lang='en'><head><meta charset='utf-8'><title>" << Escape(title)
+  html << "<!doctype html>\n<html lang='en'><head><meta charset='utf-8'><title>" << MarkupEscape(title)
        << "</title>\n<style>body{font:13px system-ui,sans-serif;margin:16px;color:#222;display:flex;"
           "gap:24px;flex-wrap:wrap}pre{font-size:12px;max-width:720px;white-space:pre-wrap}</style>"
           "</head><body>\n<div>"
-       << FitReportSvg(fit, observed_pixels, ids) << "</div>\n<pre>" << Escape(summary_text)
+       << FitReportSvg(fit, observed_pixels, ids) << "</div>\n<pre>" << MarkupEscape(summary_text)
        << "</pre>\n</body></html>\n";
   return html.str();
 }

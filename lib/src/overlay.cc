@@ -14,6 +14,7 @@
 #include "camproj/file_io.h"
 #include "camproj/image_header.h"
 #include "check.h"
+#include "drawing.h"
 
 namespace camproj {
 
@@ -88,16 +89,6 @@ const cv::Scalar kOutlierColour(31, 90, 255);  // vermillion (BGR), away from vi
 const cv::Scalar kBehindColour(170, 170, 170);
 const cv::Scalar kInk(0, 0, 0);
 const cv::Scalar kWhite(255, 255, 255);
-
-// 1, 2 or 5 times a power of ten, at most `x`, at least 1.
-double NiceFloor(double x) {
-  if (!(x > 1.0)) return 1.0;
-  const double decade = std::pow(10.0, std::floor(std::log10(x)));
-  for (double m : {5.0, 2.0, 1.0}) {
-    if (m * decade <= x) return m * decade;
-  }
-  return decade;
-}
 
 std::string FormatPx(double px) {
   char text[32];
@@ -344,7 +335,7 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
   }
   stats.magnify = options.magnify > 0.0
                       ? options.magnify
-                      : NiceFloor(stats.largest_residual_px > 0.0
+                      : internal::NiceFloor(stats.largest_residual_px > 0.0
                                       ? options.residual_fraction * std::min(w, h) /
                                             stats.largest_residual_px
                                       : 1.0);

@@ -11,6 +11,7 @@
 #include "camproj/file_io.h"
 #include "camproj/image_header.h"
 #include "check.h"
+#include "drawing.h"
 #include "view/assets.h"
 #include "view/obj_mesh.h"
 
@@ -221,20 +222,6 @@ std::string ScriptSafeJson(const json& value) {
   return out;
 }
 
-std::string HtmlEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 void ReplaceOnce(std::string& text, const std::string& key, const std::string& value) {
   const size_t at = text.find(key);
   if (at == std::string::npos) throw std::logic_error("web/view.html lacks " + key);
@@ -269,7 +256,7 @@ std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_te
   std::string page(assets.page_template);
   const std::string title =
       options.title.empty() ? "camproj view: " + camera_name : options.title;
-  ReplaceOnce(page, "@CAMPROJ_TITLE@", HtmlEscape(title));
+  ReplaceOnce(page, "@CAMPROJ_TITLE@", internal::MarkupEscape(title));
   ReplaceOnce(page, "@CAMPROJ_DATA@", ScriptSafeJson(data));
   ReplaceOnce(page, "@CAMPROJ_THREE_CORE@", Base64(assets.three_core));
   ReplaceOnce(page, "@CAMPROJ_THREE_MODULE@", Base64(assets.three_module));
