@@ -40,30 +40,13 @@ struct FitArgs {
   bool json = false;
   bool trace = false;
   std::string report_path;
-  std::string model = "auto";
-  std::string criterion = "bic";
-  std::vector<std::string> free;
-  std::vector<std::string> fix;
-  double focal = 0.0;
-  double fovy_deg = 0.0;
-  double aspect = 0.0;
+  // The fit's options (fit_request.h), bound to the command line directly; the three below are
+  // what the command line reads or parses into them.
+  FitArguments fit;
   std::string principal_point;
-  double skew = NAN;
-  double k1 = NAN;
-  double k2 = NAN;
   std::string intrinsics_path;
-  std::string pixel_origin = "center";
-  std::string loss = "none";
-  bool keep_all = false;
-  double ransac_px = 0.0;
-  double sigma = 0.0;
-  double max_uncertainty = 0.0;  // 0: AutoFitOptions' default
   std::string object_points_path;
-  double z_near = 0.0;
-  double z_far = 0.0;
-  int max_iterations = 100;
 };
-
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
 
@@ -96,31 +79,12 @@ FileFit FitFile(const std::string& path, const ImageSize& size, const FitRequest
 // The library's request (fit_request.h) for the parsed options; the files they name are read
 // here, and a value the library refuses is a usage error.
 FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
-  FitArguments arguments;
-  arguments.model = args.model;
-  arguments.criterion = args.criterion;
-  arguments.free = args.free;
-  arguments.fix = args.fix;
-  arguments.focal = args.focal;
-  arguments.fovy_deg = args.fovy_deg;
-  arguments.aspect = args.aspect;
+  FitArguments arguments = args.fit;
   if (!args.principal_point.empty()) {
     const std::vector<double> c = ParseNumbers(args.principal_point, 2, "--principal-point");
     arguments.principal_point = Eigen::Vector2d(c[0], c[1]);
   }
-  arguments.skew = args.skew;
-  arguments.k1 = args.k1;
-  arguments.k2 = args.k2;
   if (!args.intrinsics_path.empty()) arguments.known_intrinsics = ReadIntrinsicsFile(args.intrinsics_path);
-  arguments.pixel_origin = args.pixel_origin;
-  arguments.loss = args.loss;
-  arguments.keep_all = args.keep_all;
-  arguments.ransac_px = args.ransac_px;
-  arguments.sigma = args.sigma;
-  arguments.max_uncertainty = args.max_uncertainty;
-  arguments.z_near = args.z_near;
-  arguments.z_far = args.z_far;
-  arguments.max_iterations = args.max_iterations;
   try {
     if (!args.object_points_path.empty()) {
       // Every other option is checked before the file is read (with one placeholder point:
@@ -325,55 +289,55 @@ Command AddFitCommand(CLI::App& root) {
                   "also write plots of the fit, drawn by camproj: .svg (residual per point, "
                   "residuals over the image, the models tried with their criterion) or .html "
                   "(the same with the summary)");
-  app->add_option("--model", args->model,
+  app->add_option("--model", args->fit.model,
                   "auto (default): the simplest model the data support; or the free intrinsics "
                   "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
                   "pose: none (with --intrinsics or fixed values); orthographic[+aspect][+skew]: "
                   "a parallel projection (scale in px per world unit)");
-  app->add_option("--criterion", args->criterion,
+  app->add_option("--criterion", args->fit.criterion,
                   "model selection criterion: bic (default) or aic")
       ->check(CLI::IsMember({"aic", "bic"}));
-  app->add_option("--free", args->free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
+  app->add_option("--free", args->fit.free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
       ->delimiter(',')->check(CLI::IsMember(kParameterNames));
-  app->add_option("--fix", args->fix, "hold these at their defaults (aspect 1, principal point at "
+  app->add_option("--fix", args->fit.fix, "hold these at their defaults (aspect 1, principal point at "
                                       "the image centre, skew 0, k 0)")
       ->delimiter(',')->check(CLI::IsMember(kParameterNames));
-  app->add_option("--focal", args->focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
-  app->add_option("--fovy", args->fovy_deg, "fix the focal length by the vertical field of view (degrees)")
+  app->add_option("--focal", args->fit.focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
+  app->add_option("--fovy", args->fit.fovy_deg, "fix the focal length by the vertical field of view (degrees)")
       ->check(CLI::PositiveNumber);
-  app->add_option("--aspect", args->aspect, "fix fy/fx")->check(CLI::PositiveNumber);
+  app->add_option("--aspect", args->fit.aspect, "fix fy/fx")->check(CLI::PositiveNumber);
   app->add_option("--principal-point", args->principal_point, "fix cx,cy (px)");
-  app->add_option("--skew", args->skew, "fix the skew (px)");
-  app->add_option("--k1", args->k1, "fix k1");
-  app->add_option("--k2", args->k2, "fix k2");
+  app->add_option("--skew", args->fit.skew, "fix the skew (px)");
+  app->add_option("--k1", args->fit.k1, "fix k1");
+  app->add_option("--k2", args->fit.k2, "fix k2");
   app->add_option("--intrinsics", args->intrinsics_path,
                   "known intrinsics (a camera file or {\"intrinsics\": {...}}): fit the pose only");
-  app->add_option("--pixel-origin", args->pixel_origin,
+  app->add_option("--pixel-origin", args->fit.pixel_origin,
                   "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
                   "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
-  app->add_option("--loss", args->loss, "none, huber:SCALE or cauchy:SCALE (px)");
-  app->add_option("--ransac", args->ransac_px,
+  app->add_option("--loss", args->fit.loss, "none, huber:SCALE or cauchy:SCALE (px)");
+  app->add_option("--ransac", args->fit.ransac_px,
                   "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
                   "instead of the automatic outlier stage; they are left out and listed")
       ->check(CLI::PositiveNumber);
-  app->add_flag("--keep-all", args->keep_all,
+  app->add_flag("--keep-all", args->fit.keep_all,
                 "keep every point: no automatic outlier stage (a scene with mis-clicks is then "
                 "refused by the consistency check, naming the worst points)");
-  app->add_option("--sigma", args->sigma,
+  app->add_option("--sigma", args->fit.sigma,
                   "pixel noise per axis (px): the model selection, the consistency check and the "
                   "uncertainties use it; default: a 1 px prior for clicked points, combined with "
                   "the residuals")->check(CLI::PositiveNumber);
-  app->add_option("--max-uncertainty", args->max_uncertainty,
+  app->add_option("--max-uncertainty", args->fit.max_uncertainty,
                   "refuse a camera the points determine more loosely than this (px, 1 sigma over "
                   "the box the points span; default 5)")->check(CLI::PositiveNumber);
   app->add_option("--object-points", args->object_points_path,
                   "CSV with X,Y,Z of the object's other points (e.g. the model's vertices): the "
                   "camera must be determined to --max-uncertainty there too, where they are in "
                   "the image (u,v columns are ignored)");
-  app->add_option("--near", args->z_near, "near plane of the GL matrices (default: tight)")
+  app->add_option("--near", args->fit.z_near, "near plane of the GL matrices (default: tight)")
       ->check(CLI::PositiveNumber);
-  app->add_option("--far", args->z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
-  app->add_option("--max-iterations", args->max_iterations, "refinement iterations")
+  app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
+  app->add_option("--max-iterations", args->fit.max_iterations, "refinement iterations")
       ->check(CLI::NonNegativeNumber);
 
   return {app, [args]() {
