@@ -35,11 +35,14 @@ std::vector<FitOptions> DetectionModels(const AutoFitOptions& options) {
   return models;
 }
 
-// A subset fitted with the first of `models` it determines, and gated.
+// A subset fitted with the first of `models` it determines, and gated. With
+// `next_only_for_planes`, a refusal moves on to the next model only where the subset is a plane
+// that cannot determine the model (kPlanarUnderdetermined); any other refusal ends the subset.
 Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& left_out,
                  const ImageSize& size, const std::vector<FitOptions>& models,
-                 const AutoFitOptions& options, const NoiseReference& noise) {
+                 const AutoFitOptions& options, const NoiseReference& noise,
+                 bool next_only_for_planes = false) {
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Vector2d> u;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -62,9 +65,16 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
       subset.fit = Prefit{model, std::move(fit)};
       return subset;
-    } catch (const std::exception& e) {
-      // Not determined by this subset (or a numerical failure): try the next model.
+    } catch (const SceneError& e) {
+      // Not determined by this subset: try the next model.
       subset.summary = e.what();
+      if (next_only_for_planes && e.reason() != SceneError::Reason::kPlanarUnderdetermined) {
+        return subset;
+      }
+    } catch (const std::exception& e) {
+      // A numerical failure: try the next model.
+      subset.summary = e.what();
+      if (next_only_for_planes) return subset;
     }
   }
   return subset;
@@ -88,12 +98,13 @@ OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
   // model (points behind it), and a simpler one would call a projector's lens shift a mis-click.
   // (Measured on the click benchmark: judging with the screen's fitted model instead names 71
   // instead of 91 of 100 mis-clicks at 8 points.)
+  // A subset that is a plane (the mis-click the only point off it) cannot determine the richer
+  // model; it is judged with the next one instead, so that its reading counts too (seen: 7
+  // coplanar clicks and a mis-click off their plane, answered with the mis-click kept, fx 755
+  // for 1484 px: FitAutoTest.OneMisclickAmongEightIsNamed at seed offset 1001).
   std::vector<FitOptions> models;
   for (const FitOptions& model : DetectionModels(options)) {
-    if (2 * n - NumParameters(model) >= options.min_redundancy) {
-      models.push_back(model);
-      break;
-    }
+    if (2 * n - NumParameters(model) >= options.min_redundancy) models.push_back(model);
   }
   OutlierSearch search;
   if (models.empty()) {
@@ -120,7 +131,9 @@ OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
       for (int b = k == 2 ? a + 1 : n; b <= (k == 2 ? n - 1 : n); ++b) {
         left_out[0] = a;
         if (k == 2) left_out[1] = b;
-        if (FitSubset(points, pixels, left_out, size, models, options, noise).consistent) {
+        if (FitSubset(points, pixels, left_out, size, models, options, noise,
+                      /*next_only_for_planes=*/true)
+                .consistent) {
           explaining.push_back(left_out);
         }
       }
