@@ -209,10 +209,12 @@ def fit(points_in_world: ArrayLike, pixels: ArrayLike, image_size: ImageSize, *,
         loss: str = "none", keep_all: bool = False, ransac_px: Optional[float] = None,
         sigma: Optional[float] = None, max_uncertainty: Optional[float] = None,
         object_points_in_world: Optional[ArrayLike] = None, near: Optional[float] = None,
-        far: Optional[float] = None, max_iterations: int = 100) -> Camera:
+        far: Optional[float] = None, bounds: Optional[Sequence[float]] = None,
+        max_iterations: int = 100) -> Camera:
     """`camproj fit` on arrays: points_in_world (N, 3) seen at pixels (N, 2); every option is
     the command line's (`camproj fit --help`), with '-' as '_' (fovy -> fovy_deg, ransac ->
-    ransac_px, intrinsics: a camera-file path or an Intrinsics in OpenCV's origin). Same
+    ransac_px, intrinsics: a camera-file path or an Intrinsics in OpenCV's origin; bounds: the
+    6 numbers of --bounds). Same
     camera, same report, same refusals (SceneError subclasses) as the command line. Releases
     the GIL while fitting."""
 

@@ -126,6 +126,14 @@ FitArguments ArgumentsOf(const py::kwargs& kwargs) {
       a.object_points_in_world = Rows<3>(value.cast<Array>(), "object_points_in_world");
     } else if (key == "near") a.z_near = value.cast<double>();
     else if (key == "far") a.z_far = value.cast<double>();
+    else if (key == "bounds") {
+      const auto b = value.cast<std::vector<double>>();
+      if (b.size() != 6) {
+        throw std::invalid_argument("bounds: expected 6 numbers X0,Y0,Z0,X1,Y1,Z1, got " +
+                                    std::to_string(b.size()));
+      }
+      a.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
+    }
     else if (key == "max_iterations") a.max_iterations = value.cast<int>();
     else throw std::invalid_argument("fit: unknown option \"" + key + "\" (see help(camproj.fit))");
   }

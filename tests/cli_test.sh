@@ -213,6 +213,97 @@ EOF
     expect_exit 2 "$bin" export "$work/bad.json"
     expect_in err "bad.json"
     ;;
+  fit_bounds_cover_the_model)
+    # Default: near and far come from the fitted points only, and the summary says so.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080
+    expect_in out "^note: near .*cover the fitted points' depths only, widened by 10 %.*--bounds"
+    # --bounds-mesh: the box's 8 corners' depths, widened by 10 % (docs: the fit's margin rule),
+    # checked against the written camera to 1e-12 relative (the same doubles, a few roundings).
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds-mesh "$data/projector/box.obj" -o "$work/mesh.json"
+    expect_in out "^note: near .*cover the --bounds box (its 8 corners' depths, widened by 10 %)"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds=-0.5,-0.3,-0.4,0.5,0.3,0.4 -o "$work/box.json"
+    py -c "import json, sys; a, b = (json.load(open(f))['frustum'] for f in sys.argv[1:]); sys.exit(not (a['near'], a['far']) == (b['near'], b['far']))" \
+      "$work/mesh.json" "$work/box.json" || fail "--bounds-mesh box.obj and --bounds of its box differ"
+    py - "$work/mesh.json" <<'PY' || fail "near/far do not cover the box's corners"
+import itertools, json, sys
+c = json.load(open(sys.argv[1]))
+R, t = c["cam_from_world"]["R"], c["cam_from_world"]["t"]
+depths = [sum(R[2][i] * p[i] for i in range(3)) + t[2]
+          for p in itertools.product((-0.5, 0.5), (-0.3, 0.3), (-0.4, 0.4))]
+near, far = c["frustum"]["near"], c["frustum"]["far"]
+want_near, want_far = min(depths) / 1.1, max(depths) * 1.1
+ok = abs(near - want_near) <= 1e-12 * want_near and abs(far - want_far) <= 1e-12 * want_far
+print(near, want_near, far, want_far)
+sys.exit(0 if ok else 1)
+PY
+    # --near given: only far from the box.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds=-0.5,-0.3,-0.4,0.5,0.3,0.4 --near 0.5
+    expect_in out "^note: near 0.5, far .*; near as given"
+    # A box around the camera: corners behind it, no near plane covers it.
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds=-10,-10,-10,10,10,10 -o "$work/around.json"
+    expect_in err "--bounds: the box's corner (.*) is at depth -.*give --near"
+    [[ ! -e "$work/around.json" ]] || fail "a refused --bounds wrote a camera file"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds=-10,-10,-10,10,10,10 --near 0.1
+    # Bad boxes and files.
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds 1,2,3
+    expect_in err "--bounds"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds 1,0,0,0,1,1
+    expect_in err "--bounds: box min must be <= max"
+    expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds 0,0,0,1,1,1 --bounds-mesh "$data/projector/box.obj"
+    printf 'f 1 2 3\n' >"$work/empty.obj"
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds-mesh "$work/empty.obj"
+    expect_in err "empty.obj"
+    printf 'v 0 0 0\nv 1 x 1\n' >"$work/bad.obj"
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds-mesh "$work/bad.obj"
+    expect_in err "bad.obj.*2"
+    ;;
+  export_gl_headers)
+    # Every GL-facing export states the pixel convention and whether it holds the whole camera.
+    expect_exit 0 "$bin" export "$data/projector/truth.json" --to gl
+    expect_in out "^# pixels: GL window x = u + 0.5, y = 1080 - (v + 0.5) for camproj's kCenter pixel"
+    expect_in out "^# distortion: none"
+    expect_exit 0 "$bin" export "$data/projector/truth.json" --to glm
+    expect_in out "^// pixels: GL window x = u + 0.5"
+    expect_exit 0 "$bin" export "$data/projector/truth.json" --to three
+    expect_in out "camproj's kCenter pixel + 0.5"
+    # three: the depth advice is three's renderer options, not glClipControl.
+    expect_in err "reversedDepthBuffer: true"
+    expect_in err "logarithmicDepthBuffer: true"
+    ! grep -q glClipControl "$work/err" || fail "--to three advises glClipControl:\n$(cat "$work/err")"
+    # A distorted camera (k1 = -0.15, k2 = 0.02): header and stderr say the matrix drops it and by
+    # how much at the worst image corner. Expected: the pinhole ray through each outer corner,
+    # distorted, against the corner (docs/exports.md), to the 3 digits printed.
+    py - "$data/projector/truth.json" "$work/lens.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["intrinsics"]["k1"], c["intrinsics"]["k2"] = -0.15, 0.02
+for key in ("gl", "look_at"):
+    c.pop(key, None)
+json.dump(c, open(sys.argv[2], "w"))
+k = c["intrinsics"]; W, H = c["image_size"]
+worst = 0
+for u, v in ((-0.5, -0.5), (W - 0.5, -0.5), (-0.5, H - 0.5), (W - 0.5, H - 0.5)):
+    y = (v - k["cy"]) / k["fy"]; x = (u - k["cx"] - k["skew"] * y) / k["fx"]
+    r2 = x * x + y * y; d = 1 + k["k1"] * r2 + k["k2"] * r2 * r2
+    du, dv = k["fx"] * d * x + k["skew"] * d * y + k["cx"] - u, k["fy"] * d * y + k["cy"] - v
+    worst = max(worst, (du * du + dv * dv) ** 0.5)
+open(sys.argv[2] + ".px", "w").write("%.3g" % worst)
+PY
+    px=$(cat "$work/lens.json.px")
+    for to in gl glm three; do
+      expect_exit 0 "$bin" export "$work/lens.json" --to "$to" --quiet
+      expect_in out "k1 = -0.14999999999999999, k2 = 0.02 are not in the projection matrix .*up to $px px (worst image corner)"
+      expect_in err "^camproj: warning: k1 = -0.15, k2 = 0.02: the $to export's projection matrix is the pinhole part only and puts points up to $px px (worst image corner)"
+    done
+    expect_exit 0 "$bin" export "$work/lens.json" --to opencv-yaml
+    ! grep -q "k1 = " "$work/err" || fail "opencv-yaml keeps k1 but warned:\n$(cat "$work/err")"
+    ;;
   project_points)
     expect_exit 0 "$bin" project "$data/projector/truth.json" "$data/projector/points.csv"
     expect_in out "^id,X,Y,Z,u,v,depth"

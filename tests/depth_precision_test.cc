@@ -253,6 +253,25 @@ TEST(DepthPrecisionTest, WarnsAboutInfiniteFarWithoutZoReversedZ) {
   EXPECT_TRUE(AdviseDepth(0.1, kInfinity, kReversedZo).warnings.empty());
 }
 
+// For three.js the remedies are the renderer's options, not GL calls three users cannot make; the
+// table is the same.
+TEST(DepthPrecisionTest, ThreeJsAdviceNamesTheRendererOptions) {
+  for (const GlDepth& depth : {GlDepth{}, kReversedNo, kReversedZo}) {
+    const DepthAdvice gl = AdviseDepth(1e-4, 1000.0, depth);
+    const DepthAdvice three = AdviseDepth(1e-4, 1000.0, depth, DepthAdviceTarget::kThreeJs);
+    EXPECT_EQ(three.table, gl.table);
+    ASSERT_EQ(three.warnings.size(), 1u);
+    for (const std::string& text : {three.advice, three.warnings[0]}) {
+      EXPECT_EQ(text.find("glClipControl"), std::string::npos) << text;
+      EXPECT_NE(text.find("reversedDepthBuffer: true"), std::string::npos) << text;
+    }
+    if (!(depth.clip_depth == ClipDepth::kZeroToOne && depth.reversed_z)) {
+      EXPECT_NE(three.advice.find("logarithmicDepthBuffer: true"), std::string::npos) << three.advice;
+      EXPECT_NE(three.advice.find("--depth zo --reversed-z"), std::string::npos) << three.advice;
+    }
+  }
+}
+
 TEST(DepthPrecisionTest, TableShowsTheIssueFiguresAndTheAdvice) {
   const DepthAdvice advice = AdviseDepth(0.1, 1000.0);
   EXPECT_NE(advice.table.find("24-bit NO"), std::string::npos) << advice.table;

@@ -1,4 +1,5 @@
 // camproj export: a camera file in another tool's terms.
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -83,7 +84,10 @@ Command AddExportCommand(CLI::App& root) {
                            "step is (far - near) / 2^24 = "
                         << (camera.z_far - camera.z_near) / 16777216.0 << " world units\n";
             } else if (gl_like) {
-              const DepthAdvice advice = AdviseDepth(camera.z_near, camera.z_far, options.depth);
+              const DepthAdvice advice = AdviseDepth(
+                  camera.z_near, camera.z_far, options.depth,
+                  format == ExportFormat::kThree ? DepthAdviceTarget::kThreeJs
+                                                 : DepthAdviceTarget::kOpenGl);
               for (const std::string& warning : advice.warnings) {
                 std::cerr << "camproj: warning: " << warning << '\n';
               }
@@ -93,6 +97,18 @@ Command AddExportCommand(CLI::App& root) {
                   std::cerr << "camproj: note: " << line << '\n';
                 }
               }
+            }
+            if (gl_like && camera.intrinsics.HasDistortion()) {
+              // Not only in the export's comment: the matrix is not this camera.
+              char line[512];
+              std::snprintf(line, sizeof line,
+                            "camproj: warning: k1 = %.6g, k2 = %.6g: the %s export's projection "
+                            "matrix is the pinhole part only and puts points up to %.3g px (worst "
+                            "image corner) from where the lens images them; opencv-yaml, colmap "
+                            "and json keep k1, k2 (docs/exports.md)\n",
+                            camera.intrinsics.k1, camera.intrinsics.k2, args->to.c_str(),
+                            PinholeErrorAtWorstCornerPx(camera));
+              std::cerr << line;
             }
             std::string text;
             try {

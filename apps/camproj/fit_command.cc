@@ -46,6 +46,8 @@ struct FitArgs {
   std::string principal_point;
   std::string intrinsics_path;
   std::string object_points_path;
+  std::string bounds;  // --bounds X0,Y0,Z0,X1,Y1,Z1
+  std::string bounds_mesh_path;
 };
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
@@ -85,6 +87,16 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
     arguments.principal_point = Eigen::Vector2d(c[0], c[1]);
   }
   if (!args.intrinsics_path.empty()) arguments.known_intrinsics = ReadIntrinsicsFile(args.intrinsics_path);
+  if (!args.bounds.empty() && !args.bounds_mesh_path.empty()) {
+    throw UsageError("give --bounds or --bounds-mesh, not both");
+  }
+  if (!args.bounds.empty()) {
+    const std::vector<double> b = ParseNumbers(args.bounds, 6, "--bounds");
+    arguments.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
+  }
+  if (!args.bounds_mesh_path.empty()) {
+    arguments.bounds_in_world = ReadObjBoundingBox(args.bounds_mesh_path);
+  }
   try {
     if (!args.object_points_path.empty()) {
       // Every other option is checked before the file is read (with one placeholder point:
@@ -337,6 +349,11 @@ Command AddFitCommand(CLI::App& root) {
   app->add_option("--near", args->fit.z_near, "near plane of the GL matrices (default: tight)")
       ->check(CLI::PositiveNumber);
   app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
+  app->add_option("--bounds", args->bounds,
+                  "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
+                  "its 8 corners' depths + 10 %) instead of the fitted points only");
+  app->add_option("--bounds-mesh", args->bounds_mesh_path,
+                  "an OBJ file: near and far cover its vertices' bounding box, as --bounds");
   app->add_option("--max-iterations", args->fit.max_iterations, "refinement iterations")
       ->check(CLI::NonNegativeNumber);
 
@@ -385,6 +402,7 @@ Command AddFitCommand(CLI::App& root) {
               std::cout << text;
             } else {
               std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
+              std::cout << "note: " << NearFarNote(request, fit);
               if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
               // The summary's time is the fit's; reading and writing the files add to it.
               const double wall_ms = std::chrono::duration<double, std::milli>(

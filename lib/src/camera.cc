@@ -81,4 +81,43 @@ std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
   return PixelFromCam(camera.intrinsics, point_in_cam);
 }
 
+void BoxInWorld::Check() const {
+  for (int axis = 0; axis < 3; ++axis) {
+    internal::Require(std::isfinite(min_in_world[axis]) && std::isfinite(max_in_world[axis]),
+                      "box coordinates must be finite, got min ", min_in_world.transpose(),
+                      ", max ", max_in_world.transpose());
+    internal::Require(min_in_world[axis] <= max_in_world[axis], "box min must be <= max on each axis, got ",
+                      "min ", min_in_world.transpose(), ", max ", max_in_world.transpose());
+  }
+}
+
+Eigen::Vector3d BoxInWorld::Corner(int index) const {
+  return {(index & 1) ? max_in_world.x() : min_in_world.x(),
+          (index & 2) ? max_in_world.y() : min_in_world.y(),
+          (index & 4) ? max_in_world.z() : min_in_world.z()};
+}
+
+DepthRangeOfBox DepthRangeCoveringBox(const Rigid3& cam_from_world, const BoxInWorld& box,
+                                      double depth_margin) {
+  box.Check();
+  internal::Require(std::isfinite(depth_margin) && depth_margin >= 0.0,
+                    "depth margin must be >= 0, got ", depth_margin);
+  DepthRangeOfBox range;
+  for (int i = 0; i < 8; ++i) {
+    const double depth = (cam_from_world * box.Corner(i)).z();
+    if (i == 0 || depth < range.min_depth) {
+      range.min_depth = depth;
+      range.nearest_corner = i;
+    }
+    if (i == 0 || depth > range.max_depth) range.max_depth = depth;
+  }
+  internal::Require(range.max_depth > 0.0, "the box (min ", box.min_in_world.transpose(), ", max ",
+                    box.max_in_world.transpose(),
+                    ") is entirely behind the camera (its farthest corner at depth ",
+                    range.max_depth, ")");
+  if (range.min_depth > 0.0) range.z_near = range.min_depth / (1.0 + depth_margin);
+  range.z_far = range.max_depth * (1.0 + depth_margin);
+  return range;
+}
+
 }  // namespace camproj

@@ -172,8 +172,22 @@ constexpr char kFloatZoReversedAdvice[] =
     "reversed-Z with a float depth buffer (GL_DEPTH_COMPONENT32F) and "
     "glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)";
 
+constexpr char kThreeReversedAdvice[] =
+    "new THREE.WebGLRenderer({ reversedDepthBuffer: true }) (needs EXT_clip_control: check "
+    "renderer.capabilities.reversedDepthBuffer) with an export made with --depth zo --reversed-z; "
+    "it rebuilds projectionMatrix from fov, aspect and view on the first render";
+constexpr char kThreeLogAdvice[] =
+    "or new THREE.WebGLRenderer({ logarithmicDepthBuffer: true }) with the default --depth no "
+    "(depth written per fragment, which costs early depth testing)";
+
 // What to do about a large depth range, given the convention in use.
-std::string Remedy(const GlDepth& depth) {
+std::string Remedy(const GlDepth& depth, DepthAdviceTarget target) {
+  if (target == DepthAdviceTarget::kThreeJs) {
+    return IsZoReversed(depth)
+               ? "create the renderer with reversedDepthBuffer: true (three r187: WebGLRenderer "
+                 "with EXT_clip_control, or WebGPURenderer)"
+               : Concat("use ", kThreeReversedAdvice, ", ", kThreeLogAdvice);
+  }
   if (IsZoReversed(depth)) {
     return "keep your ZO reversed-Z projection and make sure the depth buffer is float32 "
            "(GL_DEPTH_COMPONENT32F)";
@@ -187,7 +201,8 @@ std::string Remedy(const GlDepth& depth) {
 
 }  // namespace
 
-DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth) {
+DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
+                        DepthAdviceTarget target) {
   CheckRange(z_near, z_far);
   const bool infinite = std::isinf(z_far);
   const GlDepth standard_no{ClipDepth::kNegativeOneToOne, false};
@@ -200,14 +215,14 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth) {
         Distance(z_far), ") is above ", Ratio(kDepthRatioWarning),
         ": a 24-bit depth buffer resolves only ",
         TwoDigits(DepthStepAt(z_far, z_near, z_far, standard_no, DepthBuffer::kFixed24)),
-        " world units at the far plane; ", Remedy(depth), ", or raise near"));
+        " world units at the far plane; ", Remedy(depth, target), ", or raise near"));
   }
   if (infinite && !IsZoReversed(depth)) {
     const double z = 1000.0 * z_near;
     advice.warnings.push_back(Concat(
         "infinite far plane without ZO reversed-Z: the depth step grows as z^2/near (",
         TwoDigits(DepthStepAt(z, z_near, z_far, depth, DepthBuffer::kFloat32)),
-        " world units at 1000 near = ", Distance(z), " even with a float32 buffer); ", Remedy(depth)));
+        " world units at 1000 near = ", Distance(z), " even with a float32 buffer); ", Remedy(depth, target)));
   }
 
   std::vector<double> distances;
@@ -280,6 +295,15 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth) {
   }
   advice.table = table.str();
 
+  if (target == DepthAdviceTarget::kThreeJs) {
+    advice.advice = IsZoReversed(depth)
+                        ? Concat("ZO reversed-Z in three.js: ", Remedy(depth, target),
+                                 "; it rebuilds projectionMatrix from fov, aspect and view on "
+                                 "the first render")
+                        : Concat("where depth precision matters in three.js: ",
+                                 Remedy(depth, target).substr(4));
+    return advice;
+  }
   advice.advice = IsZoReversed(depth)
                       ? "ZO reversed-Z: use it with a float depth buffer (GL_DEPTH_COMPONENT32F), "
                         "glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), glDepthFunc(GL_GREATER) "

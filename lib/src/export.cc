@@ -62,11 +62,20 @@ std::string DepthSummary(const GlDepth& depth) {
   return text;
 }
 
-std::string DistortionNote(const Intrinsics& intrinsics) {
+std::string DistortionNote(const Camera& camera) {
   auto out = ExactStream();
-  out << "k1 = " << intrinsics.k1 << ", k2 = " << intrinsics.k2
-      << " are not in the projection matrix (GL projection is linear)";
+  out << "k1 = " << camera.intrinsics.k1 << ", k2 = " << camera.intrinsics.k2
+      << " are not in the projection matrix (GL projection is linear): it puts points up to "
+      << std::setprecision(3) << PinholeErrorAtWorstCornerPx(camera)
+      << " px (worst image corner) from where the lens images them";
   return out.str();
+}
+
+// The pixel convention of GL window coordinates against camproj's pixels, one sentence.
+std::string GlPixelNote(const Camera& camera) {
+  return internal::Concat("pixels: GL window x = u + 0.5, y = ", camera.image_size.height,
+                          " - (v + 0.5) for camproj's kCenter pixel (u, v) (docs/conventions.md, "
+                          "section 2)");
 }
 
 void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, bool row_major) {
@@ -94,8 +103,11 @@ std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
       << (camera.projection == Projection::kOrthographic ? "; orthographic" : "")
       << "; near " << camera.z_near << ", far " << camera.z_far << "; viewport 0 0 "
       << camera.image_size.width << ' ' << camera.image_size.height << '\n';
+  out << "# " << GlPixelNote(camera) << '\n';
   if (camera.intrinsics.HasDistortion()) {
-    out << "# note: " << DistortionNote(camera.intrinsics) << '\n';
+    out << "# note: " << DistortionNote(camera) << '\n';
+  } else {
+    out << "# distortion: none (k1 and k2 are 0): the matrices are the whole camera\n";
   }
   PrintMatrix(out, "projection", views.clip_from_gl_eye, options.row_major);
   PrintMatrix(out, "view", views.gl_eye_from_world, options.row_major);
@@ -142,8 +154,11 @@ std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
       << "//   glUniformMatrix4fv(view_location, 1, GL_FALSE, glm::value_ptr(view_f));\n"
       << "// or to a dmat4 uniform (GL 4.0): glUniformMatrix4dv(location, 1, GL_FALSE, "
          "glm::value_ptr(projection)).\n";
+  out << "// " << GlPixelNote(camera) << ".\n";
   if (camera.intrinsics.HasDistortion()) {
-    out << "// Note: " << DistortionNote(camera.intrinsics) << ".\n";
+    out << "// Note: " << DistortionNote(camera) << ".\n";
+  } else {
+    out << "// Distortion: none (k1 and k2 are 0): the matrices are the whole camera.\n";
   }
   PrintGlmMatrix(out, "projection", views.clip_from_gl_eye);
   PrintGlmMatrix(out, "view", views.gl_eye_from_world);
@@ -347,9 +362,13 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
                      : "")
               : (depth.clip_depth == ClipDepth::kZeroToOne ? " Depth zo: WebGPURenderer."
                                                            : " Depth no: WebGLRenderer.");
-  if (camera.intrinsics.HasDistortion()) {
-    note += " " + DistortionNote(camera.intrinsics) + ".";
-  }
+  note +=
+      " Pixels: three's canvas pixels (Vector3.project mapped by x = (ndc.x + 1) / 2 * W, y = "
+      "(1 - ndc.y) / 2 * H) are corner-origin: camproj's kCenter pixel + 0.5 (docs/conventions.md, "
+      "section 2).";
+  note += camera.intrinsics.HasDistortion()
+              ? " " + DistortionNote(camera) + "."
+              : std::string(" Distortion: none (k1 and k2 are 0): projectionMatrix is the whole camera.");
   note +=
       " matrixWorld = world_from_gl_eye (three's camera looks down -z with y up); for a camera "
       "without a parent set camera.position.fromArray(position) and "
@@ -359,6 +378,21 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
 }
 
 }  // namespace
+
+double PinholeErrorAtWorstCornerPx(const Camera& camera) {
+  camera.Check();
+  if (!camera.intrinsics.HasDistortion()) return 0.0;
+  const Intrinsics pinhole = camera.intrinsics.Pinhole();
+  const double w = camera.image_size.width;
+  const double h = camera.image_size.height;
+  double worst = 0.0;
+  for (const Eigen::Vector2d corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
+                                       Eigen::Vector2d(-0.5, h - 0.5), Eigen::Vector2d(w - 0.5, h - 0.5)}) {
+    const Eigen::Vector3d ray = CamRayFromPixel(pinhole, corner);
+    worst = std::max(worst, (PixelFromCam(camera.intrinsics, ray) - corner).norm());
+  }
+  return worst;
+}
 
 const char* ToString(ExportFormat format) {
   for (const FormatName& entry : kFormatNames) {

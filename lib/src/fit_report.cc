@@ -153,7 +153,7 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
         << " bottom " << Format("%.6g", f.bottom) << " top " << Format("%.6g", f.top) << "\n";
   }
   out << "near " << Format("%.6g", fit.camera.z_near) << ", far " << Format("%.6g", fit.camera.z_far)
-      << " (points' depth range + 10 %)\n";
+      << " (GL depth range)\n";
   out << "residuals: rms " << Format("%.3f", fit.rms_px) << " px, median "
       << Format("%.3f", fit.median_px) << " px, max " << Format("%.3f", fit.max_px) << " px\n";
   // The worst among the points used (outliers are listed above).

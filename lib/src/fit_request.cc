@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <stdexcept>
 
+#include "camproj/errors.h"
+#include "camproj/file_io.h"
 #include "camproj/fit_report.h"
+#include "check.h"
+#include "view/obj_mesh.h"
 
 namespace camproj {
 
@@ -163,6 +168,17 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
   if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
+  if (args.bounds_in_world) {
+    try {
+      args.bounds_in_world->Check();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--bounds: ") + e.what());
+    }
+    if (options.z_near && options.z_far) {
+      throw std::invalid_argument("--bounds sets near and far: give it or both --near and --far, not all three");
+    }
+    request.bounds_in_world = args.bounds_in_world;
+  }
   options.max_iterations = args.max_iterations;
   if (!forced && options.loss != LossType::kNone) {
     throw std::invalid_argument(
@@ -195,10 +211,63 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& pixels,
                         const std::vector<std::string>& ids, const ImageSize& size,
                         const FitRequest& request) {
-  if (!request.automatic) return FitCamera(points_in_world, pixels, size, request.options());
-  AutoFitOptions options = request.auto_options;
-  if (ids.size() == pixels.size()) options.point_names = ids;
-  return FitCameraAuto(points_in_world, pixels, size, options);
+  FitResult result;
+  if (!request.automatic) {
+    result = FitCamera(points_in_world, pixels, size, request.options());
+  } else {
+    AutoFitOptions options = request.auto_options;
+    if (ids.size() == pixels.size()) options.point_names = ids;
+    result = FitCameraAuto(points_in_world, pixels, size, options);
+  }
+  if (!request.bounds_in_world) return result;
+  const FitOptions& options = request.options();
+  const BoxInWorld& box = *request.bounds_in_world;
+  const DepthRangeOfBox range =
+      DepthRangeCoveringBox(result.camera.cam_from_world, box, options.depth_margin);
+  Camera& camera = result.camera;
+  if (!options.z_near) {
+    const Eigen::Vector3d corner = box.Corner(range.nearest_corner);
+    internal::Require(range.z_near.has_value(), "--bounds: the box's corner (", corner.x(), ", ",
+                      corner.y(), ", ", corner.z(), ") is at depth ", range.min_depth,
+                      ", not in front of the fitted camera, so no near plane covers the box: give "
+                      "--near (what is nearer is clipped)");
+    camera.z_near = *range.z_near;
+  }
+  if (!options.z_far) camera.z_far = range.z_far;
+  internal::Require(camera.z_far > camera.z_near, "--bounds: far ", camera.z_far,
+                    " (the box's farthest corner) is not beyond --near ", camera.z_near);
+  result.views = ViewsOfCamera(camera, (result.views.look_at.target - result.views.look_at.eye).norm());
+  return result;
+}
+
+std::string NearFarNote(const FitRequest& request, const FitResult& fit) {
+  const FitOptions& options = request.options();
+  char range[128];
+  std::snprintf(range, sizeof range, "near %.6g, far %.6g: ", fit.camera.z_near, fit.camera.z_far);
+  char margin[64];
+  std::snprintf(margin, sizeof margin, ", widened by %.6g %%", 100.0 * options.depth_margin);
+  if (options.z_near && options.z_far) return range + std::string("as given (--near, --far)\n");
+  if (request.bounds_in_world) {
+    return range + std::string("cover the --bounds box (its 8 corners' depths") + margin + ")" +
+           (options.z_near ? "; near as given" : options.z_far ? "; far as given" : "") + "\n";
+  }
+  return range + std::string("cover the fitted points' depths only") + margin +
+         "; the rest of the model may be clipped: give --bounds X0,Y0,Z0,X1,Y1,Z1 or "
+         "--bounds-mesh model.obj to cover it, or --near/--far\n";
+}
+
+BoxInWorld ReadObjBoundingBox(const std::string& path) {
+  const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path), path);
+  if (mesh.positions.empty()) throw InputError(path + ": no vertices (v lines) for a bounding box");
+  BoxInWorld box;
+  box.min_in_world = box.max_in_world =
+      Eigen::Vector3d(mesh.positions[0], mesh.positions[1], mesh.positions[2]);
+  for (size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
+    const Eigen::Vector3d p(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]);
+    box.min_in_world = box.min_in_world.cwiseMin(p);
+    box.max_in_world = box.max_in_world.cwiseMax(p);
+  }
+  return box;
 }
 
 std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin) {

@@ -61,6 +61,38 @@ void RequireFiniteViews(const Camera& camera, const GlDepth& depth = {});
 std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
                                               const Eigen::Vector3d& point_in_world);
 
+// An axis-aligned box in world units, e.g. a model's bounding box: min_in_world <= max_in_world on
+// each axis.
+struct BoxInWorld {
+  Eigen::Vector3d min_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max_in_world = Eigen::Vector3d::Zero();
+
+  // Throws std::invalid_argument unless every coordinate is finite and min <= max on each axis.
+  void Check() const;
+  // The 8 corners; bit 0 of the index picks x from max (else min), bit 1 y, bit 2 z.
+  Eigen::Vector3d Corner(int index) const;
+};
+
+// The depth range (along the view axis, z in cam) that covers a box: its 8 corners' depths,
+// widened like FitOptions' default: z_near = min depth / (1 + depth_margin), z_far = max depth *
+// (1 + depth_margin).
+struct DepthRangeOfBox {
+  double min_depth = 0.0;  // of the 8 corners (may be <= 0: the box reaches behind the camera)
+  double max_depth = 0.0;
+  int nearest_corner = 0;  // BoxInWorld::Corner index of min_depth
+  // Absent when a corner is not in front of the camera (min_depth <= 0): the box then crosses
+  // the camera's plane, and points of it in front come arbitrarily close, so no near plane covers
+  // it (give one: the part nearer than it is clipped).
+  std::optional<double> z_near;
+  double z_far = 0.0;
+};
+
+// The range for `box` seen by a camera at `cam_from_world`. Throws std::invalid_argument when the
+// whole box is behind the camera (max depth <= 0), naming the depth, or for an invalid box or
+// depth_margin < 0.
+DepthRangeOfBox DepthRangeCoveringBox(const Rigid3& cam_from_world, const BoxInWorld& box,
+                                      double depth_margin = 0.1);
+
 }  // namespace camproj
 
 #endif  // CAMPROJ_CAMERA_H_

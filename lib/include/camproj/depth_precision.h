@@ -81,9 +81,17 @@ struct DepthAdvice {
 // far/near above which AdviseDepth warns.
 inline constexpr double kDepthRatioWarning = 1e5;
 
-// The advice for a projection with z_near, z_far (kInfinity allowed) and `depth`. Throws
-// std::invalid_argument unless 0 < z_near < z_far, z_near finite.
-DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth = {});
+// Whose calls the advice names: OpenGL's (glClipControl, glDepthFunc, GL_DEPTH_COMPONENT32F) or
+// three.js's, where those calls are the renderer's (WebGLRenderer's reversedDepthBuffer, which
+// three r187 has, and logarithmicDepthBuffer).
+enum class DepthAdviceTarget { kOpenGl, kThreeJs };
+
+// The advice for a projection with z_near, z_far (kInfinity allowed) and `depth`, for `target`
+// (kThreeJs: the remedies in warnings and `advice` are three's renderer options instead of GL
+// calls; the table is the same). Throws std::invalid_argument unless 0 < z_near < z_far, z_near
+// finite.
+DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth = {},
+                        DepthAdviceTarget target = DepthAdviceTarget::kOpenGl);
 
 }  // namespace camproj
 

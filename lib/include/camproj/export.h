@@ -54,7 +54,15 @@ struct ExportOptions {
   PixelOrigin pixel_origin = PixelOrigin::kCenter;
 };
 
-// The text of `camera` in `format` (see the file comment), ending in a newline.
+// How far (px) the pinhole projection matrix of the gl, glm and three exports puts a point from
+// where the lens (k1, k2) images it, worst over the image's 4 outer corners (kCenter (-0.5, -0.5),
+// (W - 0.5, -0.5), (-0.5, H - 0.5), (W - 0.5, H - 0.5)): for the ray the matrix sends to a corner
+// c, |PixelFromCam(intrinsics, ray) - c|. 0 without distortion. Throws on an invalid camera.
+double PinholeErrorAtWorstCornerPx(const Camera& camera);
+
+// The text of `camera` in `format` (see the file comment), ending in a newline. The gl, glm and
+// three headers (comments; three's `note`) state the pixel convention and, with k1 or k2 != 0,
+// that the matrix drops the distortion and PinholeErrorAtWorstCornerPx.
 // Throws std::invalid_argument on an invalid camera, on one whose derived numbers overflow
 // (RequireFiniteViews: every format alike, nothing non-finite is ever written), or when the format
 // cannot represent it, saying why: opencv-yaml and colmap refuse skew != 0 (OpenCV's projectPoints ignores

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "camproj/camera.h"
 #include "camproj/camera_file.h"
 #include "camproj/conventions.h"
 #include "camproj/fit.h"
@@ -43,6 +44,9 @@ struct FitArguments {
   std::vector<Eigen::Vector3d> object_points_in_world;
   double z_near = 0.0;  // GL depth range when > 0
   double z_far = 0.0;
+  // --bounds / --bounds-mesh: near and far (those not given above) cover this box, e.g. the
+  // whole model, instead of the fitted points only (DepthRangeCoveringBox, camera.h).
+  std::optional<BoxInWorld> bounds_in_world;
   int max_iterations = 100;
 };
 
@@ -51,6 +55,7 @@ struct FitArguments {
 struct FitRequest {
   bool automatic = true;
   AutoFitOptions auto_options;  // its `fit` is the options in both cases
+  std::optional<BoxInWorld> bounds_in_world;  // applied by RunFitRequest after the fit
   const FitOptions& options() const { return auto_options.fit; }
 };
 
@@ -60,10 +65,22 @@ FitRequest FitRequestFrom(const FitArguments& arguments, const ImageSize& size);
 
 // Runs the request: FitCameraAuto with `ids` as the point names (when one per point), or
 // FitCamera. Throws like them (SceneError for a refusal, std::invalid_argument for bad input).
+// With bounds_in_world, the fitted camera's near and far (those not given as --near / --far)
+// then cover the box (DepthRangeCoveringBox), and its views are rederived; a box that reaches
+// behind the camera without --near, or lies wholly behind it, throws std::invalid_argument
+// naming --bounds, the corner and its depth.
 FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& pixels,
                         const std::vector<std::string>& ids, const ImageSize& size,
                         const FitRequest& request);
+
+// One line (ending in '\n') saying where the fitted camera's near and far come from: the fitted
+// points' depths only (the default; with how to cover the whole model), the box, or the options.
+std::string NearFarNote(const FitRequest& request, const FitResult& fit);
+
+// The bounding box of a Wavefront OBJ's vertices (`v x y z` lines; --bounds-mesh). Throws
+// InputError naming the file (and line) for an unreadable file, a bad vertex or no vertices.
+BoxInWorld ReadObjBoundingBox(const std::string& path);
 
 // The camera file `camproj fit -o` writes for a fit: cx, cy in `pixel_origin`, the look-at target
 // at the fit's distance, and the `fit` record (fit_report.h).

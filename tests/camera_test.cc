@@ -1,0 +1,65 @@
+#include "camproj/camera.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+namespace camproj {
+namespace {
+
+// A camera rotated 90 degrees about y and moved: x_cam = R x_world + t with R = [0 0 1; 0 1 0;
+// -1 0 0], t = (0, 0, 10), so a world point's depth is z_cam = 10 - x_world whatever its y and z.
+Rigid3 TurnedCamera() {
+  Rigid3 cam_from_world;
+  cam_from_world.rotation << 0, 0, 1, 0, 1, 0, -1, 0, 0;
+  cam_from_world.translation = {0, 0, 10};
+  return cam_from_world;
+}
+
+TEST(CameraTest, DepthRangeCoveringBoxByHand) {
+  // x in [1, 4]: depths 6 (the x = 4 corners) to 9 (x = 1). With the 10 % margin: near 6 / 1.1,
+  // far 9 * 1.1. The first corner at depth 6 is index 1 (x from max, y and z from min).
+  const BoxInWorld box{{1, -2, -3}, {4, 5, 6}};
+  const DepthRangeOfBox range = DepthRangeCoveringBox(TurnedCamera(), box, 0.1);
+  EXPECT_EQ(range.min_depth, 6.0);
+  EXPECT_EQ(range.max_depth, 9.0);
+  EXPECT_EQ(range.nearest_corner, 1);
+  EXPECT_EQ(box.Corner(range.nearest_corner), Eigen::Vector3d(4, -2, -3));
+  ASSERT_TRUE(range.z_near.has_value());
+  EXPECT_DOUBLE_EQ(*range.z_near, 6.0 / 1.1);
+  EXPECT_DOUBLE_EQ(range.z_far, 9.9);
+  // Margin 0: the corners' depths themselves.
+  const DepthRangeOfBox tight = DepthRangeCoveringBox(TurnedCamera(), box, 0.0);
+  EXPECT_EQ(*tight.z_near, 6.0);
+  EXPECT_EQ(tight.z_far, 9.0);
+  // The identity camera looks down +z: a box at z in [2, 5] gives depths 2 to 5.
+  const DepthRangeOfBox ahead = DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{-1, -1, 2}, {1, 1, 5}}, 0.0);
+  EXPECT_EQ(*ahead.z_near, 2.0);
+  EXPECT_EQ(ahead.z_far, 5.0);
+}
+
+TEST(CameraTest, DepthRangeOfABoxReachingBehindTheCameraHasNoNear) {
+  // x in [-1, 12]: depths -2 (x = 12, behind) to 11. No near plane covers it; far still does.
+  const DepthRangeOfBox range = DepthRangeCoveringBox(TurnedCamera(), BoxInWorld{{-1, 0, 0}, {12, 1, 1}});
+  EXPECT_FALSE(range.z_near.has_value());
+  EXPECT_EQ(range.min_depth, -2.0);
+  EXPECT_DOUBLE_EQ(range.z_far, 11.0 * 1.1);
+}
+
+TEST(CameraTest, DepthRangeRefusesABoxBehindTheCameraAndBadBoxes) {
+  try {
+    DepthRangeCoveringBox(TurnedCamera(), BoxInWorld{{11, 0, 0}, {12, 1, 1}});
+    FAIL() << "a box wholly behind the camera was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("entirely behind the camera"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("depth -1"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, -1, 3}}), std::invalid_argument);
+  EXPECT_THROW(DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, 1, NAN}}), std::invalid_argument);
+  EXPECT_THROW(DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, 1, 3}}, -0.1),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace camproj
