@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
-# Memory per point of `camproj fit` (docs/reliability.md): the peak RSS of the command line on
-# seeded synthetic scenes of N points (synth, 0.5 px noise), for the default automatic fit and
-# for --model focal, and the slope between the smallest and the largest N in bytes per point
-# (the fixed cost of the binary and its libraries cancels in the slope).
-# Usage: scripts/bench_memory.sh [N...]   (default 100000 400000)
+# Memory per point (docs/reliability.md):
+# 1. the fit's own: `bench --memory --out docs/bench` (apps/bench/memory.cc) writes
+#    docs/bench/memory.md, the peak resident set one fit holds on top of its input, per point;
+# 2. the whole `camproj fit` command's: its peak RSS on seeded synthetic scenes of N points
+#    (synth, 0.5 px noise; reading the CSV, the ids and the fit), for the default automatic fit
+#    and for --model focal, and the slope between the smallest and the largest N in bytes per
+#    point (the fixed cost of the binary and its libraries cancels in the slope); printed only.
+# Usage: scripts/bench_memory.sh [N...]   (N for part 2; default 100000 400000)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build/release"
+bash "$root/scripts/build_release.sh" "$build" bench_memory camproj_bench >/dev/null
 bash "$root/scripts/build_release.sh" "$build" bench_memory camproj_cli >/dev/null
+cd "$root"
+echo "\$ build/release/apps/bench --memory --out docs/bench"
+"$build/apps/bench" --memory --out docs/bench
+echo
+echo "The camproj fit command (peak RSS of the process):"
 bin="$build/apps/camproj"
 sizes=("$@")
 ((${#sizes[@]} > 0)) || sizes=(100000 400000)

@@ -35,7 +35,7 @@ if ! CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCAMPROJ_FUZZ=O
   echo "fuzz: configuring $build failed" >&2
   exit 1
 fi
-targets=(points_csv camera_json)
+targets=(points_csv camera_json fit_scene)
 if ! cmake --build "$build" --target "${targets[@]/%/_fuzzer}" >"$logs/build.log" 2>&1; then
   cat "$logs/build.log" >&2
   echo "fuzz: building the fuzzers failed" >&2
@@ -50,9 +50,9 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/camproj-fuzz.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 # Bounds: -timeout reports an input that takes longer than that (a hang); -max_len 64 KiB, but
 # for the camera-file reader its own size limit, 1 MiB: a deep nesting needs ~130 KB to crash a
-# recursive reader (issue #11).
+# recursive reader (issue #11); and 4 KiB for the fitter's scenes, which read ~400 bytes at most.
 common=(-rss_limit_mb=2048 -timeout=10)
-declare -A max_len=([points_csv]=65536 [camera_json]=1048576)
+declare -A max_len=([points_csv]=65536 [camera_json]=1048576 [fit_scene]=4096)
 
 # Prints a failed step's log and the reproducers it left; $1 target, $2 step, $3 exit code, $4 log.
 report_failure() {
@@ -107,8 +107,10 @@ for target in "${targets[@]}"; do
   cp "${seeds[@]}" "$work/$target/"
   log="$logs/$target.fuzz.log"
   code=0
+  dict=()  # the parsers' tokens; the fitter's scenes are numbers, it has none
+  [[ -f "$root/fuzz/$target.dict" ]] && dict=(-dict="$root/fuzz/$target.dict")
   "$fuzzer" "$work/$target" -max_total_time="$seconds" -print_final_stats=1 \
-    -dict="$root/fuzz/$target.dict" "${common[@]}" "${prefix[@]}" >"$log" 2>&1 || code=$?
+    "${dict[@]}" "${common[@]}" "${prefix[@]}" >"$log" 2>&1 || code=$?
   if ((code != 0)); then
     report_failure "$target" "fuzzing" "$code" "$log"
     failed=1

@@ -17,6 +17,7 @@ expect_exit() {
   [[ $got -eq $want ]] || fail "exit $got, expected $want: $*\n--- stdout\n$(cat "$work/out")\n--- stderr\n$(cat "$work/err")"
 }
 expect_in() { grep -q -- "$2" "$work/$1" || fail "$1 lacks '$2':\n$(cat "$work/$1")"; }
+expect_not_in() { ! grep -q -- "$2" "$work/$1" || fail "$1 has '$2':\n$(cat "$work/$1")"; }
 py() { /usr/bin/python3 "$@"; }
 
 case $case in
@@ -604,6 +605,80 @@ INNER
     expect_in err "/dev/zero: is a character device"
     expect_exit 2 timeout 20 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" "$work/fifo.csv" -o "$work/o.png"
     expect_in err "fifo.csv: is a FIFO"
+    ;;
+  out_of_memory_refused)
+    # More points than the process can hold: exit 2 naming the file and what a point costs, no
+    # output file, never "std::bad_alloc" (or, without the up-front check, the OOM killer). The
+    # limit is an address-space one (ulimit -v) set from the binary's own need: the smallest
+    # limit, in 16 MB steps, under which a 6-point fit runs, plus a margin. A sanitizer build
+    # reserves terabytes of address space and cannot run under any such limit: SKIPPED there.
+    if ! (ulimit -v 4000000; "$bin" --version >/dev/null 2>&1); then
+      echo "SKIPPED [$case]: the binary does not start under a 4 GB address-space limit (a sanitizer build)"
+      exit 77
+    fi
+    "$bin" synth --seed 1 --points 300000 --noise 0.5 -o "$work/big.csv" --truth "$work/t.json" >/dev/null
+    "$bin" synth --seed 1 --points 6 --noise 0.5 -o "$work/small.csv" --truth "$work/t6.json" >/dev/null
+    base=""
+    for ((kb = 65536; kb <= 4000000; kb += 16384)); do
+      if (ulimit -v $kb; "$bin" fit "$work/small.csv" --image-size 1920x1080 >/dev/null 2>&1); then
+        base=$kb
+        break
+      fi
+    done
+    [[ -n $base ]] || fail "no address-space limit up to 4 GB lets a 6-point fit run"
+    # 48 MB more: enough to read the 300 000 points (about 80 bytes a point with their ids), not
+    # to fit them too (200 bytes a point, 60 MB): refused up front, before fitting.
+    expect_exit 2 bash -c 'ulimit -v $1; exec "$2" fit "$3" --image-size 1920x1080 -o "$4"' _ \
+      $((base + 49152)) "$bin" "$work/big.csv" "$work/big.json"
+    expect_in err "big.csv: fitting its 300000 points needs about 60 MB (200 bytes a point"
+    expect_not_in err "bad_alloc"
+    [[ ! -e "$work/big.json" ]] || fail "a refused fit wrote its output"
+    # 4 MB more: not even the points can be read; reported as out of memory, naming the file.
+    expect_exit 2 bash -c 'ulimit -v $1; exec "$2" fit "$3" --image-size 1920x1080 -o "$4"' _ \
+      $((base + 4096)) "$bin" "$work/big.csv" "$work/big.json"
+    expect_in err "big.csv: out of memory reading it"
+    expect_not_in err "bad_alloc"
+    [[ ! -e "$work/big.json" ]] || fail "a fit out of memory wrote its output"
+    # And the same file fits where the memory is there (the limit is not what refused it).
+    expect_exit 0 bash -c 'ulimit -v $1; exec "$2" fit "$3" --image-size 1920x1080 -o "$4"' _ \
+      $((base + 409600)) "$bin" "$work/big.csv" "$work/big.json"
+    ;;
+  exit2_messages_name_the_file)
+    # The audit of exit 2 (bad input): every file slot of every command, given a file that is
+    # missing, a folder, or garbage, exits 2 with a message that names that file (issue #11).
+    cam="$data/projector/truth.json"
+    pts="$data/projector/points.csv"
+    mkdir -p "$work/a_folder.csv"
+    printf 'not a camera, points, photo or mesh\n\x01\x02 1,2\n' >"$work/garbage.txt"
+    printf 'v 0 0 nope\n' >"$work/garbage.obj"
+    slots=(
+      "fit @ --image-size 1920x1080 -o $work/o1.json"
+      "fit $pts --image-size 1920x1080 --intrinsics @ -o $work/o2.json"
+      "fit $pts --image-size 1920x1080 --object-points @ -o $work/o3.json"
+      "fit $pts --image-size 1920x1080 --bounds-mesh @ -o $work/o4.json"
+      "export @"
+      "export @ --to three"
+      "project @ $pts"
+      "project $cam @"
+      "overlay @ $pts -o $work/o5.png"
+      "overlay $cam @ -o $work/o6.png"
+      "overlay $cam $pts @ -o $work/o7.png"
+      "view @ $pts -o $work/o8.html"
+      "view $cam @ -o $work/o9.html"
+      "view $cam $pts --image @ -o $work/o10.html"
+      "view $cam $pts --mesh @ -o $work/o11.html"
+    )
+    for slot in "${slots[@]}"; do
+      bads=("$work/missing.csv" "$work/a_folder.csv" "$work/garbage.txt")
+      # (fit's POINTS may be a folder of CSV files: an empty one is a usage error, exit 1.)
+      [[ $slot == "fit @"* ]] && bads=("$work/missing.csv" "$work/garbage.txt")
+      [[ $slot == *--bounds-mesh* || $slot == *--mesh* ]] && bads+=("$work/garbage.obj")
+      for bad in "${bads[@]}"; do
+        # shellcheck disable=SC2086  # the slot is a word list
+        expect_exit 2 "$bin" ${slot//@/$bad}
+        expect_in err "$bad"
+      done
+    done
     ;;
   export_non_finite_refused)
     # fx = 1e308 overflowed the GL matrices to inf (gl) or null (json), exit 0; cx = 1e308 failed

@@ -4,6 +4,7 @@
 //   bench [--quick] [--out DIR] [--scenes-scale X] [--mapamok-literal-focal]
 //   bench --clicks [--quick] [--out DIR] [--scenes N]     (the click benchmark: clicks.h)
 //   bench --stage-cost [--n N,N,...] [--seeds K]          (the default path's cost: stage_cost.h)
+//   bench --memory [--n N,N,...] [--out DIR]              (memory per point: memory.h)
 //
 // Writes DIR/results.csv, DIR/results.json and DIR/table.md. Single-threaded (OpenCV is set to
 // one thread, Ceres runs with one), so 1 / median time is fits per second per core.
@@ -35,6 +36,7 @@
 #include "camproj/synth.h"
 #include "common.h"
 #include "clicks.h"
+#include "memory.h"
 #include "stage_cost.h"
 
 #ifndef CAMPROJ_CERES_VERSION
@@ -97,7 +99,8 @@ const char* kUsage =
     "\n"
     "bench --clicks [...] runs the click benchmark of the default fitting path instead\n"
     "(bench --clicks --help); bench --stage-cost [...] what the default path costs on clean\n"
-    "scenes (bench --stage-cost --help).\n"
+    "scenes (bench --stage-cost --help); bench --memory [...] the fit's memory per point\n"
+    "(bench --memory --help).\n"
     "\n"
     "Example:\n"
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
@@ -968,6 +971,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--clicks") return camproj::bench::ClicksMain(argc, argv);
     if (std::string(argv[i]) == "--stage-cost") return camproj::bench::StageCostMain(argc, argv);
+    if (std::string(argv[i]) == "--memory") return camproj::bench::MemoryMain(argc, argv);
   }
   camproj::bench::BenchOptions options;
   options.command = "bench";

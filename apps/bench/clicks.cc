@@ -959,38 +959,6 @@ std::string UtcNow() {
   return buffer;
 }
 
-// First line of a shell command's output, "" on failure.
-std::string ShellLine(const std::string& command) {
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return "";
-  char buffer[256];
-  std::string line;
-  if (std::fgets(buffer, sizeof buffer, pipe) != nullptr) line = buffer;
-  pclose(pipe);
-  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
-  return line;
-}
-
-// "1.23 0.98 0.50" from /proc/loadavg, "unknown" elsewhere.
-std::string LoadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string one, five, fifteen;
-  if (!(in >> one >> five >> fifteen)) return "unknown";
-  return one + " " + five + " " + fifteen;
-}
-
-// The source's commit, marked when lib/ or apps/ differ from it.
-std::string GitDescription() {
-  const std::string dir = CAMPROJ_SOURCE_DIR;
-  const std::string git = "git -C '" + dir + "' ";
-  std::string commit = ShellLine(git + "rev-parse --short HEAD 2>/dev/null");
-  if (commit.empty()) return "unknown";
-  if (!ShellLine(git + "status --porcelain -- lib apps 2>/dev/null").empty()) {
-    commit += " (with uncommitted changes in lib/ or apps/)";
-  }
-  return commit;
-}
-
 std::string RefusalSummary(const BandStats& s) {
   std::string text = std::to_string(s.refused);
   if (s.refusals.empty()) return text;

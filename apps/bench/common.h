@@ -1,11 +1,13 @@
-// Helpers both benchmarks (bench.cc: error against run time; clicks.cc: the default path on
-// clicked scenes) use: table numbers, order statistics and OpenCV's camera -> camproj's.
+// Helpers the benchmarks (bench.cc: error against run time; clicks.cc: the default path on
+// clicked scenes; memory.cc: memory per point) use: table numbers, order statistics, OpenCV's
+// camera -> camproj's, and the machine's state for a report's header.
 #ifndef CAMPROJ_APPS_BENCH_COMMON_H_
 #define CAMPROJ_APPS_BENCH_COMMON_H_
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,38 @@ inline Intrinsics IntrinsicsFromCv(const cv::Mat& k) {
   intrinsics.cy = k.at<double>(1, 2);
   intrinsics.skew = k.at<double>(0, 1);
   return intrinsics;
+}
+
+// First line of a shell command's output, "" on failure.
+inline std::string ShellLine(const std::string& command) {
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return "";
+  char buffer[256];
+  std::string line;
+  if (std::fgets(buffer, sizeof buffer, pipe) != nullptr) line = buffer;
+  pclose(pipe);
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+  return line;
+}
+
+// "1.23 0.98 0.50" from /proc/loadavg, "unknown" elsewhere.
+inline std::string LoadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (!(in >> one >> five >> fifteen)) return "unknown";
+  return one + " " + five + " " + fifteen;
+}
+
+// The source's commit, marked when lib/ or apps/ differ from it.
+inline std::string GitDescription() {
+  const std::string dir = CAMPROJ_SOURCE_DIR;
+  const std::string git = "git -C '" + dir + "' ";
+  std::string commit = ShellLine(git + "rev-parse --short HEAD 2>/dev/null");
+  if (commit.empty()) return "unknown";
+  if (!ShellLine(git + "status --porcelain -- lib apps 2>/dev/null").empty()) {
+    commit += " (with uncommitted changes in lib/ or apps/)";
+  }
+  return commit;
 }
 
 }  // namespace bench

@@ -1,4 +1,5 @@
 // camproj fit: correspondences -> camera file and a summary.
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -52,6 +55,57 @@ struct FitArgs {
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
 
+// The memory the default fit holds per point on top of the points as read (bytes): its
+// bytes per point at 100 000 and 400 000 points in docs/bench/memory.md (`bench --memory`: 189
+// and 171), rounded up. Below 100 000 points the fixed part dominates, but then it is a few MB.
+constexpr double kFitBytesPerPoint = 200.0;
+
+// A field of a /proc file in kB ("MemAvailable" of /proc/meminfo, "VmSize" of
+// /proc/self/status); nullopt where the file or the field is missing.
+std::optional<double> ProcKb(const char* path, const std::string& field) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, field.size() + 1, field + ":") == 0) {
+      return std::atof(line.c_str() + field.size() + 1);
+    }
+  }
+  return std::nullopt;
+}
+
+// The memory this process can still take (bytes): the smaller of the machine's available
+// memory and, under an address-space limit (ulimit -v), the limit minus what is mapped now;
+// nullopt where neither is known. Linux overcommits: without this check a fit too large for the
+// machine ends by the OOM killer, not by a message.
+std::optional<double> AvailableBytes() {
+  std::optional<double> available;
+  if (const std::optional<double> kb = ProcKb("/proc/meminfo", "MemAvailable")) {
+    available = 1024.0 * *kb;
+  }
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    if (const std::optional<double> kb = ProcKb("/proc/self/status", "VmSize")) {
+      const double left = static_cast<double>(limit.rlim_cur) - 1024.0 * *kb;
+      available = available ? std::min(*available, left) : left;
+    }
+  }
+  return available;
+}
+
+// Refuses, naming the file, a fit that needs more memory than this process can still take.
+void RequireMemoryToFit(const std::string& path, size_t num_points) {
+  const double needed = kFitBytesPerPoint * static_cast<double>(num_points);
+  const std::optional<double> available = AvailableBytes();
+  if (!available || needed <= *available) return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "fitting its %zu points needs about %.0f MB (%.0f bytes a point, "
+                "docs/reliability.md), more than the %.0f MB this process can still take (free "
+                "memory, ulimit -v): fit fewer points",
+                num_points, needed / 1e6, kFitBytesPerPoint, std::max(0.0, *available) / 1e6);
+  throw InputError(path + ": " + text);
+}
+
 FitResult RunFit(const Correspondences& data, const ImageSize& size, const FitRequest& request) {
   return RunFitRequest(data.points_in_world, data.pixels, data.ids, size, request);
 }
@@ -66,13 +120,15 @@ FileFit FitFile(const std::string& path, const ImageSize& size, const FitRequest
   FileFit result;
   try {
     result.data = ReadCorrespondencesFile(path);
+    RequireMemoryToFit(path, result.data.pixels.size());
     result.fit = RunFit(result.data, size, request);
   } catch (const std::bad_alloc&) {
     const size_t rows = result.data.pixels.size();
     throw InputError(path + ": out of memory " +
                      (rows == 0 ? std::string("reading it")
                                 : "fitting its " + std::to_string(rows) + " points") +
-                     ": the automatic fit needs about 1 KB per point (docs/reliability.md); fit "
+                     ": a fit needs about " + std::to_string(static_cast<int>(kFitBytesPerPoint)) +
+                     " bytes a point on top of the points read (docs/reliability.md); fit "
                      "fewer points");
   }
   return result;

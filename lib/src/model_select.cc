@@ -31,23 +31,37 @@ using Clock = std::chrono::steady_clock;
 
 using internal::Px;
 
-std::vector<std::string> NamesOf(const AutoFitOptions& options, size_t n) {
+// The points' names in messages: the caller's (not copied), else "point 1", "point 2", ...
+// made in `made`.
+const std::vector<std::string>& NamesOf(const AutoFitOptions& options, size_t n,
+                                        std::vector<std::string>* made) {
   if (!options.point_names.empty()) return options.point_names;
-  std::vector<std::string> names(n);
-  for (size_t i = 0; i < n; ++i) names[i] = "point " + std::to_string(i + 1);
-  return names;
+  made->resize(n);
+  for (size_t i = 0; i < n; ++i) (*made)[i] = "point " + std::to_string(i + 1);
+  return *made;
 }
 
 // The points not in `left_out` (sorted).
 template <typename T>
 std::vector<T> Kept(const std::vector<T>& values, const std::vector<int>& left_out) {
   std::vector<T> kept;
+  kept.reserve(values.size() - std::min(values.size(), left_out.size()));
   for (size_t i = 0; i < values.size(); ++i) {
     if (!std::binary_search(left_out.begin(), left_out.end(), static_cast<int>(i))) {
       kept.push_back(values[i]);
     }
   }
   return kept;
+}
+
+// `values` itself when nothing is left out (no copy: the points can be millions), else the
+// points not in `left_out`, held in `storage`.
+template <typename T>
+const std::vector<T>& KeptOrAll(const std::vector<T>& values, const std::vector<int>& left_out,
+                                std::vector<T>* storage) {
+  if (left_out.empty()) return values;
+  *storage = Kept(values, left_out);
+  return *storage;
 }
 
 // Lengths of the residuals of the points not in `left_out` (sorted).
@@ -269,9 +283,12 @@ Gated Gate(internal::Selection selection, const std::vector<int>& left_out,
   Gated gated;
   gated.residuals_px = internal::ResidualsAgainst(selection.fit.camera, points, pixels,
                                                   options.fit.pixel_origin);
+  std::vector<Eigen::Vector3d> kept_points;
+  std::vector<Eigen::Vector2d> kept_pixels;
   gated.check = internal::CheckConsistency(
       KeptLengths(gated.residuals_px, left_out),
-      internal::Repeats(Kept(points, left_out), Kept(pixels, left_out)),
+      internal::Repeats(KeptOrAll(points, left_out, &kept_points),
+                        KeptOrAll(pixels, left_out, &kept_pixels)),
       static_cast<int>(selection.fit.free_parameters.size()), noise, options);
   gated.selection = std::move(selection);
   return gated;
@@ -285,7 +302,10 @@ Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
                const internal::NoiseReference& noise, const internal::Screen* screen = nullptr) {
   const internal::Prefit* prefit =
       screen != nullptr && screen->fit && left_out.empty() ? &*screen->fit : nullptr;
-  return Gate(internal::SelectModel(Kept(points, left_out), Kept(pixels, left_out), size, options,
+  std::vector<Eigen::Vector3d> kept_points;
+  std::vector<Eigen::Vector2d> kept_pixels;
+  return Gate(internal::SelectModel(KeptOrAll(points, left_out, &kept_points),
+                                    KeptOrAll(pixels, left_out, &kept_pixels), size, options,
                                     prefit),
               left_out, points, pixels, options, noise);
 }
@@ -298,11 +318,15 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                  const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                  const AutoFitOptions& options, const std::vector<std::string>& names) {
   // The refusals first, in order (mirror, gate, determination), on the selection as gated.
-  const std::vector<Eigen::Vector3d> kept_points = Kept(points, left_out);
+  std::vector<Eigen::Vector3d> kept_points_storage;
+  std::vector<Eigen::Vector2d> kept_pixels_storage;
+  const std::vector<Eigen::Vector3d>& kept_points =
+      KeptOrAll(points, left_out, &kept_points_storage);
+  const std::vector<Eigen::Vector2d>& kept_pixels =
+      KeptOrAll(pixels, left_out, &kept_pixels_storage);
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
   const std::optional<internal::Rival> mirrored = MirrorTest(
-      gated.selection, gated.check.rms_px, kept_points, Kept(pixels, left_out), size, options,
-      noise);
+      gated.selection, gated.check.rms_px, kept_points, kept_pixels, size, options, noise);
   if (!gated.check.passed) {
     throw SceneError(SceneError::Reason::kInconsistent,
                      "no camera explains these points: " + gated.check.summary +
@@ -312,7 +336,7 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
                                       : "; if your points are this noisy, give --sigma PX"));
   }
   if (mirrored) gated.selection.rivals.push_back(*mirrored);
-  for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, Kept(pixels, left_out), size)) {
+  for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, kept_pixels, size)) {
     gated.selection.rivals.push_back(std::move(rival));
   }
   const DeterminationCheck determination =
@@ -403,7 +427,8 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
 FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
                       const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                       const AutoFitOptions& options, Clock::time_point start) {
-  const std::vector<std::string> names = NamesOf(options, points.size());
+  std::vector<std::string> made_names;
+  const std::vector<std::string>& names = NamesOf(options, points.size(), &made_names);
   const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
   std::vector<int> left_out;
   std::string method;
@@ -431,12 +456,16 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
     if (!screen.consistent && options.find_outliers) run_search();
     std::optional<SceneError> refusal;
     std::string problem;
+    // The options as the selection reads them, without the names (which `names` holds): each
+    // selection below copies them, and the names are as many as the points.
+    AutoFitOptions unnamed = options;
+    std::vector<std::string>().swap(unnamed.point_names);
     auto select = [&] {
       refusal.reset();
       gated.reset();
       // After a failed screen that no outliers explain, a richer model must leave N equations
       // to spare (model_select.h, min_redundancy).
-      AutoFitOptions guarded = options;
+      AutoFitOptions guarded = unnamed;
       if (!screen.consistent && left_out.empty()) {
         guarded.min_redundancy = std::max(options.min_redundancy, static_cast<int>(points.size()));
       }

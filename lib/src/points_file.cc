@@ -128,6 +128,12 @@ class CsvParser {
       throw InputError(source_ + ": the header (line " + std::to_string(header_line_) +
                        ") is followed by no data rows");
     }
+    // The rows were appended one by one (capacity up to twice the size); the fit holds them
+    // throughout, so give the slack back.
+    result_.points_in_world.shrink_to_fit();
+    result_.pixels.shrink_to_fit();
+    result_.ids.shrink_to_fit();
+    result_.line_numbers.shrink_to_fit();
     return std::move(result_);
   }
 

@@ -202,6 +202,11 @@ json ImageJson(const std::string& path, const Camera& camera) {
 
 json MeshJson(const std::string& path, ViewStats& stats) {
   const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path, kMaxMeshFileBytes), path);
+  // ParseObjMesh skips the lines it does not know (OBJ has many): a file of none it knows is
+  // not a mesh, and drawing nothing would hide that.
+  if (mesh.triangles.empty()) {
+    throw InputError(path + ": no faces (f lines with vertices from v lines): not an OBJ mesh");
+  }
   stats.mesh_triangles = static_cast<int>(mesh.triangles.size() / 3);
   return {{"name", path}, {"positions", mesh.positions}, {"triangles", mesh.triangles}};
 }

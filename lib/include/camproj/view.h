@@ -28,8 +28,8 @@ struct ViewOptions {
   // camera's image size (EXIF-turned JPEGs are refused: the page would show them turned). Empty:
   // none.
   std::string image_path;
-  // Wavefront OBJ in world units (`v` and `f` lines; others ignored), drawn in the orbit view.
-  // Empty: none.
+  // Wavefront OBJ in world units (`v` and `f` lines; others ignored; a file without a face is
+  // refused), drawn in the orbit view. Empty: none.
   std::string mesh_path;
   std::string title;  // page title; empty: "camproj view: " + the camera's name
   void Check() const;  // nothing to check today; kept for the options-in convention

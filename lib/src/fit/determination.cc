@@ -177,26 +177,41 @@ Camera InUnitWorld(const Camera& camera, const Eigen::Vector3d& origin, double u
 }
 
 // ReprojectionSigmaPx's linearization of one camera, prepared once: the Jacobi-scaled inverse
-// of J^T J; SigmaAt then costs one point's Jacobian.
+// of J^T J; SigmaAt then costs one point's Jacobian. J is never held whole: J^T J is summed over
+// blocks of points, and a fitted point's rows are recomputed where they are asked for, so the
+// memory does not grow with the points (at a million points J alone would be ~100 MB).
 class PixelUncertainty {
  public:
-  // Throws std::invalid_argument if a fitted point is not in front of the camera.
+  // `fitted_points` (with z negated if mirrored_z) must outlive this object. Throws
+  // std::invalid_argument if a fitted point is not in front of the camera.
   PixelUncertainty(const Camera& camera, const FitOptions& model,
-                   const std::vector<Eigen::Vector3d>& fitted_points, double sigma_px)
-      : sigma_px_(sigma_px) {
+                   const std::vector<Eigen::Vector3d>& fitted_points, double sigma_px,
+                   bool mirrored_z = false)
+      : sigma_px_(sigma_px), fitted_(&fitted_points), mirrored_z_(mirrored_z) {
     Require(!fitted_points.empty(), "no fitted points");
     const std::vector<Parameter> params = ParametersOf(camera, model);
     // The eye's step scale: the median distance from the eye to the fitted points.
     const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
     std::vector<double> distances;
-    for (const Eigen::Vector3d& x : fitted_points) distances.push_back((x - eye).norm());
+    distances.reserve(fitted_points.size());
+    for (size_t i = 0; i < fitted_points.size(); ++i) distances.push_back((Fitted(i) - eye).norm());
     std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
     const double length_scale = std::max(distances[distances.size() / 2], 1e-300);
     at_ = Linearization{camera, length_scale, params};
 
-    const std::optional<size_t> behind = PixelJacobian(at_, fitted_points, &fitted_jacobian_);
-    Require(!behind, "point ", behind.value_or(0), " is not in front of the camera");
-    const Eigen::MatrixXd normal = fitted_jacobian_.transpose() * fitted_jacobian_;
+    constexpr size_t kBlock = 256;  // points per block of J: large enough for a blocked product
+    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(params.size(), params.size());
+    std::vector<Eigen::Vector3d> block;
+    Eigen::MatrixXd block_jacobian;
+    for (size_t begin = 0; begin < fitted_points.size(); begin += kBlock) {
+      block.clear();
+      for (size_t i = begin; i < std::min(begin + kBlock, fitted_points.size()); ++i) {
+        block.push_back(Fitted(i));
+      }
+      const std::optional<size_t> behind = PixelJacobian(at_, block, &block_jacobian);
+      Require(!behind, "point ", begin + behind.value_or(0), " is not in front of the camera");
+      normal.noalias() += block_jacobian.transpose() * block_jacobian;
+    }
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the eigen-decomposition, refusing near-singular directions.
     const Eigen::VectorXd d_inverse = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
@@ -206,10 +221,9 @@ class PixelUncertainty {
     singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));
     if (singular_) return;
     // (J^T J)^-1 = W W^T with W = D^-1 V L^-1/2 (scaled = V L V^T): a point's variance is the
-    // squared norm of J_x W, and every fitted point's comes from one product J W.
+    // squared norm of J_x W.
     whitening_ = d_inverse.asDiagonal() * eigen.eigenvectors() *
                  values.cwiseSqrt().cwiseInverse().asDiagonal();
-    fitted_whitened_ = fitted_jacobian_ * whitening_;
   }
 
   // The 1-sigma length of the reprojection error of `x`; +inf where J^T J is singular or `x` is
@@ -230,27 +244,41 @@ class PixelUncertainty {
   // moves its prediction (identity where J^T J is singular).
   Eigen::Matrix2d HatAt(size_t i) const {
     if (singular_) return Eigen::Matrix2d::Identity();
-    const Eigen::MatrixXd rows = fitted_whitened_.middleRows(2 * i, 2);
+    const Eigen::MatrixXd rows = FittedRows(i) * whitening_;
     return rows * rows.transpose();
   }
 
-  // SigmaAt of fitted point i, whose Jacobian (J's rows 2i, 2i+1) is known: the same numbers.
+  // SigmaAt of fitted point i (J's rows 2i, 2i+1; in front of the camera, as the constructor
+  // checked).
   double SigmaAtFitted(size_t i) const {
     if (singular_) return std::numeric_limits<double>::infinity();
-    return sigma_px_ * std::sqrt(fitted_whitened_.middleRows(2 * i, 2).squaredNorm());
+    return SigmaOf(FittedRows(i));
   }
 
  private:
+  Eigen::Vector3d Fitted(size_t i) const {
+    Eigen::Vector3d x = (*fitted_)[i];
+    if (mirrored_z_) x.z() = -x.z();
+    return x;
+  }
+
+  // Rows 2i, 2i + 1 of J.
+  Eigen::MatrixXd FittedRows(size_t i) const {
+    Eigen::MatrixXd jacobian;
+    PixelJacobian(at_, {Fitted(i)}, &jacobian);
+    return jacobian;
+  }
+
   // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
   double SigmaOf(const Eigen::MatrixXd& jacobian) const {
     return sigma_px_ * std::sqrt((jacobian * whitening_).squaredNorm());
   }
 
   double sigma_px_;
+  const std::vector<Eigen::Vector3d>* fitted_;
+  bool mirrored_z_ = false;
   Linearization at_;
-  Eigen::MatrixXd fitted_jacobian_;
-  Eigen::MatrixXd whitening_;        // W: (J^T J)^-1 = W W^T
-  Eigen::MatrixXd fitted_whitened_;  // J W, two rows per fitted point
+  Eigen::MatrixXd whitening_;  // W: (J^T J)^-1 = W W^T
   bool singular_ = false;
 };
 
@@ -285,7 +313,7 @@ bool BeforeTheFold(const Camera& camera, const Eigen::Vector3d& point_in_world,
 TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>& points,
                         double min_thickness,
                         const std::vector<Eigen::Vector3d>& object_points = {}) {
-  std::vector<Eigen::Vector3d> candidates = points;
+  std::vector<Eigen::Vector3d> box;  // corners, then face centres
   if (!points.empty()) {
     const Eigen::Vector3d mean = Centroid(points);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
@@ -306,27 +334,35 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
     for (int bits = 0; bits < 8; ++bits) {  // corners
       const Eigen::Vector3d c((bits & 1) ? hi.x() : lo.x(), (bits & 2) ? hi.y() : lo.y(),
                               (bits & 4) ? hi.z() : lo.z());
-      candidates.push_back(mean + axes * c);
+      box.push_back(mean + axes * c);
     }
     for (int axis = 0; axis < 3; ++axis) {  // face centres
       for (const double side : {lo(axis), hi(axis)}) {
         Eigen::Vector3d c = mid;
         c(axis) = side;
-        candidates.push_back(mean + axes * c);
+        box.push_back(mean + axes * c);
       }
     }
   }
-  candidates.insert(candidates.end(), object_points.begin(), object_points.end());
+  // The fitted points, the box, the object points, in that order, where the image shows them
+  // (reserved once: the fitted points can be millions).
   TestPoints inside;
-  for (size_t k = 0; k < candidates.size(); ++k) {
-    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, candidates[k]);
+  const size_t total = points.size() + box.size() + object_points.size();
+  inside.points.reserve(total);
+  inside.fitted.reserve(total);
+  inside.object.reserve(total);
+  auto consider = [&](const Eigen::Vector3d& x, int fitted, bool object) {
+    const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, x);
     if (u && u->x() >= -0.5 && u->x() <= camera.image_size.width - 0.5 && u->y() >= -0.5 &&
-        u->y() <= camera.image_size.height - 0.5 && BeforeTheFold(camera, candidates[k], *u)) {
-      inside.points.push_back(candidates[k]);
-      inside.fitted.push_back(k < points.size() ? static_cast<int>(k) : -1);
-      inside.object.push_back(k >= candidates.size() - object_points.size());
+        u->y() <= camera.image_size.height - 0.5 && BeforeTheFold(camera, x, *u)) {
+      inside.points.push_back(x);
+      inside.fitted.push_back(fitted);
+      inside.object.push_back(object);
     }
-  }
+  };
+  for (size_t k = 0; k < points.size(); ++k) consider(points[k], static_cast<int>(k), false);
+  for (const Eigen::Vector3d& x : box) consider(x, -1, false);
+  for (const Eigen::Vector3d& x : object_points) consider(x, -1, true);
   return inside;
 }
 
@@ -450,9 +486,8 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     const Camera rival_camera = InUnitWorld(rival.camera, flip.asDiagonal() * origin, unit);
     try {
       counted.push_back({&rival, rival_camera,
-                         PixelUncertainty(rival_camera, rival.options,
-                                          rival.mirrored_world ? MirroredZ(points) : points,
-                                          sigma)});
+                         PixelUncertainty(rival_camera, rival.options, points, sigma,
+                                          rival.mirrored_world)});
     } catch (const std::invalid_argument&) {
     }
   }

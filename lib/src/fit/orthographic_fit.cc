@@ -69,39 +69,53 @@ void AffineRq(const Eigen::Matrix<double, 2, 3>& a, Eigen::Matrix2d* k2, Eigen::
   r->row(2) = r1.cross(r2).transpose();  // proper: the depth order a right-handed world implies
 }
 
-}  // namespace
+SceneError NoAffineCamera() {
+  return SceneError(SceneError::Reason::kDegenerate,
+                    "no affine camera fits these points (their image is degenerate): check the "
+                    "correspondences");
+}
 
-FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
+// The orthographic family's linear part, shared by FitOrthographic and AffineSumSquaresPx2: the
+// normalized world (centred, unit RMS distance), kCenter pixels, and the affine camera
+// [X 1] a_row = u, v by least squares (4 x 4 normal equations), after the refusals every
+// orthographic fit makes (too few points, collinear or coplanar points, coordinates too large).
+struct AffineScene {
+  std::vector<Eigen::Vector3d> points;  // normalized world
+  std::vector<Eigen::Vector2d> pixels;  // kCenter
+  Eigen::Vector3d centroid;
+  double scale = 1.0;
+  double shift = 0.0;  // pixel origin shift to kCenter
+  Eigen::Matrix<double, 4, 2> solution;  // rows: A^T (3), b^T
+};
+
+AffineScene PrepareAffine(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels,
-                          const ImageSize& image_size, const FitOptions& options) {
-  const auto start_time = std::chrono::steady_clock::now();
+                          const FitOptions& options, int num_params) {
   const int n = static_cast<int>(points_in_world.size());
-  const bool scale_free = options.focal.IsFree() || options.focal.kind == ParameterMode::Kind::kDefault;
-  const bool aspect_free = options.aspect.IsFree();
-  const bool skew_free = options.skew.IsFree();
-  const int num_params = 5 + (scale_free ? 1 : 0) + (aspect_free ? 1 : 0) + (skew_free ? 1 : 0);
   if (2 * n < num_params || n < 4) {
     throw SceneError(SceneError::Reason::kTooFewPoints,
                      Concat(n, " points give ", 2 * n, " equations; the orthographic model has ",
                             num_params, " unknowns and its linear start needs 4 points off a "
                             "plane: add points"));
   }
-
-  // The normalized world (centred, unit RMS distance) and kCenter pixels, as in FitCamera.
-  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
-  const Eigen::Vector3d centroid = Centroid(points_in_world);
-  Eigen::MatrixXd centred(n, 3);
-  for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
-  const double scale = RmsRowLength(centred);
+  AffineScene scene;
+  scene.shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  scene.centroid = Centroid(points_in_world);
+  {
+    Eigen::MatrixXd centred(n, 3);
+    for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - scene.centroid).transpose();
+    scene.scale = RmsRowLength(centred);
+  }
+  const double scale = scene.scale;
   if (!std::isfinite(scale)) throw TooLargeForDouble();
-  std::vector<Eigen::Vector3d> points(n);
-  std::vector<Eigen::Vector2d> pixels(n);
+  scene.points.resize(n);
+  scene.pixels.resize(n);
   // The shape from the normalized points (the scatter of the raw ones overflows above ~1e154).
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (int i = 0; i < n; ++i) {
-    points[i] = centred.row(i).transpose() / scale;
-    pixels[i] = observed_pixels[i] + Eigen::Vector2d(shift, shift);
-    scatter += points[i] * points[i].transpose();
+    scene.points[i] = (points_in_world[i] - scene.centroid) / scale;  // as centred.row(i) / scale
+    scene.pixels[i] = observed_pixels[i] + Eigen::Vector2d(scene.shift, scene.shift);
+    scatter += scene.points[i] * scene.points[i].transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> shape(scatter);
   const Eigen::Vector3d extents = shape.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
@@ -115,26 +129,59 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                      "poses (the sign of its tilt is not in the image); add points off the plane "
                      "or fit a perspective camera");
   }
-  CheckOffset(points_in_world, scale, pixels);
+  CheckOffset(points_in_world, scale, scene.pixels);
 
-  // Affine start: [X 1] a_row = u, v by least squares (4 x 4 normal equations).
   Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
   Eigen::Matrix<double, 4, 2> rhs = Eigen::Matrix<double, 4, 2>::Zero();
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector4d h = points[i].homogeneous();
+    const Eigen::Vector4d h = scene.points[i].homogeneous();
     normal += h * h.transpose();
-    rhs += h * pixels[i].transpose();
+    rhs += h * scene.pixels[i].transpose();
   }
-  const Eigen::Matrix<double, 4, 2> solution = normal.ldlt().solve(rhs);
+  scene.solution = normal.ldlt().solve(rhs);
+  return scene;
+}
+
+}  // namespace
+
+double AffineSumSquaresPx2(const std::vector<Eigen::Vector3d>& points_in_world,
+                           const std::vector<Eigen::Vector2d>& observed_pixels,
+                           const FitOptions& options) {
+  const AffineScene scene = PrepareAffine(points_in_world, observed_pixels, options, 8);
+  const Eigen::Matrix<double, 2, 3> a = scene.solution.topRows<3>().transpose();
+  const Eigen::Vector2d b = scene.solution.row(3).transpose();
+  Eigen::Matrix2d k2;
+  Eigen::Matrix3d rotation;
+  AffineRq(a, &k2, &rotation);
+  if (!(k2(0, 0) > 0.0 && k2(1, 1) > 0.0) || !rotation.allFinite()) throw NoAffineCamera();
+  double sum_squares = 0.0;
+  for (size_t i = 0; i < scene.points.size(); ++i) {
+    sum_squares += (scene.pixels[i] - a * scene.points[i] - b).squaredNorm();
+  }
+  return sum_squares;
+}
+
+FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
+                          const std::vector<Eigen::Vector2d>& observed_pixels,
+                          const ImageSize& image_size, const FitOptions& options) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const int n = static_cast<int>(points_in_world.size());
+  const bool scale_free = options.focal.IsFree() || options.focal.kind == ParameterMode::Kind::kDefault;
+  const bool aspect_free = options.aspect.IsFree();
+  const bool skew_free = options.skew.IsFree();
+  const int num_params = 5 + (scale_free ? 1 : 0) + (aspect_free ? 1 : 0) + (skew_free ? 1 : 0);
+  AffineScene scene = PrepareAffine(points_in_world, observed_pixels, options, num_params);
+  const std::vector<Eigen::Vector3d>& points = scene.points;
+  const std::vector<Eigen::Vector2d>& pixels = scene.pixels;
+  const Eigen::Vector3d& centroid = scene.centroid;
+  const double scale = scene.scale;
+  const double shift = scene.shift;
+  const Eigen::Matrix<double, 4, 2>& solution = scene.solution;
   Eigen::Matrix<double, 2, 3> a = solution.topRows<3>().transpose();
   Eigen::Matrix2d k2;
   Eigen::Matrix3d rotation;
   AffineRq(a, &k2, &rotation);
-  if (!(k2(0, 0) > 0.0 && k2(1, 1) > 0.0) || !rotation.allFinite()) {
-    throw SceneError(SceneError::Reason::kDegenerate,
-                     "no affine camera fits these points (their image is degenerate): check the "
-                     "correspondences");
-  }
+  if (!(k2(0, 0) > 0.0 && k2(1, 1) > 0.0) || !rotation.allFinite()) throw NoAffineCamera();
 
   // Start values projected onto the model; given values (px per world unit) converted to the
   // normalized world.

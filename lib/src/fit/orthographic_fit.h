@@ -20,6 +20,15 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& observed_pixels,
                           const ImageSize& image_size, const FitOptions& options);
 
+// The least sum of squares (px^2) of any affine camera, pixel = A X + b, in closed form: a lower
+// bound on every orthographic camera's (each is an affine camera; with aspect and skew free
+// the bound is reached). It costs what FitOrthographic's start costs, without its refinement
+// and the two Ceres problems of 2N residuals. Throws SceneError as FitOrthographic does (too
+// few points, collinear or coplanar points, coordinates too large, no affine camera).
+double AffineSumSquaresPx2(const std::vector<Eigen::Vector3d>& points_in_world,
+                           const std::vector<Eigen::Vector2d>& observed_pixels,
+                           const FitOptions& options);
+
 }  // namespace internal
 }  // namespace camproj
 

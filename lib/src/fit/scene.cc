@@ -35,6 +35,32 @@ constexpr double kUnitRoundoff = 0.5 * std::numeric_limits<double>::epsilon();
 // decisions, even on noise-free data.
 constexpr double kMaxOffsetRoundingPx = 0.1 * kMinNoisePx;
 
+// The SVD (singular values, descending, and V) of `centred` (n x 3) from its R factor
+// accumulated over blocks of rows (TSQR: R of [R; next block] until the rows run out): centred =
+// Q R and R = U S V^T give centred = (Q U) S V^T, the same values and V as the whole matrix's SVD
+// to rounding (V's columns up to sign), in the memory of one block rather than of n rows. The rows are
+// first scaled by a power of two (exact) that brings the largest entry to [1, 2), so that the
+// Householder norms neither overflow above ~1e154 nor underflow.
+Eigen::JacobiSVD<Eigen::Matrix3d> SvdOfRows(const Eigen::MatrixXd& centred) {
+  const double largest = centred.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0 && std::isfinite(largest))) {
+    return Eigen::JacobiSVD<Eigen::Matrix3d>(Eigen::Matrix3d::Zero(), Eigen::ComputeFullV);
+  }
+  const double unit = std::ldexp(1.0, -std::ilogb(largest));
+  constexpr Eigen::Index kBlockRows = 256;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> stacked(kBlockRows + 3, 3);
+  Eigen::Matrix3d r = Eigen::Matrix3d::Zero();
+  for (Eigen::Index begin = 0; begin < centred.rows(); begin += kBlockRows) {
+    const Eigen::Index rows = std::min(kBlockRows, centred.rows() - begin);
+    stacked.resize(rows + 3, 3);
+    stacked.topRows<3>() = r;
+    stacked.bottomRows(rows) = unit * centred.middleRows(begin, rows);
+    const Eigen::HouseholderQR<Eigen::Matrix<double, Eigen::Dynamic, 3>> qr(stacked);
+    r = qr.matrixQR().topRows<3>().triangularView<Eigen::Upper>();
+  }
+  return Eigen::JacobiSVD<Eigen::Matrix3d>(r / unit, Eigen::ComputeFullV);
+}
+
 }  // namespace
 
 SceneError TooLargeForDouble() {
@@ -113,21 +139,25 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
   const double scale = RmsRowLength(centred);
   if (!std::isfinite(scale)) throw TooLargeForDouble();
-  // (JacobiSVD scales the matrix to its largest entry itself.)
-  const Eigen::JacobiSVD<Eigen::MatrixXd> shape(centred, Eigen::ComputeThinV);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> shape = SvdOfRows(centred);
   const Eigen::Vector3d extents = shape.singularValues();
   if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
     throw SceneError(SceneError::Reason::kCollinearPoints,
                      "the 3D points are collinear (or coincide): a line does not determine a "
                      "camera's rotation about it; add points off the line");
   }
-  std::vector<Eigen::Vector3d> sorted = points_in_world;
-  auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  // The distinct points, counted on sorted indices (4 bytes a point, not a copy of 24).
+  std::vector<int> sorted(n);
+  for (int i = 0; i < n; ++i) sorted[i] = i;
+  auto less = [&](int a, int b) {
+    const double* x = points_in_world[a].data();
+    const double* y = points_in_world[b].data();
+    return std::lexicographical_compare(x, x + 3, y, y + 3);
   };
   std::sort(sorted.begin(), sorted.end(), less);
+  auto same = [&](int a, int b) { return points_in_world[a] == points_in_world[b]; };
   scene.num_distinct_points =
-      static_cast<int>(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
+      static_cast<int>(std::unique(sorted.begin(), sorted.end(), same) - sorted.begin());
   require_points(scene.num_distinct_points);
   CheckOffset(points_in_world, scale, scene.pixels);
   scene.centroid = centroid;

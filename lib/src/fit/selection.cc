@@ -1,5 +1,7 @@
 #include "fit/selection.h"
 
+#include "fit/orthographic_fit.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +11,7 @@
 
 #include "fit/candidate.h"
 #include "fit/common.h"
+#include "fit/orthographic_fit.h"
 
 namespace camproj {
 namespace internal {
@@ -345,13 +348,20 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     for (const int g : candidates) {
       if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
     }
-    // No orthographic model fits better than the affine camera (all of them free), so when even
-    // its sum of squares with the fewest orthographic parameters' penalty cannot beat the best
-    // perspective model, the orthographic ladder cannot win: skip it (one fit, not up to four).
-    const Evaluation& affine_fit = affine_evaluation();
+    // No orthographic model fits better than the affine camera (every A), so when even its sum
+    // of squares with the fewest orthographic parameters' penalty cannot beat the best
+    // perspective model, the orthographic ladder cannot win: skip it (one closed-form solve,
+    // not up to four Ceres fits of 2N residuals each).
+    std::optional<double> affine_sum_squares;
+    std::string affine_refusal;
+    try {
+      affine_sum_squares = AffineSumSquaresPx2(points, pixels, ortho_options);
+    } catch (const SceneError& error) {
+      affine_refusal = error.what();
+    }
     const double ortho_lower_bound =
-        affine_fit.fit ? affine_fit.sum_squares / (sigma * sigma) + penalty * 6
-                       : std::numeric_limits<double>::infinity();
+        affine_sum_squares ? *affine_sum_squares / (sigma * sigma) + penalty * 6
+                           : std::numeric_limits<double>::infinity();
     Ladder ortho;
     if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
       ortho = run_ladder(ortho_options, "orthographic", ortho_groups, nullptr);
@@ -360,10 +370,11 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       c.name = "orthographic";  // with the forced groups, as its ladder would name it
       if (ortho_options.aspect.IsFree()) c.name += "+aspect";
       if (ortho_options.skew.IsFree()) c.name += "+skew";
-      c.verdict = affine_fit.fit ? "not supported: even the affine camera's residual (rms " +
-                                       Fixed(affine_fit.fit->rms_px) + " px) puts every "
-                                       "orthographic model above the best perspective one"
-                                 : "not determined: " + affine_fit.refusal;
+      c.verdict = affine_sum_squares
+                      ? "not supported: even the affine camera's residual (rms " +
+                            Fixed(std::sqrt(*affine_sum_squares / n)) + " px) puts every "
+                            "orthographic model above the best perspective one"
+                      : "not determined: " + affine_refusal;
       tried.push_back(c);
     }
     if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
