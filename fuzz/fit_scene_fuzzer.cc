@@ -21,7 +21,8 @@
 //     std::invalid_argument (e.g. colmap and skew).
 // A violated check prints what differs and aborts, so libFuzzer saves the input.
 //
-// Build and run: scripts/fuzz.sh.
+// Build and run: scripts/fuzz.sh. CAMPROJ_FUZZ_DUMP=FILE writes each scene run as a points file
+// (its first line says the image size), to refit a finding with `camproj fit`.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cmath>
@@ -119,8 +120,20 @@ Scene MakeScene(FuzzedDataProvider& in) {
   return s;
 }
 
-// A non-finite number in text: nan, inf, infinity or null as a word (C printf, JavaScript,
-// JSON), in any case.
+// A JSON document's non-finite number: nlohmann writes one as null (strings are not numbers:
+// a message may say "inf" in words).
+bool HasNull(const nlohmann::json& value) {
+  if (value.is_null()) return true;
+  if (value.is_structured()) {
+    for (const nlohmann::json& item : value) {
+      if (HasNull(item)) return true;
+    }
+  }
+  return false;
+}
+
+// A non-finite number in an export's text: nan, inf, infinity or null as a word (C printf,
+// JavaScript, JSON), in any case.
 bool HasNonFinite(const std::string& text) {
   static const std::regex word("(^|[^A-Za-z_])(nan|inf|infinity|null)([^A-Za-z_]|$)",
                                std::regex::icase);
@@ -159,7 +172,9 @@ void CheckCamera(const FitResult& fit, const Scene& s) {
     Fail(text);
   }
   const std::string file = camproj::FitCameraFileText(fit, camproj::PixelOrigin::kCenter);
-  if (HasNonFinite(file)) Fail("the camera file holds a non-finite number:\n" + file);
+  if (HasNull(nlohmann::json::parse(file))) {
+    Fail("the camera file holds a non-finite number (null):\n" + file);
+  }
   const Camera read_back = camproj::CameraFromJsonText(file, "fuzzed camera file");
   if (RecomputedRms(read_back, s, kept) != rms) Fail("the camera file's camera has another RMS");
   for (const camproj::ExportFormat format :
@@ -185,6 +200,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   (void)quiet;
   FuzzedDataProvider in(data, size);
   const Scene s = MakeScene(in);
+  if (const char* dump = std::getenv("CAMPROJ_FUZZ_DUMP")) {
+    // The scene as a points file for `camproj fit` (reproducing a finding outside the fuzzer).
+    if (FILE* out = std::fopen(dump, "w")) {
+      std::fprintf(out, "# image size %dx%d\nid,X,Y,Z,u,v\n", s.size.width, s.size.height);
+      for (size_t i = 0; i < s.points.size(); ++i) {
+        std::fprintf(out, "%s,%.17g,%.17g,%.17g,%.17g,%.17g\n", s.ids[i].c_str(), s.points[i].x(),
+                     s.points[i].y(), s.points[i].z(), s.pixels[i].x(), s.pixels[i].y());
+      }
+      std::fclose(out);
+    }
+  }
   const camproj::FitRequest request = camproj::FitRequestFrom(camproj::FitArguments(), s.size);
   try {
     CheckCamera(camproj::RunFitRequest(s.points, s.pixels, s.ids, s.size, request), s);

@@ -118,6 +118,7 @@ FitArguments ArgumentsOf(const py::kwargs& kwargs) {
                                : value.cast<Intrinsics>();
     } else if (key == "pixel_origin") a.pixel_origin = value.cast<std::string>();
     else if (key == "loss") a.loss = value.cast<std::string>();
+    else if (key == "refiner") a.refiner = value.cast<std::string>();
     else if (key == "keep_all") a.keep_all = value.cast<bool>();
     else if (key == "ransac_px") a.ransac_px = value.cast<double>();
     else if (key == "sigma") a.sigma = value.cast<double>();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -95,6 +96,32 @@ TEST(CameraFileTest, InfiniteFarAndLookAtPoseAreRead) {
   EXPECT_EQ(camera.z_far, kInfinity);
   EXPECT_EQ(camera.cam_from_world.translation, Eigen::Vector3d(0, 0, 5));
   EXPECT_NE(CameraToJsonText(camera).find("\"perspective\""), std::string::npos);
+}
+
+// The fit record holds no non-finite number, which JSON would write as null: an unbounded
+// linearity deviation (a point crosses behind the camera within the probed region) and a
+// left-out point behind the camera (no pixel, no residual) are said in words. Found by the
+// fit_scene fuzzer (issue #11): both were null.
+TEST(CameraFileTest, FitRecordHoldsNoNonFiniteNumber) {
+  std::mt19937_64 rng(testing::Seed(10));
+  const Camera camera = RandomFileCamera(rng);
+  FitRecord fit;
+  fit.outliers = {3, 5};
+  fit.outlier_method = "leave-one-out";
+  fit.outlier_points = {{3, std::numeric_limits<double>::infinity(), 0.0}, {5, 120.5, 0.7}};
+  fit.linearity.checked = true;
+  fit.linearity.worst_deviation = std::numeric_limits<double>::infinity();
+  fit.linearity.worst_direction = "fx";
+  const std::string text = CameraToJsonText(camera, {}, &fit);
+  EXPECT_EQ(text.find("null"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"behind_camera\": true"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"residual_px\": 120.5"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"unbounded\": true"), std::string::npos) << text;
+  EXPECT_EQ(text.find("worst_deviation"), std::string::npos) << text;
+  fit.linearity.worst_deviation = 0.25;
+  const std::string bounded = CameraToJsonText(camera, {}, &fit);
+  EXPECT_NE(bounded.find("\"worst_deviation\": 0.25"), std::string::npos) << bounded;
+  EXPECT_NE(bounded.find("\"unbounded\": false"), std::string::npos) << bounded;
 }
 
 TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {

@@ -138,6 +138,7 @@ enum class Model {
 enum class MethodId {
   kOursStart,
   kOursRefine,
+  kOursRefineCeres,
   kOursDefault,
   kOursAuto,
   kCvCalib80,
@@ -156,8 +157,10 @@ struct Method {
 const std::vector<Method> kMethods = {
     {MethodId::kOursStart, "ours-start", "camproj closed-form start only (refine = false)",
      Model::kShared},
-    {MethodId::kOursRefine, "ours-refine", "camproj start + Ceres (compute_uncertainty = false)",
-     Model::kShared},
+    {MethodId::kOursRefine, "ours-refine",
+     "camproj start + the own LM and polish (compute_uncertainty = false)", Model::kShared},
+    {MethodId::kOursRefineCeres, "ours-refine-ceres",
+     "the same with ceres::Solver for LM (FitOptions::refiner = kCeres)", Model::kShared},
     {MethodId::kOursDefault, "ours-default",
      "camproj default FitOptions (10 parameters, covariance included)", Model::kDefault},
     {MethodId::kOursAuto, "ours-auto",
@@ -283,14 +286,16 @@ Outcome Run(const Method& method, const SceneInput& in, const MethodConfig& conf
   if (method.id == MethodId::kOursStart || method.id == MethodId::kCvCalibOurStart) {
     options.refine = false;
     options.compute_uncertainty = false;
-  } else if (method.id == MethodId::kOursRefine) {
+  } else if (method.id == MethodId::kOursRefine || method.id == MethodId::kOursRefineCeres) {
     options.compute_uncertainty = false;
+    if (method.id == MethodId::kOursRefineCeres) options.refiner = Refiner::kCeres;
   }
   const Clock::time_point start = Clock::now();
   try {
     switch (method.id) {
       case MethodId::kOursStart:
       case MethodId::kOursRefine:
+      case MethodId::kOursRefineCeres:
       case MethodId::kOursDefault:
         outcome.estimate = FromFit(FitCamera(in.points, in.pixels, kImageSize, options));
         break;

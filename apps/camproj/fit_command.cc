@@ -384,6 +384,10 @@ Command AddFitCommand(CLI::App& root) {
                   "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
                   "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
   app->add_option("--loss", args->fit.loss, "none, huber:SCALE or cauchy:SCALE (px)");
+  app->add_option("--refiner", args->fit.refiner,
+                  "least-squares engine: lm (the project's own Levenberg-Marquardt, default) or "
+                  "ceres (ceres::Solver on the same residuals); either ends with the same "
+                  "Gauss-Newton polish, at the same optimum");
   app->add_option("--ransac", args->fit.ransac_px,
                   "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
                   "instead of the automatic outlier stage; they are left out and listed")

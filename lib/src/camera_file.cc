@@ -333,7 +333,14 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
       record["outlier_method"] = fit->outlier_method;
       json points = json::array();
       for (const FitRecord::OutlierPoint& p : fit->outlier_points) {
-        points.push_back({{"index", p.index}, {"residual_px", p.residual_px}});
+        // A left-out point behind the camera has no pixel, so no residual: said, not written
+        // as a non-finite number.
+        points.push_back({{"index", p.index}});
+        if (std::isfinite(p.residual_px)) {
+          points.back()["residual_px"] = p.residual_px;
+        } else {
+          points.back()["behind_camera"] = true;
+        }
         if (p.rms_with_px > 0.0 && std::isfinite(p.rms_with_px)) {
           points.back()["rms_with_px"] = p.rms_with_px;
         }
@@ -373,9 +380,12 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     record["jacobian_condition"] = fit->jacobian_condition;
     if (fit->linearity.checked) {
       const LinearityCheck& l = fit->linearity;
-      record["linearity"] = {{"linear", l.linear}, {"level", l.level},
-                             {"worst_deviation", l.worst_deviation}, {"bound", l.bound},
-                             {"worst_direction", l.worst_direction}};
+      // An unbounded deviation (a point crosses behind the camera within the region) is said
+      // as "unbounded": true, without the number: the file holds no non-finite number.
+      record["linearity"] = {{"linear", l.linear}, {"level", l.level}, {"bound", l.bound},
+                             {"worst_direction", l.worst_direction},
+                             {"unbounded", !std::isfinite(l.worst_deviation)}};
+      if (std::isfinite(l.worst_deviation)) record["linearity"]["worst_deviation"] = l.worst_deviation;
     }
     record["time_ms"] = fit->time_ms;
     document["fit"] = record;

@@ -173,8 +173,10 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
     constexpr size_t kListed = 20;
     for (size_t j = 0; j < std::min(kListed, fit.left_out.size()); ++j) {
       const LeftOutPoint& p = fit.left_out[j];
-      out << "  " << name(p.index) << " is " << Format("%.3g", p.residual_px)
-          << " px from where the camera puts it";
+      out << "  " << name(p.index) << " is "
+          << (std::isfinite(p.residual_px)
+                  ? Format("%.3g", p.residual_px) + " px from where the camera puts it"
+                  : std::string("behind the camera (it has no pixel there)"));
       if (p.rms_with_px > 0.0) {
         out << "; with it the rms would be "
             << (std::isfinite(p.rms_with_px) ? Format("%.3g", p.rms_with_px) + " px"

@@ -161,6 +161,10 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
     options.loss = kind == "huber" ? LossType::kHuber : LossType::kCauchy;
     options.loss_scale_px = colon == std::string::npos ? 1.0 : LossScale(args.loss.substr(colon + 1));
   }
+  if (args.refiner != "lm" && args.refiner != "ceres") {
+    throw std::invalid_argument("--refiner: expected lm or ceres, got \"" + args.refiner + "\"");
+  }
+  options.refiner = args.refiner == "ceres" ? Refiner::kCeres : Refiner::kLevenbergMarquardt;
   if (args.ransac_px > 0.0) {
     options.ransac = true;
     options.ransac_threshold_px = args.ransac_px;

@@ -86,7 +86,9 @@ std::string WorstPoints(const std::vector<Eigen::Vector2d>& residuals,
             [&](int a, int b) { return residuals[a].norm() > residuals[b].norm(); });
   std::string text;
   for (int i = 0; i < std::min<int>(count, static_cast<int>(order.size())); ++i) {
-    text += (i == 0 ? "" : ", ") + names[order[i]] + " (" + Px(residuals[order[i]].norm()) + ")";
+    const double r = residuals[order[i]].norm();
+    text += (i == 0 ? "" : ", ") + names[order[i]] + " (" +
+            (std::isfinite(r) ? Px(r) : std::string("behind the camera")) + ")";
   }
   return text;
 }
@@ -224,8 +226,10 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
                         const std::vector<int>& left_out, const std::vector<std::string>& names) {
   std::string text;
   for (const int i : left_out) {
-    text += (text.empty() ? "" : ", ") + names[i] + " (" + Px(residuals[i].norm()) +
-            " from where the camera puts it)";
+    const double r = residuals[i].norm();
+    text += (text.empty() ? "" : ", ") + names[i] + " (" +
+            (std::isfinite(r) ? Px(r) + " from where the camera puts it"
+                              : std::string("behind the camera")) + ")";
   }
   return text;
 }

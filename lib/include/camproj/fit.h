@@ -3,8 +3,9 @@
 // FitCamera starts from a closed form (Hartley-normalized DLT for >= 6 non-coplanar points, a
 // homography with constrained intrinsics for planar scenes, SQPnP when the intrinsics are known or
 // only the focal length is free with few points), then refines -- least squares by the
-// project's own Levenberg-Marquardt on normal equations accumulated point by point, then a
-// Gauss-Newton polish; Ceres (ceres::Problem) only for a robust loss -- where residuals are
+// project's own Levenberg-Marquardt on normal equations accumulated point by point (or, with
+// FitOptions::refiner = kCeres, ceres::Solver on the same residuals), then a Gauss-Newton
+// polish; Ceres (ceres::Problem) always for a robust loss -- where residuals are
 // predicted - observed pixels; rotation on a quaternion manifold, translation in a world frame
 // centred and scaled to the points (so units and offsets do not matter); fixed intrinsics are
 // constants, not penalties. Conventions: docs/conventions.md.
@@ -45,6 +46,15 @@ struct ParameterMode {
 
 enum class LossType { kNone, kHuber, kCauchy };
 
+// The least-squares engine without a robust loss (with one, Ceres always runs):
+// kLevenbergMarquardt, the project's own (ceres::TinySolver's algorithm on normal equations
+// accumulated point by point, least_squares.cc), or kCeres, ceres::Solver on a ceres::Problem of
+// the same residuals (one analytic block per point, the rotation on a quaternion manifold,
+// DENSE_NORMAL_CHOLESKY). Either is followed by the same Gauss-Newton polish and the same test
+// that the answer is at the minimum, so both return the same optimum (FitTest.CeresRefinerFinds
+// TheSameOptimum: 1e-9 relative); the own LM is the faster (bench: docs/bench/README.md).
+enum class Refiner { kLevenbergMarquardt, kCeres };
+
 struct FitOptions {
   // The intrinsic model. focal: fx (fy = aspect * fx). Defaults: focal, aspect and principal
   // point free (an off-axis pinhole: 10 parameters with the pose), skew 0, no distortion.
@@ -82,6 +92,7 @@ struct FitOptions {
 
   LossType loss = LossType::kNone;
   double loss_scale_px = 1.0;  // Huber / Cauchy scale, px, > 0
+  Refiner refiner = Refiner::kLevenbergMarquardt;  // without a loss (see Refiner)
 
   // Expected pixel noise (standard deviation per axis, px). Unset: estimated from the residuals
   // as sqrt(sum of squared residuals / (2N - p)).
@@ -299,9 +310,10 @@ struct FitResult {
 
   int iterations = 0;
   // What refined the camera: "levenberg-marquardt" (the project's own LM on accumulated normal
-  // equations, then undamped Gauss-Newton steps: every least-squares fit), "ceres, huber loss
-  // 2 px" / "ceres, cauchy loss 2 px" (FitOptions::loss: a ceres::Problem), "ceres"
-  // (orthographic) or "none" (FitOptions::refine = false).
+  // equations, then undamped Gauss-Newton steps: least squares by default), "ceres" (the same
+  // with ceres::Solver for LM: FitOptions::refiner = kCeres; also the orthographic fit's), "ceres, huber loss
+  // 2 px" / "ceres, cauchy loss 2 px" (FitOptions::loss: a ceres::Problem) or "none"
+  // (FitOptions::refine = false).
   std::string refiner;
   std::string termination;  // why it stopped, in the refiner's words
   double time_ms = 0.0;

@@ -37,6 +37,7 @@ struct FitArguments {
   std::optional<Intrinsics> known_intrinsics;  // in kCenter (as ReadIntrinsicsFile returns them)
   std::string pixel_origin = "center";         // of the pixels and of the values above
   std::string loss = "none";                   // none | huber:SCALE | cauchy:SCALE (px)
+  std::string refiner = "lm";                  // lm | ceres: FitOptions::refiner
   bool keep_all = false;
   double ransac_px = 0.0;        // RANSAC inlier threshold (px) when > 0
   double sigma = 0.0;            // pixel noise per axis (px) when > 0

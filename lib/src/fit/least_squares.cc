@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "fit/ceres_minimize.h"
+
 namespace camproj {
 namespace internal {
 
@@ -427,6 +429,20 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   outcome.model = model;
   bool have_normal = false;
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
+    if (options.refiner == Refiner::kCeres) {
+      // The same residuals in a ceres::Problem; each round resumes from the last.
+      const CeresSummary summary =
+          MinimizeWithCeres(points, pixels, nullptr, options, start_time, &outcome.rotation,
+                            &outcome.center, &outcome.model, &outcome.trace);
+      outcome.iterations += summary.iterations;
+      outcome.termination = "ceres " + summary.termination;
+      have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
+                                           outcome.model, &outcome.normal);
+      if (!have_normal) break;
+      outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
+                                            &outcome.model, &outcome.normal);
+      continue;
+    }
     const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
     ParamVector u = problem.Pack(outcome.center);
     // The first round is TinySolver's LM; where its answer is short of the minimum (a curved

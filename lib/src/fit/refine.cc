@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "check.h"
+#include "fit/ceres_minimize.h"
 #include "fit/closed_form.h"
 #include "fit/common.h"
 #include "fit/least_squares.h"
@@ -25,43 +27,6 @@ namespace {
 // Below this many points a DLT start with the principal point free gets a second start from
 // the image centre (the DLT's principal point is poorly determined there).
 constexpr int kSecondStartBelowPoints = 20;
-
-// Records (iteration, elapsed, RMS) after every Ceres iteration.
-class TraceCallback : public ceres::IterationCallback {
- public:
-  TraceCallback(const std::vector<Eigen::Vector3d>& points,
-                const std::vector<Eigen::Vector2d>& pixels, const double* rotation,
-                const double* center, const double* intrinsics, Clock::time_point start,
-                std::vector<TraceEntry>* trace)
-      : points_(points), pixels_(pixels), rotation_(rotation), center_(center),
-        intrinsics_(intrinsics), start_(start), trace_(trace) {}
-
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-    if (summary.iteration > 0 && !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
-    const double n = static_cast<double>(points_.size());
-    // With a robust loss the cost is robustified: recompute the plain RMS.
-    const Eigen::Map<const Eigen::Quaterniond> q(rotation_);
-    const Eigen::Map<const Eigen::Vector3d> c(center_);
-    double sum = 0.0;
-    for (size_t i = 0; i < points_.size(); ++i) {
-      const Eigen::Vector3d p = q * (points_[i] - c);
-      double pixel[2];
-      PixelFromFitIntrinsics(intrinsics_, p.x() / p.z(), p.y() / p.z(), pixel);
-      sum += (Eigen::Vector2d(pixel[0], pixel[1]) - pixels_[i]).squaredNorm();
-    }
-    trace_->push_back({summary.iteration, MicrosecondsSince(start_), std::sqrt(sum / n)});
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const std::vector<Eigen::Vector3d>& points_;
-  const std::vector<Eigen::Vector2d>& pixels_;
-  const double* rotation_;
-  const double* center_;
-  const double* intrinsics_;
-  Clock::time_point start_;
-  std::vector<TraceEntry>* trace_;
-};
 
 // `other` replaces `*best` if it is a camera at a lower cost (by more than rounding).
 void KeepTheLower(LeastSquaresOutcome other, LeastSquaresOutcome* best) {
@@ -182,78 +147,42 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
   refined.model = std::move(best.model);
   refined.normal = std::move(best.normal);
   refined.iterations = best.iterations;
-  refined.refiner = "levenberg-marquardt";
+  refined.refiner = options.refiner == Refiner::kCeres ? "ceres" : "levenberg-marquardt";
   refined.termination = std::move(best.termination);
   refined.trace = std::move(best.trace);
   return refined;
 }
 
-// With a robust loss: a ceres::Problem with one block per point, the rotation on
-// EigenQuaternionManifold and fixed intrinsics held by a SubsetManifold.
+// With a robust loss: Ceres (MinimizeWithCeres), which the own LM does not replace there
+// (a robust loss reweights each point's residual).
 RefinedCamera RefineRobust(const Scene& scene, const Start& start, const FitOptions& options,
                            Clock::time_point start_time) {
   RefinedCamera refined;
+  refined.rotation = start.camera.rotation;
   refined.center = start.camera.center;
   refined.model = start.model;
-  Eigen::Vector3d& center = refined.center;
-  Eigen::Quaterniond rotation(start.camera.rotation);
-  rotation.normalize();
-  std::array<double, kFitIntrinsicsSize> intrinsics = start.model.value;
-  ceres::Problem problem;
-  ceres::LossFunction* loss =
+  const std::unique_ptr<ceres::LossFunction> loss(
       options.loss == LossType::kHuber
           ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale_px))
-          : new ceres::CauchyLoss(options.loss_scale_px);
-  // A robust loss weighs each point's squared distance, so each point has its own block.
-  for (int i = 0; i < scene.NumPoints(); ++i) {
-    problem.AddResidualBlock(new PointReprojectionCost(scene.points[i], scene.pixels[i]), loss,
-                             rotation.coeffs().data(), center.data(), intrinsics.data());
-  }
-  problem.SetManifold(rotation.coeffs().data(), new ceres::EigenQuaternionManifold);
-  std::vector<int> constant_slots;
-  for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
-    if (!start.model.free[slot]) constant_slots.push_back(slot);
-  }
-  if (constant_slots.size() == kFitIntrinsicsSize) {
-    problem.SetParameterBlockConstant(intrinsics.data());
-  } else if (!constant_slots.empty()) {
-    problem.SetManifold(intrinsics.data(),
-                        new ceres::SubsetManifold(kFitIntrinsicsSize, constant_slots));
-  }
-  ceres::Solver::Options solver_options;
-  // p <= 13 unknowns: the normal equations (O(N p^2)) beat QR of the 2N x p Jacobian.
-  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.num_threads = 1;
-  solver_options.update_state_every_iteration = true;
-  TraceCallback trace_callback(scene.points, scene.pixels, rotation.coeffs().data(), center.data(),
-                               intrinsics.data(), start_time, &refined.trace);
-  solver_options.callbacks.push_back(&trace_callback);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+          : new ceres::CauchyLoss(options.loss_scale_px));
+  const CeresSummary summary =
+      MinimizeWithCeres(scene.points, scene.pixels, loss.get(), options, start_time,
+                        &refined.rotation, &refined.center, &refined.model, &refined.trace);
   if (summary.termination_type == ceres::FAILURE) {
     throw SceneError(SceneError::Reason::kDegenerate,
-                     "the refinement failed: " + summary.message + ": check the correspondences");
+                     "the refinement failed: " + summary.termination + ": check the correspondences");
   }
   if (summary.termination_type == ceres::NO_CONVERGENCE) {
     // As for least squares: never a camera short of the minimum.
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("the robust refinement did not converge in ", options.max_iterations,
-                            " iterations (", summary.message, "): the points barely determine "
+                            " iterations (", summary.termination, "): the points barely determine "
                             "the model; fix intrinsics, add points, or raise --max-iterations"));
   }
-  refined.model.value = intrinsics;
-  rotation.normalize();
-  refined.rotation = rotation.toRotationMatrix();
-  refined.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  refined.iterations = summary.iterations;
   refined.refiner = Concat("ceres, ", options.loss == LossType::kHuber ? "huber" : "cauchy",
                            " loss ", options.loss_scale_px, " px");
-  refined.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) +
-                        ": " + summary.message;
+  refined.termination = summary.termination;
   return refined;
 }
 

@@ -102,6 +102,11 @@ std::string Fixed(double value, int digits = 3) {
 // A criterion difference in words: "BIC 2.15 above pose+focal+principal-point's: its better
 // fit does not pay for its extra parameters".
 std::string Versus(const char* criterion, double delta, const std::string& against) {
+  // Against a refused model (criterion +inf) there is no difference to print.
+  if (std::isinf(delta)) {
+    return delta < 0.0 ? "determined where " + against + " is not"
+                       : std::string("not determined");
+  }
   return std::string(criterion) + " " + Fixed(std::abs(delta)) + (delta < 0.0 ? " below " : " above ") +
          against + "'s: " + (delta < 0.0 ? "its better fit pays for its extra parameters"
                                            : "its better fit does not pay for its extra parameters");
