@@ -670,6 +670,12 @@ assert m["max_interpolation_error_px"] <= 0.01 and len(m["undistorted_uv"]) == 2
     expect_exit 2 "$bin" export "$work/folded.json" --to glsl
     expect_in err "cannot export as glsl: the lens model does not cover the image"
     [[ ! -s $work/out ]] || fail "partial glsl on stdout"
+    # -o writes any export atomically, and never over the camera file it reads.
+    expect_exit 0 "$bin" export "$work/lens.json" --to glsl -o "$work/lens.glsl"
+    grep -q "^vec4 camproj_lens" "$work/lens.glsl" || fail "lens.glsl lacks camproj_lens"
+    cp "$work/lens.json" "$work/lens_copy.json"
+    expect_exit 2 "$bin" export "$work/lens.json" --to glsl -o "$work/lens.json"
+    cmp -s "$work/lens.json" "$work/lens_copy.json" || fail "the camera file was overwritten"
     ;;
   export_non_finite_refused)
     # fx = 1e308 overflowed the GL matrices to inf (gl) or null (json), exit 0; cx = 1e308 failed

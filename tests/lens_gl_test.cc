@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "camproj/export.h"
 #include "camproj/look_at.h"
 
 namespace camproj {
@@ -230,6 +232,38 @@ TEST(LensGlTest, GlslTextHasTheLensFunctionAndNoCharacterGlslLacks) {
   // r_limit = min(fold 1.054, 2 x the image corner's radius ~0.87).
   EXPECT_NEAR(LensRadiusLimit(camera), 1.0 / std::sqrt(0.9), 1e-15);
   EXPECT_NEAR(LensRadiusLimit(TestCamera(0.25, 0.08)), 2.0 * LensImageRadius(TestCamera(0.25, 0.08)), 1e-15);
+}
+
+// The 16 numbers after `const mat4 NAME = mat4(` in `text`, column-major.
+Eigen::Matrix4d GlslMatrix(const std::string& text, const std::string& name) {
+  const std::string key = "const mat4 " + name + " = mat4(";
+  const size_t start = text.find(key);
+  EXPECT_NE(start, std::string::npos) << name;
+  std::string numbers = text.substr(start + key.size(), text.find(')', start) - start - key.size());
+  for (char& c : numbers) c = c == ',' ? ' ' : c;
+  std::istringstream in(numbers);
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) in >> m.data()[i];
+  return m;
+}
+
+TEST(LensGlTest, GlslHoldsTheGlExportsMatricesBitForBit) {
+  for (const Camera& camera : Lenses()) {
+    for (const GlDepth depth : {GlDepth{}, GlDepth{ClipDepth::kZeroToOne, true}}) {
+      const std::string text = LensGlslText(camera, depth);
+      EXPECT_EQ(GlslMatrix(text, "camproj_projection"),
+                ClipFromGlEye(camera.intrinsics.Pinhole(), camera.image_size, camera.z_near,
+                              camera.z_far, depth));
+      EXPECT_EQ(GlslMatrix(text, "camproj_view"), GlEyeFromWorld(camera.cam_from_world));
+      ExportOptions options;
+      options.depth = depth;
+      EXPECT_EQ(ExportCamera(camera, ExportFormat::kGlsl, options), text);
+    }
+  }
+  // The pinhole-only exports name the ones that render the lens.
+  const std::string gl = ExportCamera(TestCamera(-0.3, 0.0), ExportFormat::kGl);
+  EXPECT_THAT(gl, HasSubstr("to render the lens: export glsl (per vertex), distortion-mesh or "
+                            "stmap (post-process warp)"));
 }
 
 TEST(LensGlTest, MeshHasTheGridAndItsErrorMeetsTheStepRule) {

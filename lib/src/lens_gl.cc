@@ -162,14 +162,20 @@ LensRenderTarget LensRenderTargetOf(const Camera& camera) {
   }
   // Target pixel q + offset must keep kLensRenderTargetMarginPx from the centres of the first
   // and last texels (0 and size - 1).
-  LensRenderTarget target;
-  target.offset_x = static_cast<int>(std::ceil(kLensRenderTargetMarginPx - low.x()));
-  target.offset_y = static_cast<int>(std::ceil(kLensRenderTargetMarginPx - low.y()));
-  const double width = std::ceil(high.x() + target.offset_x + kLensRenderTargetMarginPx) + 1.0;
-  const double height = std::ceil(high.y() + target.offset_y + kLensRenderTargetMarginPx) + 1.0;
-  Require(width <= kLensRenderTargetMaxSidePx && height <= kLensRenderTargetMaxSidePx,
+  const double offset_x = std::ceil(kLensRenderTargetMarginPx - low.x());
+  const double offset_y = std::ceil(kLensRenderTargetMarginPx - low.y());
+  const double width = std::ceil(high.x() + offset_x + kLensRenderTargetMarginPx) + 1.0;
+  const double height = std::ceil(high.y() + offset_y + kLensRenderTargetMarginPx) + 1.0;
+  // Checked in double before any conversion to int (offsets beyond the side limit only occur
+  // with a side beyond it too: the image's own footprint lies inside the target).
+  Require(width <= kLensRenderTargetMaxSidePx && height <= kLensRenderTargetMaxSidePx &&
+              std::abs(offset_x) <= kLensRenderTargetMaxSidePx &&
+              std::abs(offset_y) <= kLensRenderTargetMaxSidePx,
           "the lens's render target would be ", width, " x ", height, " px (k1 = ", k.k1,
           ", k2 = ", k.k2, "), more than ", kLensRenderTargetMaxSidePx, " px a side");
+  LensRenderTarget target;
+  target.offset_x = static_cast<int>(offset_x);
+  target.offset_y = static_cast<int>(offset_y);
   target.size = {static_cast<int>(width), static_cast<int>(height)};
   target.intrinsics = pinhole;
   target.intrinsics.cx += target.offset_x;
@@ -187,38 +193,61 @@ double LensSecondDerivativePx(const Camera& camera) {
   const Intrinsics& k = camera.intrinsics;
   if (!k.HasDistortion()) return 0.0;
   // D(p) = A F(A^-1 (p - c)) + c with A = [fx skew; 0 fy] and F(n) = n d(|n|^2), so
-  // D''[t, t] = A F''[a, a] with a = A^-1 t, and (differentiating F(n + e a) twice in e)
-  // F''[a, a] = 4 d' (n.a) a + n (4 d'' (n.a)^2 + 2 d' |a|^2), d' = k1 + 2 k2 s, d'' = 2 k2.
+  // D''[t, t] = A F''[a, a] with a = A^-1 t, and (differentiating F(n + e a) twice in e) the
+  // symmetric bilinear form F''[a, b] = 2 d' ((n.a) b + (n.b) a) + n (4 d'' (n.a)(n.b) + 2 d' a.b),
+  // d' = k1 + 2 k2 s, d'' = 2 k2. With t = (cos, sin), D''[t, t] = cos^2 G11 + 2 cos sin G12 +
+  // sin^2 G22, G_ij = A F''[b_i, b_j], b_i = A^-1 e_i: three evaluations per point.
   Eigen::Matrix2d a_matrix;
   a_matrix << k.fx, k.skew, 0.0, k.fy;
+  const Eigen::Matrix2d b = a_matrix.inverse();
   constexpr int kDirections = 64;
-  std::array<Eigen::Vector2d, kDirections> directions;
+  std::array<Eigen::Vector3d, kDirections> weights;  // cos^2, 2 cos sin, sin^2
   for (int i = 0; i < kDirections; ++i) {
     const double angle = M_PI * i / kDirections;
-    directions[i] = a_matrix.inverse() * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    const double c = std::cos(angle);
+    const double sn = std::sin(angle);
+    weights[i] = Eigen::Vector3d(c * c, 2.0 * c * sn, sn * sn);
   }
   const auto second_derivative = [&](const Eigen::Vector2d& n) {
     const double s = n.squaredNorm();
     const double d1 = k.k1 + 2.0 * k.k2 * s;
     const double d2 = 2.0 * k.k2;
-    double worst = 0.0;
-    for (const Eigen::Vector2d& a : directions) {
+    const auto form = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& c) -> Eigen::Vector2d {
       const double na = n.dot(a);
-      const Eigen::Vector2d f2 = 4.0 * d1 * na * a + n * (4.0 * d2 * na * na + 2.0 * d1 * a.squaredNorm());
-      worst = std::max(worst, (a_matrix * f2).norm());
+      const double nc = n.dot(c);
+      return a_matrix * (2.0 * d1 * (na * c + nc * a) + n * (4.0 * d2 * na * nc + 2.0 * d1 * a.dot(c)));
+    };
+    const Eigen::Vector2d g11 = form(b.col(0), b.col(0));
+    const Eigen::Vector2d g12 = form(b.col(0), b.col(1));
+    const Eigen::Vector2d g22 = form(b.col(1), b.col(1));
+    double worst = 0.0;
+    for (const Eigen::Vector3d& w : weights) {
+      worst = std::max(worst, (w.x() * g11 + w.y() * g12 + w.z() * g22).squaredNorm());
     }
-    return worst;
+    return std::sqrt(worst);
   };
-  double worst = 0.0;
-  for (const Eigen::Vector2d& corner : OuterCorners(camera.image_size)) {
-    worst = std::max(worst, second_derivative(UndistortedNormalized(k, corner)));
-  }
-  // The footprint: render target pixels whose distorted image lies in the image (outer edges).
+  // The footprint: the preimage of the image's outer edges (every px), and the render target
+  // pixels whose lens pixel lies in the image, every `stride`-th so that at most ~250 000 are
+  // visited (the second derivative varies on the scale of the image, not of a pixel).
   const double w = camera.image_size.width;
   const double h = camera.image_size.height;
+  double worst = 0.0;
+  const auto edge = [&](double u, double v) {
+    worst = std::max(worst, second_derivative(UndistortedNormalized(k, {u, v})));
+  };
+  for (int i = 0; i <= camera.image_size.width; ++i) {
+    edge(i - 0.5, -0.5);
+    edge(i - 0.5, h - 0.5);
+  }
+  for (int i = 0; i <= camera.image_size.height; ++i) {
+    edge(-0.5, i - 0.5);
+    edge(w - 0.5, i - 0.5);
+  }
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
-  for (int y = 0; y < target.size.height; ++y) {
-    for (int x = 0; x < target.size.width; ++x) {
+  const int stride = std::max(
+      1, static_cast<int>(std::sqrt(1.0 * target.size.width * target.size.height / 250000.0)));
+  for (int y = 0; y < target.size.height; y += stride) {
+    for (int x = 0; x < target.size.width; x += stride) {
       const Eigen::Vector2d n = PinholeNormalized(target.intrinsics, {x, y});
       if (!(n.norm() < r_fold)) continue;
       const Eigen::Vector2d p = LensPixel(k, n);
@@ -238,6 +267,10 @@ double LensMaxEdgePx(const Camera& camera, double error_px) {
 
 std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
   const double r_limit = LensRadiusLimit(camera);
+  const double m = LensSecondDerivativePx(camera);
+  const auto max_edge = [m](double error_px) {
+    return m == 0.0 ? std::numeric_limits<double>::infinity() : std::sqrt(6.0 * error_px / m);
+  };
   const Intrinsics& k = camera.intrinsics;
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
   const CameraViews views = ViewsOfCamera(camera, 1.0, depth);
@@ -258,9 +291,9 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << "// Exact at vertices (float32: ~1e-5 px); between them GL interpolates linearly, so "
          "tessellate: keep\n"
       << "// the longest edge of every triangle, in px on the undistorted image, below "
-      << Short(LensMaxEdgePx(camera, 0.1)) << " px for 0.1 px, " << Short(LensMaxEdgePx(camera, 0.01))
-      << " px for 0.01 px, " << Short(LensMaxEdgePx(camera, 0.001)) << " px for 0.001 px\n"
-      << "// (M L^2 / 6 <= error, M = " << Short(LensSecondDerivativePx(camera))
+      << Short(max_edge(0.1)) << " px for 0.1 px, " << Short(max_edge(0.01))
+      << " px for 0.01 px, " << Short(max_edge(0.001)) << " px for 0.001 px\n"
+      << "// (M L^2 / 6 <= error, M = " << Short(m)
       << " px^-1, the largest second derivative of the lens map over the image).\n"
       << "// "
       << (std::isfinite(r_fold)

@@ -73,8 +73,9 @@ Eigen::Matrix4d LensRenderTargetClipFromGlEye(const Camera& camera, const GlDept
 // With M = max |d^2 D / dt^2| over unit directions t and the image's footprint, the error inside a
 // triangle is at most (M / 2) rho^2, rho = radius of the smallest disc holding the triangle on the
 // pinhole image: M L^2 / 8 for right and obtuse triangles, M L^2 / 6 for any triangle (rho <=
-// L / sqrt 3), L = its longest edge in pinhole px. Samples the footprint every pixel and 64
-// directions. px per px^2; 0 without distortion.
+// L / sqrt 3), L = its longest edge in pinhole px. Samples the footprint (the preimage of the
+// image's edges every px, and the render target's pixels inside it, every one up to 250 000 of
+// them, else every stride-th) and 64 directions. px per px^2; 0 without distortion.
 double LensSecondDerivativePx(const Camera& camera);
 
 // Longest edge (pinhole px) for an interpolation error <= error_px in any triangle:
