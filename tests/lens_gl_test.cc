@@ -309,6 +309,26 @@ TEST(LensGlTest, StMapFilesAreFloatRgbaInNukeChannelOrder) {
     EXPECT_EQ(image.at<cv::Vec4f>(1, 2)[3], 1.0f) << extension;
   }
   EXPECT_THROW(EncodeStMap(map, ".png"), std::invalid_argument);
+  // A whole map reads back bit for bit (OpenCV's TIFF writer was seen to alter 3-channel floats;
+  // 4 channels are stored as they are).
+  const StMap full = LensStMap(TestCamera(-0.3, 0.0), LensMapDirection::kUndistort);
+  for (const std::string extension : {".tiff", ".exr"}) {
+    const std::string bytes = EncodeStMap(full, extension);
+    const cv::Mat image = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()),
+                                       cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(image.rows, full.height);
+    ASSERT_EQ(image.cols, full.width);
+    int differ = 0;
+    for (int y = 0; y < full.height; ++y) {
+      for (int x = 0; x < full.width; ++x) {
+        const cv::Vec4f texel = image.at<cv::Vec4f>(y, x);
+        const float* want = &full.rgba[(static_cast<size_t>(y) * full.width + x) * 4];
+        differ += texel[2] != want[0] || texel[1] != want[1] || texel[0] != want[2] ||
+                  texel[3] != want[3];
+      }
+    }
+    EXPECT_EQ(differ, 0) << extension;
+  }
 }
 
 }  // namespace
