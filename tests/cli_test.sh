@@ -658,6 +658,8 @@ import json, sys
 m = json.load(open(sys.argv[1]))
 assert m["max_interpolation_error_px"] <= 0.01 and len(m["undistorted_uv"]) == 2 * m["vertex_count"], m["step_px"]
 ' "$work/mesh.json" || fail "bad distortion mesh"
+    expect_exit 0 "$bin" export "$work/lens.json" --to distortion-mesh -o "$work/mesh.obj"
+    grep -q "^vt " "$work/mesh.obj" && grep -q "^f 1/1 2/2 " "$work/mesh.obj" || fail "bad OBJ mesh"
     # Refusals: exit 1 (usage) or 2 (a lens folding inside the image), no file written.
     expect_exit 1 "$bin" export "$work/lens.json" --to stmap
     expect_in err "give -o MAP.tif, MAP.tiff or MAP.exr"

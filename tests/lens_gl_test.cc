@@ -293,6 +293,47 @@ TEST(LensGlTest, MeshHasTheGridAndItsErrorMeetsTheStepRule) {
   }
 }
 
+TEST(LensGlTest, MeshObjHoldsTheJsonMeshNumbers) {
+  const Camera camera = TestCamera(0.1, -0.3, 8.0);
+  const nlohmann::json mesh = nlohmann::json::parse(LensDistortionMeshJson(camera, 16));
+  std::istringstream obj(LensDistortionMeshObj(camera, 16));
+  std::vector<double> positions;
+  std::vector<double> uvs;
+  std::vector<int> faces;
+  for (std::string line; std::getline(obj, line);) {
+    std::istringstream in(line);
+    std::string kind;
+    in >> kind;
+    if (kind == "v") {
+      double x = 0.0, y = 0.0, z = 1.0;
+      in >> x >> y >> z;
+      EXPECT_EQ(z, 0.0);
+      positions.insert(positions.end(), {x, y});
+    } else if (kind == "vt") {
+      double u = 0.0, v = 0.0;
+      in >> u >> v;
+      uvs.insert(uvs.end(), {u, v});
+    } else if (kind == "f") {
+      for (int i = 0; i < 3; ++i) {
+        std::string corner;
+        in >> corner;
+        const int index = std::stoi(corner.substr(0, corner.find('/')));
+        EXPECT_EQ(corner, std::to_string(index) + "/" + std::to_string(index));
+        faces.push_back(index - 1);
+      }
+    } else {
+      EXPECT_EQ(kind.substr(0, 1), "#") << line;
+    }
+  }
+  ASSERT_EQ(positions.size(), mesh["distorted_uv"].size());
+  for (size_t i = 0; i < positions.size(); ++i) {
+    // Both are the same double, printed to round-trip: x * 2 - 1 of it, to rounding.
+    EXPECT_NEAR(positions[i], mesh["distorted_uv"][i].get<double>() * 2.0 - 1.0, 1e-15);
+  }
+  EXPECT_EQ(uvs, mesh["undistorted_uv"].get<std::vector<double>>());
+  EXPECT_EQ(faces, mesh["triangles"].get<std::vector<int>>());
+}
+
 TEST(LensGlTest, StMapFilesAreFloatRgbaInNukeChannelOrder) {
   StMap map;
   map.width = 3;

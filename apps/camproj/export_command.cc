@@ -57,7 +57,8 @@ Command AddExportCommand(CLI::App& root) {
       "  three        JSON for a three.js PerspectiveCamera (projectionMatrix, matrixWorld)\n"
       "  json         the camera file itself\n"
       "  glsl         GLSL rendering the lens (k1, k2) per vertex: camproj_lens(), matrices\n"
-      "  distortion-mesh  JSON mesh warping a pinhole render target onto the image (--mesh-step)\n"
+      "  distortion-mesh  JSON (or -o MESH.obj: OBJ) mesh warping a pinhole render target onto\n"
+      "               the image (--mesh-step)\n"
       "  stmap        -o MAP.tif|.exr: Nuke STMap (32-bit float) warping the pinhole render\n"
       "               target onto the image; stdout: the render target's size and matrices\n"
       "  undistort-stmap  -o MAP.tif|.exr: STMap warping the plate onto the render target\n\n"
@@ -177,9 +178,12 @@ Command AddExportCommand(CLI::App& root) {
                             PinholeErrorAtWorstCornerPx(camera));
               std::cerr << line;
             }
+            const bool obj = format == ExportFormat::kDistortionMesh &&
+                             ExtensionOf(args->output_path) == ".obj";
             std::string text;
             try {
-              text = ExportCamera(camera, format, options);
+              text = obj ? LensDistortionMeshObj(camera, options.mesh_step_px, options.depth)
+                         : ExportCamera(camera, format, options);
             } catch (const std::invalid_argument& e) {
               throw InputError(args->camera_path + ": cannot export as " + args->to + ": " + e.what());
             }

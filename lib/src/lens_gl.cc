@@ -558,6 +558,53 @@ std::string LensDistortionMeshJson(const Camera& camera, int step_px, const GlDe
   return document.dump() + "\n";
 }
 
+std::string LensDistortionMeshObj(const Camera& camera, int step_px, const GlDepth& depth) {
+  const LensRenderTarget target = LensRenderTargetOf(camera);
+  if (step_px == 0) step_px = LensMeshStepPx(camera, kLensMeshErrorPx);
+  const LensMesh mesh = BuildLensMesh(camera, target, step_px);
+  const double worst = LensMeshErrorPx(camera, target, mesh);
+  const double w = camera.image_size.width;
+  const double h = camera.image_size.height;
+  const Eigen::Matrix4d projection =
+      ClipFromGlEye(target.intrinsics, target.size, camera.z_near, camera.z_far, depth);
+  const Eigen::Matrix4d view = GlEyeFromWorld(camera.cam_from_world);
+  auto out = ExactStream();
+  out << "# camproj distortion mesh, OBJ form (docs/exports.md, distortion-mesh): k1 = "
+      << camera.intrinsics.k1 << ", k2 = " << camera.intrinsics.k2 << "\n"
+      << "# v x y 0: where the lens images the vertex on the camera's " << camera.image_size.width
+      << " x " << camera.image_size.height << " image, in NDC (distorted_uv * 2 - 1)\n"
+      << "# vt u v: the vertex on the render target (undistorted_uv = window / size, y up)\n"
+      << "# render target: " << target.size.width << " x " << target.size.height
+      << " px, pixel = the camera's pinhole pixel + (" << target.offset_x << ", "
+      << target.offset_y << "); fx " << target.intrinsics.fx << ", fy " << target.intrinsics.fy
+      << ", cx " << target.intrinsics.cx << ", cy " << target.intrinsics.cy << ", skew "
+      << target.intrinsics.skew << " (kCenter); depth " << ToString(depth.clip_depth)
+      << (depth.reversed_z ? ", reversed-Z" : "") << "; near " << camera.z_near << ", far "
+      << camera.z_far << "\n"
+      << "# step " << step_px << " px; max interpolation error " << worst << " px\n"
+      << "# projection";
+  for (int i = 0; i < 16; ++i) out << ' ' << projection.data()[i];
+  out << "\n# view";
+  for (int i = 0; i < 16; ++i) out << ' ' << view.data()[i];
+  out << '\n';
+  for (const Eigen::Vector2d& window : mesh.window) {
+    out << "v " << 2.0 * window.x() / w - 1.0 << ' ' << 2.0 * window.y() / h - 1.0 << " 0\n";
+  }
+  for (const Eigen::Vector2d& source : mesh.source) {
+    const Eigen::Vector2d uv = UvOfPixel(source, target.size);
+    out << "vt " << uv.x() << ' ' << uv.y() << '\n';
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+    out << 'f';
+    for (int i = 0; i < 3; ++i) {
+      const int index = mesh.triangles[t + i] + 1;  // OBJ counts from 1
+      out << ' ' << index << '/' << index;
+    }
+    out << '\n';
+  }
+  return out.str();
+}
+
 std::string LensRenderTargetText(const Camera& camera, LensMapDirection direction,
                                  const GlDepth& depth) {
   const LensRenderTarget target = LensRenderTargetOf(camera);

@@ -134,6 +134,11 @@ inline constexpr double kLensMeshErrorPx = 0.01;
 inline constexpr int kLensMeshMaxStepPx = 64;
 std::string LensDistortionMeshJson(const Camera& camera, int step_px, const GlDepth& depth = {});
 
+// The same mesh as a Wavefront OBJ: `v x y 0` = distorted_uv * 2 - 1 (the camera image's NDC),
+// `vt u v` = undistorted_uv, `f a/a b/b c/c` (1-based, counter-clockwise), the render target, step
+// and error in '#' comments. Throws as LensDistortionMeshJson.
+std::string LensDistortionMeshObj(const Camera& camera, int step_px, const GlDepth& depth = {});
+
 // The largest mesh step of kLensMeshMaxStepPx, its halves, ..., 2 whose interpolation error (as
 // above) is <= error_px; 1 if none is. Throws unless error_px > 0, and as LensRenderTargetOf.
 int LensMeshStepPx(const Camera& camera, double error_px);
