@@ -229,6 +229,7 @@ TEST(LensGlTest, GlslTextHasTheLensFunctionAndNoCharacterGlslLacks) {
   EXPECT_THAT(text, HasSubstr("const mat4 camproj_projection = mat4("));
   // GLSL before 4.20 has no '"', '\'', '`', '@', '$' or '\\' in its character set.
   EXPECT_EQ(text.find_first_of("\"'`@$\\"), std::string::npos);
+  EXPECT_THAT(LensGlslText(TestCamera(0.0, 0.0)), HasSubstr("camproj_lens is the identity"));
   // r_limit = min(fold 1.054, 2 x the image corner's radius ~0.87).
   EXPECT_NEAR(LensRadiusLimit(camera), 1.0 / std::sqrt(0.9), 1e-15);
   EXPECT_NEAR(LensRadiusLimit(TestCamera(0.25, 0.08)), 2.0 * LensImageRadius(TestCamera(0.25, 0.08)), 1e-15);

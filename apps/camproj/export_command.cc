@@ -87,7 +87,8 @@ Command AddExportCommand(CLI::App& root) {
                   "to 64 whose interpolation error is <= 0.01 px)")
       ->check(CLI::Range(1, 1 << 20));
   app->add_flag("--quiet", args->quiet,
-                "gl, glm, three: no depth-precision notes on stderr (warnings still printed)");
+                "gl, glm, glsl, three: no depth-precision notes on stderr (warnings still "
+                "printed)");
   return {app, [args]() {
             Camera camera = ReadCameraFile(args->camera_path);
             if (args->z_near > 0.0) camera.z_near = args->z_near;

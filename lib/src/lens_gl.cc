@@ -287,15 +287,19 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << " - (v + 0.5) for the camproj kCenter pixel (u, v).\n"
       << "// Depth " << ToString(depth.clip_depth) << (depth.reversed_z ? ", reversed-Z" : "")
       << "; near " << camera.z_near << ", far " << camera.z_far
-      << ": camproj_lens leaves z and w alone, so depth is as in the gl export.\n"
-      << "// Exact at vertices (float32: ~1e-5 px); between them GL interpolates linearly, so "
-         "tessellate: keep\n"
-      << "// the longest edge of every triangle, in px on the undistorted image, below "
-      << Short(max_edge(0.1)) << " px for 0.1 px, " << Short(max_edge(0.01))
-      << " px for 0.01 px, " << Short(max_edge(0.001)) << " px for 0.001 px\n"
-      << "// (M L^2 / 6 <= error, M = " << Short(m)
-      << " px^-1, the largest second derivative of the lens map over the image).\n"
-      << "// "
+      << ": camproj_lens leaves z and w alone, so depth is as in the gl export.\n";
+  if (m == 0.0) {
+    out << "// k1 = k2 = 0: camproj_lens is the identity (the matrices are the whole camera).\n";
+  } else {
+    out << "// Exact at vertices (float32: ~1e-5 px); between them GL interpolates linearly, so "
+           "tessellate: keep\n"
+        << "// the longest edge of every triangle, in px on the undistorted image, below "
+        << Short(max_edge(0.1)) << " px for 0.1 px, " << Short(max_edge(0.01))
+        << " px for 0.01 px, " << Short(max_edge(0.001)) << " px for 0.001 px\n"
+        << "// (M L^2 / 6 <= error, M = " << Short(m)
+        << " px^-1, the largest second derivative of the lens map over the image).\n";
+  }
+  out << "// "
       << (std::isfinite(r_fold)
               ? Concat("The model folds over at normalized radius ", Short(r_fold), "; ")
               : std::string("The model has no fold; "))
