@@ -2,17 +2,17 @@
 // the tessellation rule and the mesh. The GL itself is in render_test.cc (Lens* suites).
 #include "camproj/lens_gl.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "camproj/export.h"
 #include "camproj/look_at.h"
@@ -111,7 +111,8 @@ TEST(LensGlTest, RenderTargetWithoutDistortionIsTheImagePlusTheMargin) {
 
 TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
   for (const Camera& camera : Lenses()) {
-    SCOPED_TRACE(testing::Message() << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
+    SCOPED_TRACE(testing::Message()
+                 << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
     const LensRenderTarget target = LensRenderTargetOf(camera);
     const StMap map = LensStMap(camera, LensMapDirection::kDistort);
     ASSERT_EQ(map.width, camera.image_size.width);
@@ -125,8 +126,9 @@ TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
         ASSERT_GE(q.minCoeff(), 0.0);
         ASSERT_LE(q.x(), target.size.width - 1.0);
         ASSERT_LE(q.y(), target.size.height - 1.0);
-        worst = std::max(worst, (LensPixelOf(camera, NormalizedOfTargetPixel(target, q)) -
-                                 Eigen::Vector2d(u, v)).norm());
+        worst = std::max(
+            worst, (LensPixelOf(camera, NormalizedOfTargetPixel(target, q)) - Eigen::Vector2d(u, v))
+                       .norm());
       }
     }
     EXPECT_LE(worst, kMapRoundTripPx);
@@ -152,8 +154,10 @@ TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
         worst = std::max(worst, (LensPixelOf(camera, n) - p).norm());
         const bool inside = p.x() >= -0.5 && p.x() <= camera.image_size.width - 0.5 &&
                             p.y() >= -0.5 && p.y() <= camera.image_size.height - 0.5;
-        if (std::abs(p.x() + 0.5) > 1e-3 && std::abs(p.x() - camera.image_size.width + 0.5) > 1e-3 &&
-            std::abs(p.y() + 0.5) > 1e-3 && std::abs(p.y() - camera.image_size.height + 0.5) > 1e-3) {
+        if (std::abs(p.x() + 0.5) > 1e-3 &&
+            std::abs(p.x() - camera.image_size.width + 0.5) > 1e-3 &&
+            std::abs(p.y() + 0.5) > 1e-3 &&
+            std::abs(p.y() - camera.image_size.height + 0.5) > 1e-3) {
           EXPECT_EQ(st[3], inside ? 1.0f : 0.0f) << "at " << u << ", " << v;
         }
         on_plate += st[3] == 1.0f;
@@ -171,7 +175,8 @@ TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
 TEST(LensGlTest, TrianglesWithinTheMaxEdgeInterpolateTheLensWithinTheTarget) {
   std::mt19937 random(13);
   for (const Camera& camera : Lenses()) {
-    SCOPED_TRACE(testing::Message() << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
+    SCOPED_TRACE(testing::Message()
+                 << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
     const LensRenderTarget target = LensRenderTargetOf(camera);
     const Intrinsics pinhole = camera.intrinsics.Pinhole();
     for (const double error_px : {0.1, 0.01}) {
@@ -183,7 +188,8 @@ TEST(LensGlTest, TrianglesWithinTheMaxEdgeInterpolateTheLensWithinTheTarget) {
       for (int trial = 0; trial < 2000; ++trial) {
         // A triangle around the undistorted position of a random image pixel, longest edge
         // exactly `edge` (pinhole px): two vertices `edge` apart, the third at an inner angle.
-        const Eigen::Vector3d ray = CamRayFromPixel(camera.intrinsics, {u_in(random), v_in(random)});
+        const Eigen::Vector3d ray =
+            CamRayFromPixel(camera.intrinsics, {u_in(random), v_in(random)});
         const Eigen::Vector2d center = PixelFromCam(pinhole, ray);
         const double a = angle(random);
         const Eigen::Vector2d dir(std::cos(a), std::sin(a));
@@ -206,8 +212,10 @@ TEST(LensGlTest, TrianglesWithinTheMaxEdgeInterpolateTheLensWithinTheTarget) {
           for (int j = 0; i + j <= 5; ++j) {
             const double l = (5 - i - j) / 5.0;
             const Eigen::Vector2d at = (i * corners[0] + j * corners[1]) / 5.0 + l * corners[2];
-            const Eigen::Vector2d linear = (i * distorted[0] + j * distorted[1]) / 5.0 + l * distorted[2];
-            const Eigen::Vector2d exact = PixelFromCam(camera.intrinsics, CamRayFromPixel(pinhole, at));
+            const Eigen::Vector2d linear =
+                (i * distorted[0] + j * distorted[1]) / 5.0 + l * distorted[2];
+            const Eigen::Vector2d exact =
+                PixelFromCam(camera.intrinsics, CamRayFromPixel(pinhole, at));
             worst = std::max(worst, (exact - linear).norm());
           }
         }
@@ -232,7 +240,8 @@ TEST(LensGlTest, GlslTextHasTheLensFunctionAndNoCharacterGlslLacks) {
   EXPECT_THAT(LensGlslText(TestCamera(0.0, 0.0)), HasSubstr("camproj_lens is the identity"));
   // r_limit = min(fold 1.054, 2 x the image corner's radius ~0.87).
   EXPECT_NEAR(LensRadiusLimit(camera), 1.0 / std::sqrt(0.9), 1e-15);
-  EXPECT_NEAR(LensRadiusLimit(TestCamera(0.25, 0.08)), 2.0 * LensImageRadius(TestCamera(0.25, 0.08)), 1e-15);
+  EXPECT_NEAR(LensRadiusLimit(TestCamera(0.25, 0.08)),
+              2.0 * LensImageRadius(TestCamera(0.25, 0.08)), 1e-15);
 }
 
 // The 16 numbers after `const mat4 NAME = mat4(` in `text`, column-major.
@@ -280,8 +289,8 @@ TEST(LensGlTest, MeshHasTheGridAndItsErrorMeetsTheStepRule) {
   EXPECT_EQ(mesh["triangles"].size(), 3u * 2 * (columns - 1) * (rows - 1));
   EXPECT_EQ(mesh["undistorted_uv"][2].get<double>(), 8.0 / target.size.width);
   // Vertex 1's output: the lens's pixel of the source (8 - 0.5, Ht - 0.5) (window (8, 0)).
-  const Eigen::Vector2d lens_pixel = LensPixelOf(
-      camera, NormalizedOfTargetPixel(target, {7.5, target.size.height - 0.5}));
+  const Eigen::Vector2d lens_pixel =
+      LensPixelOf(camera, NormalizedOfTargetPixel(target, {7.5, target.size.height - 0.5}));
   EXPECT_NEAR(mesh["distorted_uv"][2].get<double>(), (lens_pixel.x() + 0.5) / 160.0, 1e-15);
   EXPECT_NEAR(mesh["distorted_uv"][3].get<double>(), (120.0 - lens_pixel.y() - 0.5) / 120.0, 1e-15);
   const int step = LensMeshStepPx(camera, kLensMeshErrorPx);
@@ -342,8 +351,8 @@ TEST(LensGlTest, StMapFilesAreFloatRgbaInNukeChannelOrder) {
   for (int i = 0; i < 6; ++i) map.rgba.insert(map.rgba.end(), {0.25f + i, 0.5f, 0.0f, 1.0f});
   for (const std::string extension : {".tif", ".exr"}) {
     const std::string bytes = EncodeStMap(map, extension);
-    const cv::Mat image = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()),
-                                       cv::IMREAD_UNCHANGED);
+    const cv::Mat image =
+        cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_UNCHANGED);
     ASSERT_EQ(image.type(), CV_32FC4) << extension;
     // OpenCV reads R, G, B, A into channels 2, 1, 0, 3.
     EXPECT_EQ(image.at<cv::Vec4f>(1, 2)[2], 5.25f) << extension;
@@ -356,8 +365,8 @@ TEST(LensGlTest, StMapFilesAreFloatRgbaInNukeChannelOrder) {
   const StMap full = LensStMap(TestCamera(-0.3, 0.0), LensMapDirection::kUndistort);
   for (const std::string extension : {".tiff", ".exr"}) {
     const std::string bytes = EncodeStMap(full, extension);
-    const cv::Mat image = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()),
-                                       cv::IMREAD_UNCHANGED);
+    const cv::Mat image =
+        cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_UNCHANGED);
     ASSERT_EQ(image.rows, full.height);
     ASSERT_EQ(image.cols, full.width);
     int differ = 0;

@@ -868,7 +868,8 @@ double LongestVisibleEdgePx(const std::vector<float>& triangles, const Camera& c
     }
     if (!visible) continue;
     if (behind) return std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 3; ++i) longest = std::max(longest, (pixels[i] - pixels[(i + 1) % 3]).norm());
+    for (int i = 0; i < 3; ++i)
+      longest = std::max(longest, (pixels[i] - pixels[(i + 1) % 3]).norm());
   }
   return longest;
 }
@@ -1132,7 +1133,8 @@ class LensShaderRenderTest : public GlTest, public testing::WithParamInterface<L
 // The per-vertex lens, as exported (--to glsl, the text verbatim): at every vertex the GL puts
 // world points within kMaxPixelError (1e-3 px) of the lens's pixel, with the pinhole's depth;
 // between vertices within the tessellation target the docs' rule promises.
-TEST_P(LensShaderRenderTest, VerticesWithin1em3PxMeasured3em5_PixelsWithinTarget1em2PxMeasured6em3) {
+TEST_P(LensShaderRenderTest,
+       VerticesWithin1em3PxMeasured3em5_PixelsWithinTarget1em2PxMeasured6em3) {
   const auto& [lens, depth_case] = GetParam();
   const Camera camera = LensCamera(lens);
   const std::string vertex_shader = "#version 330 core\n" + LensGlslText(camera, depth_case.depth) +
@@ -1145,8 +1147,8 @@ void main() {
 )";
   // Tessellate as docs/exports.md says: every visible edge <= LensMaxEdgePx(target).
   const double max_edge_px = LensMaxEdgePx(camera, kTessellationTargetPx);
-  const int box_cells = CellsForEdge(2, max_edge_px, camera,
-                                     [](int cells) { return TessellatedScene(cells, 0); });
+  const int box_cells =
+      CellsForEdge(2, max_edge_px, camera, [](int cells) { return TessellatedScene(cells, 0); });
   const int background_cells = CellsForEdge(kBackgroundGrid, max_edge_px, camera,
                                             [](int cells) { return TessellatedScene(0, cells); });
   const std::vector<float> triangles = TessellatedScene(box_cells, background_cells);
@@ -1206,14 +1208,15 @@ void main() {
   const WarpErrors pixels = MeasureAgainstLens(camera, readback, &depth_case.depth);
   const double covered_fraction = static_cast<double>(pixels.covered) / (width * height);
 
-  std::printf("[ lens     ] glsl %s/%s: %zu triangles (box %d, background %d cells a side, edges "
-              "<= %.3g px); %d vertices in the image, max vertex error %.3g px, depth %.3g; %d "
-              "beyond r_limit, %d of them drawn in the image; "
-              "pixels: covered %.4f, max error %.3g px (target %.3g), depth %.3g\n",
-              lens.name, depth_case.name, triangles.size() / 9, box_cells, background_cells,
-              max_edge_px, vertices_in_image, max_vertex_error, max_vertex_depth_error, beyond_limit,
-              beyond_limit_in_image, covered_fraction, pixels.max_pixel_error, kTessellationTargetPx,
-              pixels.max_depth_error);
+  std::printf(
+      "[ lens     ] glsl %s/%s: %zu triangles (box %d, background %d cells a side, edges "
+      "<= %.3g px); %d vertices in the image, max vertex error %.3g px, depth %.3g; %d "
+      "beyond r_limit, %d of them drawn in the image; "
+      "pixels: covered %.4f, max error %.3g px (target %.3g), depth %.3g\n",
+      lens.name, depth_case.name, triangles.size() / 9, box_cells, background_cells, max_edge_px,
+      vertices_in_image, max_vertex_error, max_vertex_depth_error, beyond_limit,
+      beyond_limit_in_image, covered_fraction, pixels.max_pixel_error, kTessellationTargetPx,
+      pixels.max_depth_error);
   RecordProperty("max_vertex_error_px", std::to_string(max_vertex_error));
   RecordProperty("max_pixel_error_px", std::to_string(pixels.max_pixel_error));
 
@@ -1234,10 +1237,10 @@ std::string LensShaderParamName(const testing::TestParamInfo<LensShaderParam>& i
 
 INSTANTIATE_TEST_SUITE_P(
     LensesAndDepths, LensShaderRenderTest,
-    testing::Combine(testing::ValuesIn(kLensCases),
-                     testing::Values(DepthCase{"NegativeOneToOne",
-                                               {ClipDepth::kNegativeOneToOne, false}},
-                                     DepthCase{"ZeroToOneReversed", {ClipDepth::kZeroToOne, true}})),
+    testing::Combine(
+        testing::ValuesIn(kLensCases),
+        testing::Values(DepthCase{"NegativeOneToOne", {ClipDepth::kNegativeOneToOne, false}},
+                        DepthCase{"ZeroToOneReversed", {ClipDepth::kZeroToOne, true}})),
     LensShaderParamName);
 
 constexpr char kFullScreenVertexShader[] = R"(#version 330 core
@@ -1278,8 +1281,8 @@ void main() { color = texture(u_source, v_uv); }
 
 // A post-process pass into a width x height framebuffer: the full-screen STMap pass when `mesh`
 // is null, else the mesh's triangles. Textures unit 0 = source, unit 1 = map.
-std::string WarpPass(int width, int height, GLuint source, GLuint map,
-                     const nlohmann::json* mesh, Readback* readback) {
+std::string WarpPass(int width, int height, GLuint source, GLuint map, const nlohmann::json* mesh,
+                     Readback* readback) {
   GlObjects gl;
   std::string error = mesh ? BuildProgram(kMeshVertexShader, kMeshFragmentShader, &gl)
                            : BuildProgram(kFullScreenVertexShader, kStMapFragmentShader, &gl);
@@ -1308,8 +1311,9 @@ std::string WarpPass(int width, int height, GLuint source, GLuint map,
     glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float),
                           reinterpret_cast<const void*>(2 * sizeof(float)));
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[0]);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)),
-                 indices.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)), indices.data(),
+                 GL_STATIC_DRAW);
   }
   error = BindFramebuffer(width, height, GlDepth{}, &gl);
   if (!error.empty()) {
@@ -1347,10 +1351,10 @@ TEST_P(LensWarpRenderTest, StMapWithin0p05PxMeasured3em4_MeshWithin0p05PxMeasure
   const Camera camera = LensCamera(lens);
   const LensRenderTarget target = LensRenderTargetOf(camera);
   Readback pinhole;
-  std::string error = RenderWorldPositions(
-      kVertexShader, TessellatedScene(0, kBackgroundGrid), target.size.width, target.size.height,
-      LensRenderTargetClipFromGlEye(camera), GlEyeFromWorld(camera.cam_from_world), GlDepth{},
-      &pinhole);
+  std::string error =
+      RenderWorldPositions(kVertexShader, TessellatedScene(0, kBackgroundGrid), target.size.width,
+                           target.size.height, LensRenderTargetClipFromGlEye(camera),
+                           GlEyeFromWorld(camera.cam_from_world), GlDepth{}, &pinhole);
   ASSERT_TRUE(error.empty()) << error;
   int target_covered = 0;
   for (size_t i = 3; i < pinhole.rgba.size(); i += 4) target_covered += pinhole.rgba[i] == 1.0f;
@@ -1374,14 +1378,15 @@ TEST_P(LensWarpRenderTest, StMapWithin0p05PxMeasured3em4_MeshWithin0p05PxMeasure
   const WarpErrors meshed = MeasureAgainstLens(camera, warped, nullptr);
 
   const double pixels = kImageSize.width * kImageSize.height;
-  std::printf("[ lens     ] warp %s: render target %d x %d (offset %d, %d), covered %.4f; stmap: "
-              "covered %.4f, max error %.3g px; mesh (step %d px, its interpolation error %.3g "
-              "px): covered %.4f, max error %.3g px\n",
-              lens.name, target.size.width, target.size.height, target.offset_x, target.offset_y,
-              target_covered / (1.0 * target.size.width * target.size.height),
-              stmap.covered / pixels, stmap.max_pixel_error, mesh["step_px"].get<int>(),
-              mesh["max_interpolation_error_px"].get<double>(), meshed.covered / pixels,
-              meshed.max_pixel_error);
+  std::printf(
+      "[ lens     ] warp %s: render target %d x %d (offset %d, %d), covered %.4f; stmap: "
+      "covered %.4f, max error %.3g px; mesh (step %d px, its interpolation error %.3g "
+      "px): covered %.4f, max error %.3g px\n",
+      lens.name, target.size.width, target.size.height, target.offset_x, target.offset_y,
+      target_covered / (1.0 * target.size.width * target.size.height), stmap.covered / pixels,
+      stmap.max_pixel_error, mesh["step_px"].get<int>(),
+      mesh["max_interpolation_error_px"].get<double>(), meshed.covered / pixels,
+      meshed.max_pixel_error);
   RecordProperty("stmap_max_error_px", std::to_string(stmap.max_pixel_error));
   RecordProperty("mesh_max_error_px", std::to_string(meshed.max_pixel_error));
   EXPECT_EQ(target_covered, target.size.width * target.size.height)
@@ -1413,8 +1418,8 @@ TEST_P(LensWarpRenderTest, UndistortStMapWithin0p05PxMeasured0p033) {
   std::vector<float> plate(static_cast<size_t>(width) * height * 4, 0.0f);  // row 0 = bottom
   for (int j = 0; j < height; ++j) {
     for (int i = 0; i < width; ++i) {
-      const Eigen::Vector3d ray = world_from_cam * CamRayFromPixel(camera.intrinsics,
-                                                                   {i, height - 1 - j});
+      const Eigen::Vector3d ray =
+          world_from_cam * CamRayFromPixel(camera.intrinsics, {i, height - 1 - j});
       const double t = (kBackgroundOffset - frame.normal.dot(eye)) / frame.normal.dot(ray);
       ASSERT_GT(t, 0.0);
       const Eigen::Vector3d point = eye + t * ray;
@@ -1446,8 +1451,8 @@ TEST_P(LensWarpRenderTest, UndistortStMapWithin0p05PxMeasured0p033) {
       // The source in plate pixels (kCenter): window = st * size, pixel = window - 0.5 (y down).
       const double u = st[0] * width - 0.5;
       const double v = (1.0 - st[1]) * height - 0.5;
-      const bool taps_inside = st[3] == 1.0f && u >= 0.0 && u <= width - 1.0 && v >= 0.0 &&
-                               v <= height - 1.0;
+      const bool taps_inside =
+          st[3] == 1.0f && u >= 0.0 && u <= width - 1.0 && v >= 0.0 && v <= height - 1.0;
       const size_t index = static_cast<size_t>(map.height - 1 - y) * map.width + x;
       const float* rgba = &warped.rgba[4 * index];
       if (!taps_inside) {
@@ -1457,17 +1462,18 @@ TEST_P(LensWarpRenderTest, UndistortStMapWithin0p05PxMeasured0p033) {
       ++inside;
       const Eigen::Vector3d point_in_cam =
           camera.cam_from_world * Eigen::Vector3d(rgba[0], rgba[1], rgba[2]);
-      const double error = (PixelFromCam(target.intrinsics, point_in_cam) -
-                            Eigen::Vector2d(x, y)).norm();
+      const double error =
+          (PixelFromCam(target.intrinsics, point_in_cam) - Eigen::Vector2d(x, y)).norm();
       if (!(error <= max_error)) {
         max_error = error;
         worst = Eigen::Vector2d(x, y);
       }
     }
   }
-  std::printf("[ lens     ] undistort %s: render target %d x %d, %d pixels from inside the plate, "
-              "max error %.3g px\n",
-              lens.name, map.width, map.height, inside, max_error);
+  std::printf(
+      "[ lens     ] undistort %s: render target %d x %d, %d pixels from inside the plate, "
+      "max error %.3g px\n",
+      lens.name, map.width, map.height, inside, max_error);
   RecordProperty("undistort_max_error_px", std::to_string(max_error));
   // The plate's footprint on the render target is about the plate's area (the lens scales area
   // by ~0.6 to ~1.6 over these images).

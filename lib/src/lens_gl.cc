@@ -113,8 +113,8 @@ void RequireLensCoversImage(const Camera& camera) {
     const double rd = DistortedNormalized(k, corner).norm();
     Require(rd < rd_fold, "the lens model does not cover the image: radial distortion k1 = ", k.k1,
             ", k2 = ", k.k2, " folds over at normalized radius ", r_fold, " (distorted ", rd_fold,
-            "), but the image corner (", corner.x(), ", ", corner.y(),
-            ") is at distorted radius ", rd, "; no lens rendering can reproduce it");
+            "), but the image corner (", corner.x(), ", ", corner.y(), ") is at distorted radius ",
+            rd, "; no lens rendering can reproduce it");
   }
 }
 
@@ -215,7 +215,8 @@ double LensSecondDerivativePx(const Camera& camera) {
     const auto form = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& c) -> Eigen::Vector2d {
       const double na = n.dot(a);
       const double nc = n.dot(c);
-      return a_matrix * (2.0 * d1 * (na * c + nc * a) + n * (4.0 * d2 * na * nc + 2.0 * d1 * a.dot(c)));
+      return a_matrix *
+             (2.0 * d1 * (na * c + nc * a) + n * (4.0 * d2 * na * nc + 2.0 * d1 * a.dot(c)));
     };
     const Eigen::Vector2d g11 = form(b.col(0), b.col(0));
     const Eigen::Vector2d g12 = form(b.col(0), b.col(1));
@@ -275,8 +276,8 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
   const CameraViews views = ViewsOfCamera(camera, 1.0, depth);
   auto out = ExactStream();
-  out << "// camproj GLSL lens export (docs/exports.md, section glsl): radial distortion k1 = " << k.k1
-      << ", k2 = " << k.k2 << "\n"
+  out << "// camproj GLSL lens export (docs/exports.md, section glsl): radial distortion k1 = "
+      << k.k1 << ", k2 = " << k.k2 << "\n"
       << "// applied per vertex in gl_eye, before the pinhole projection matrix. GLSL 1.30+ / ES "
          "3.00.\n"
       << "//   gl_Position = camproj_projection * camproj_lens(camproj_view * vec4(world_position, "
@@ -314,9 +315,12 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << "const float camproj_r2_limit = " << GlslFloat(r_limit * r_limit) << ";\n"
       << "const mat4 camproj_projection = " << GlslMat4(views.clip_from_gl_eye) << ";\n"
       << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_world) << ";\n"
-      << "// gl_eye (x right, y up, looking down -z) is cam (x right, y down, z forward) with y and\n"
-      << "// z negated: x = X/Z = x_eye / -z_eye, y = Y/Z = y_eye / z_eye. Only r^2 = x^2 + y^2 is\n"
-      << "// needed, and distorting (x, y) by d is scaling eye.xy by d: the x, y rows of the projection\n"
+      << "// gl_eye (x right, y up, looking down -z) is cam (x right, y down, z forward) with y "
+         "and\n"
+      << "// z negated: x = X/Z = x_eye / -z_eye, y = Y/Z = y_eye / z_eye. Only r^2 = x^2 + y^2 "
+         "is\n"
+      << "// needed, and distorting (x, y) by d is scaling eye.xy by d: the x, y rows of the "
+         "projection\n"
       << "// matrix are linear in eye.xy (skew too), its z and w rows see only eye.zw.\n"
       << "vec4 camproj_lens(vec4 eye) {\n"
       << "  if (eye.z >= 0.0) return eye;\n"
@@ -380,7 +384,8 @@ StMap LensStMap(const Camera& camera, LensMapDirection direction) {
 
 std::string EncodeStMap(const StMap& map, const std::string& extension) {
   Require(extension == ".tif" || extension == ".tiff" || extension == ".exr",
-          "an STMap is written as .tif, .tiff or .exr (32-bit float RGBA), got \"", extension, "\"");
+          "an STMap is written as .tif, .tiff or .exr (32-bit float RGBA), got \"", extension,
+          "\"");
   Require(map.width > 0 && map.height > 0 &&
               map.rgba.size() == static_cast<size_t>(map.width) * map.height * 4,
           "STMap of ", map.width, " x ", map.height, " px holds ", map.rgba.size(),
@@ -472,16 +477,16 @@ double LensMeshErrorPx(const Camera& camera, const LensRenderTarget& target, con
         if (i == 4 || j == 4 || l == 4) continue;
         const auto mix = [&](const std::vector<Eigen::Vector2d>& points) {
           return (i * points[mesh.triangles[t]] + j * points[mesh.triangles[t + 1]] +
-                  l * points[mesh.triangles[t + 2]]) / 4.0;
+                  l * points[mesh.triangles[t + 2]]) /
+                 4.0;
         };
         const Eigen::Vector2d window = mix(mesh.window);
         if (window.x() < 0.0 || window.x() > w || window.y() < 0.0 || window.y() > h) continue;
         const Eigen::Vector2d drawn(window.x() - 0.5, h - window.y() - 0.5);
         const Eigen::Vector2d n = PinholeNormalized(target.intrinsics, mix(mesh.source));
         // Beyond the fold the lens images nothing there: the drawn point is wrong by far.
-        const double error = n.norm() < r_fold
-                                 ? (LensPixel(camera.intrinsics, n) - drawn).norm()
-                                 : std::numeric_limits<double>::infinity();
+        const double error = n.norm() < r_fold ? (LensPixel(camera.intrinsics, n) - drawn).norm()
+                                               : std::numeric_limits<double>::infinity();
         worst = std::max(worst, error);
       }
     }
@@ -579,9 +584,9 @@ std::string LensDistortionMeshObj(const Camera& camera, int step_px, const GlDep
       << " x " << camera.image_size.height << " image, in NDC (distorted_uv * 2 - 1)\n"
       << "# vt u v: the vertex on the render target (undistorted_uv = window / size, y up)\n"
       << "# render target: " << target.size.width << " x " << target.size.height
-      << " px, pixel = the camera's pinhole pixel + (" << target.offset_x << ", "
-      << target.offset_y << "); fx " << target.intrinsics.fx << ", fy " << target.intrinsics.fy
-      << ", cx " << target.intrinsics.cx << ", cy " << target.intrinsics.cy << ", skew "
+      << " px, pixel = the camera's pinhole pixel + (" << target.offset_x << ", " << target.offset_y
+      << "); fx " << target.intrinsics.fx << ", fy " << target.intrinsics.fy << ", cx "
+      << target.intrinsics.cx << ", cy " << target.intrinsics.cy << ", skew "
       << target.intrinsics.skew << " (kCenter); depth " << ToString(depth.clip_depth)
       << (depth.reversed_z ? ", reversed-Z" : "") << "; near " << camera.z_near << ", far "
       << camera.z_far << "\n"
@@ -638,9 +643,9 @@ std::string LensRenderTargetText(const Camera& camera, LensMapDirection directio
         << target.size.width << " x " << target.size.height << " to overlay it\n";
   }
   out << "# render target: " << target.size.width << " x " << target.size.height
-      << " px, pixel = the camera's pinhole pixel + (" << target.offset_x << ", "
-      << target.offset_y << "); fx " << target.intrinsics.fx << ", fy " << target.intrinsics.fy
-      << ", cx " << target.intrinsics.cx << ", cy " << target.intrinsics.cy << ", skew "
+      << " px, pixel = the camera's pinhole pixel + (" << target.offset_x << ", " << target.offset_y
+      << "); fx " << target.intrinsics.fx << ", fy " << target.intrinsics.fy << ", cx "
+      << target.intrinsics.cx << ", cy " << target.intrinsics.cy << ", skew "
       << target.intrinsics.skew << " (kCenter)\n"
       << "# projection = clip_from_gl_eye, view = gl_eye_from_world, column-major (GL_FALSE); "
          "depth "

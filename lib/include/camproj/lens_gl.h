@@ -14,10 +14,9 @@
 #ifndef CAMPROJ_LENS_GL_H_
 #define CAMPROJ_LENS_GL_H_
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "camproj/camera.h"
 #include "camproj/conventions.h"
@@ -46,11 +45,11 @@ double LensRadiusLimit(const Camera& camera);
 // every side, so bilinear taps at any map sample stay inside. Larger than the image for barrel
 // (k1 < 0), possibly smaller for pincushion: same px per normalized unit, not the same size.
 struct LensRenderTarget {
-  ImageSize size;          // px
-  Intrinsics intrinsics;   // pinhole (k1 = k2 = 0), kCenter: fx, fy, skew of the camera,
-                           // cx + offset_x, cy + offset_y
-  int offset_x = 0;        // px
-  int offset_y = 0;        // px
+  ImageSize size;         // px
+  Intrinsics intrinsics;  // pinhole (k1 = k2 = 0), kCenter: fx, fy, skew of the camera,
+                          // cx + offset_x, cy + offset_y
+  int offset_x = 0;       // px
+  int offset_y = 0;       // px
 };
 
 // Margin around the preimage's bounding box: 1 px for the bilinear taps (texel centres on either
