@@ -16,11 +16,12 @@
 
 #include "camproj/export.h"
 #include "camproj/look_at.h"
+#include "seeds.h"
 
 namespace camproj {
 namespace {
 
-using testing::HasSubstr;
+using ::testing::HasSubstr;
 
 // A map value is a float32 in [0, 1] (ulp <= 6e-8) times a size of ~200 px: ~1e-5 px; the
 // round trip's double arithmetic adds nothing visible. 1e-4 px leaves 10x.
@@ -111,7 +112,7 @@ TEST(LensGlTest, RenderTargetWithoutDistortionIsTheImagePlusTheMargin) {
 
 TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
   for (const Camera& camera : Lenses()) {
-    SCOPED_TRACE(testing::Message()
+    SCOPED_TRACE(::testing::Message()
                  << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
     const LensRenderTarget target = LensRenderTargetOf(camera);
     const StMap map = LensStMap(camera, LensMapDirection::kDistort);
@@ -173,9 +174,9 @@ TEST(LensGlTest, RenderTargetHoldsEveryBilinearTapAndTheMapsRoundTrip) {
 // image's footprint against the lens evaluated in double at 21 points each; and the bound is not
 // vacuous: some triangle comes within a factor 8 of it.
 TEST(LensGlTest, TrianglesWithinTheMaxEdgeInterpolateTheLensWithinTheTarget) {
-  std::mt19937 random(13);
+  std::mt19937_64 random(testing::Seed(13));
   for (const Camera& camera : Lenses()) {
-    SCOPED_TRACE(testing::Message()
+    SCOPED_TRACE(::testing::Message()
                  << "k1 " << camera.intrinsics.k1 << ", k2 " << camera.intrinsics.k2);
     const LensRenderTarget target = LensRenderTargetOf(camera);
     const Intrinsics pinhole = camera.intrinsics.Pinhole();
