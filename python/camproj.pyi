@@ -20,7 +20,7 @@ ArrayLike = npt.ArrayLike
 Mat = npt.NDArray[np.float64]
 ImageSize = Tuple[int, int]  # (width, height) in pixels
 
-EXPORT_FORMATS: Tuple[str, ...]  # "gl", "glm", "opencv-yaml", "colmap", "three", "json"
+EXPORT_FORMATS: Tuple[str, ...]  # "gl", "glm", "opencv-yaml", "colmap", "three", "json", "glsl", "distortion-mesh"
 
 class SceneError(RuntimeError):
     """The points cannot determine the requested camera; the message says why and what to change

@@ -612,5 +612,6 @@ PYBIND11_MODULE(camproj, m) {
   m.def("write_file_atomically", &WriteFileAtomically, py::arg("path"), py::arg("contents"),
         "Writes text as camproj fit -o does (file_io.h): readers see the old file or the new one, "
         "never a partial one; flushed to disk before the rename.");
-  m.attr("EXPORT_FORMATS") = py::make_tuple("gl", "glm", "opencv-yaml", "colmap", "three", "json");
+  m.attr("EXPORT_FORMATS") = py::make_tuple("gl", "glm", "opencv-yaml", "colmap", "three", "json",
+                                            "glsl", "distortion-mesh");
 }

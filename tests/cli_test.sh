@@ -680,6 +680,80 @@ INNER
       done
     done
     ;;
+  export_lens)
+    # The exports that render the lens (docs/exports.md, "Rendering the lens"), on the projector
+    # with k1 = -0.15, k2 = 0.02. The STMap is checked against the model evaluated here
+    # independently: undistort the pixel (Newton), the pinhole pixel + the render target's offset,
+    # then Nuke's (x + 0.5) / W, 1 - (y + 0.5) / H; float32 values of ~1: 1e-6.
+    py - "$data/projector/truth.json" "$work/lens.json" "$work/folded.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+for key in ("gl", "look_at"):
+    c.pop(key, None)
+c["intrinsics"]["k1"], c["intrinsics"]["k2"] = -0.15, 0.02
+json.dump(c, open(sys.argv[2], "w"))
+c["intrinsics"]["k1"] = -1.5  # folds over inside the image
+json.dump(c, open(sys.argv[3], "w"))
+PY
+    expect_exit 0 "$bin" export "$work/lens.json" --to glsl --quiet
+    expect_in out "^vec4 camproj_lens(vec4 eye) {"
+    expect_in out "^const mat4 camproj_projection = mat4("
+    ! grep -q "pinhole part only" "$work/err" || fail "glsl renders the lens but was warned:\n$(cat "$work/err")"
+    expect_exit 0 "$bin" export "$work/lens.json" --to gl --quiet
+    expect_in err "to render the lens export glsl (per vertex), stmap or distortion-mesh"
+    expect_exit 0 "$bin" export "$work/lens.json" --to stmap -o "$work/map.tif"
+    expect_in out "^# render target: [0-9]* x [0-9]* px, pixel = the camera's pinhole pixel + ("
+    py - "$work/lens.json" "$work/map.tif" "$work/out" <<'PY'
+import json, re, sys
+import cv2
+c = json.load(open(sys.argv[1])); k = c["intrinsics"]; W, H = c["image_size"]
+m = re.search(r"render target: (\d+) x (\d+) px, pixel = the camera's pinhole pixel \+ \((-?\d+), (-?\d+)\)",
+              open(sys.argv[3]).read())
+Wt, Ht, ox, oy = map(int, m.groups())
+image = cv2.imread(sys.argv[2], cv2.IMREAD_UNCHANGED)
+assert image.shape == (H, W, 4) and image.dtype == "float32", (image.shape, image.dtype)
+for u, v in ((0, 0), (W - 1, H - 1), (W // 2, H // 2), (100, H - 100), (W - 1, 0)):
+    yd = (v - k["cy"]) / k["fy"]; xd = (u - k["cx"] - k["skew"] * yd) / k["fx"]
+    rd = (xd * xd + yd * yd) ** 0.5; r = rd
+    for _ in range(50):
+        g = r * (1 + k["k1"] * r * r + k["k2"] * r ** 4); dg = 1 + 3 * k["k1"] * r * r + 5 * k["k2"] * r ** 4
+        r -= (g - rd) / dg
+    x, y = xd * r / rd, yd * r / rd
+    qx = k["fx"] * x + k["skew"] * y + k["cx"] + ox; qy = k["fy"] * y + k["cy"] + oy
+    b, g_, red, a = image[v, u]  # OpenCV reads R, G, B, A as channels 2, 1, 0, 3
+    want = ((qx + 0.5) / Wt, 1 - (qy + 0.5) / Ht)
+    assert abs(red - want[0]) < 1e-6 and abs(g_ - want[1]) < 1e-6 and a == 1, (u, v, red, g_, want)
+PY
+    [[ $? -eq 0 ]] || fail "the STMap disagrees with the model"
+    expect_exit 0 "$bin" export "$work/lens.json" --to undistort-stmap -o "$work/undistort.exr"
+    [[ -s $work/undistort.exr ]] || fail "no undistortion map"
+    expect_exit 0 "$bin" export "$work/lens.json" --to distortion-mesh -o "$work/mesh.json"
+    py -c '
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["max_interpolation_error_px"] <= 0.01 and len(m["undistorted_uv"]) == 2 * m["vertex_count"], m["step_px"]
+' "$work/mesh.json" || fail "bad distortion mesh"
+    expect_exit 0 "$bin" export "$work/lens.json" --to distortion-mesh -o "$work/mesh.obj"
+    grep -q "^vt " "$work/mesh.obj" && grep -q "^f 1/1 2/2 " "$work/mesh.obj" || fail "bad OBJ mesh"
+    # Refusals: exit 1 (usage) or 2 (a lens folding inside the image), no file written.
+    expect_exit 1 "$bin" export "$work/lens.json" --to stmap
+    expect_in err "give -o MAP.tif, MAP.tiff or MAP.exr"
+    expect_exit 1 "$bin" export "$work/lens.json" --to stmap -o "$work/map.png"
+    expect_in err "must end in .tif, .tiff or .exr"
+    [[ ! -e $work/map.png ]] || fail "map.png written"
+    expect_exit 2 "$bin" export "$work/folded.json" --to stmap -o "$work/folded.tif"
+    expect_in err "folds over at normalized radius"
+    [[ ! -e $work/folded.tif ]] || fail "folded.tif written"
+    expect_exit 2 "$bin" export "$work/folded.json" --to glsl
+    expect_in err "cannot export as glsl: the lens model does not cover the image"
+    [[ ! -s $work/out ]] || fail "partial glsl on stdout"
+    # -o writes any export atomically, and never over the camera file it reads.
+    expect_exit 0 "$bin" export "$work/lens.json" --to glsl -o "$work/lens.glsl"
+    grep -q "^vec4 camproj_lens" "$work/lens.glsl" || fail "lens.glsl lacks camproj_lens"
+    cp "$work/lens.json" "$work/lens_copy.json"
+    expect_exit 2 "$bin" export "$work/lens.json" --to glsl -o "$work/lens.json"
+    cmp -s "$work/lens.json" "$work/lens_copy.json" || fail "the camera file was overwritten"
+    ;;
   export_non_finite_refused)
     # fx = 1e308 overflowed the GL matrices to inf (gl) or null (json), exit 0; cx = 1e308 failed
     # gl/json but passed the others. Now every reader and exporter refuses both alike.

@@ -133,9 +133,11 @@ std::vector<std::string> GlmLiterals(const std::string& text, const std::string&
 TEST(ExportFormatTest, NamesRoundTripAndBadNamesAreRefusedWithTheChoices) {
   for (const ExportFormat format :
        {ExportFormat::kGl, ExportFormat::kGlm, ExportFormat::kOpenCvYaml, ExportFormat::kColmap,
-        ExportFormat::kThree, ExportFormat::kJson}) {
+        ExportFormat::kThree, ExportFormat::kJson, ExportFormat::kGlsl,
+        ExportFormat::kDistortionMesh}) {
     EXPECT_EQ(ExportFormatFromString(ToString(format)), format) << ToString(format);
   }
+  EXPECT_EQ(ExportFormatFromString("distortion-mesh"), ExportFormat::kDistortionMesh);
   EXPECT_EQ(ExportFormatFromString("opencv-yaml"), ExportFormat::kOpenCvYaml);
   for (const std::string bad : {"", "GL", "yaml", "opencv_yaml", "json "}) {
     try {

@@ -26,7 +26,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <tuple>
@@ -35,11 +37,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "camproj/conventions.h"
 #include "camproj/gl.h"
 #include "camproj/camera.h"
 #include "camproj/intrinsics.h"
+#include "camproj/lens_gl.h"
 #include "camproj/look_at.h"
 #include "camproj/pose.h"
 
@@ -595,7 +599,9 @@ double ExpectedWindowDepth(double z, bool reversed_z, Projection projection) {
   return reversed_z ? n * (f - z) / ((f - n) * z) : f * (z - n) / ((f - n) * z);
 }
 
-class RenderTest : public testing::TestWithParam<RenderParam> {
+// The headless context, made once per test suite; without one every case skips (or fails, see
+// SetUp).
+class GlTest : public testing::Test {
  protected:
   static void SetUpTestSuite() {
     context_ = HeadlessGlContext::Create(&skip_reason_).release();
@@ -622,8 +628,10 @@ class RenderTest : public testing::TestWithParam<RenderParam> {
   static std::string skip_reason_;
 };
 
-HeadlessGlContext* RenderTest::context_ = nullptr;
-std::string RenderTest::skip_reason_;
+HeadlessGlContext* GlTest::context_ = nullptr;
+std::string GlTest::skip_reason_;
+
+class RenderTest : public GlTest, public testing::WithParamInterface<RenderParam> {};
 
 TEST_P(RenderTest, PointsProjectOntoTheirPixelsWithTheExpectedDepth) {
   const auto& [camera, depth_case] = GetParam();
@@ -731,6 +739,752 @@ INSTANTIATE_TEST_SUITE_P(
                                      DepthCase{"NegativeOneToOneReversed",
                                                {ClipDepth::kNegativeOneToOne, true}})),
     ParamName);
+
+// ---------------------------------------------------------------------------------------------
+// The lens (lens_gl.h): k1, k2 rendered three ways, each checked as above against
+// PixelFromWorld, which applies the distortion in double. Lens cases of both signs of k1 and k2,
+// two of them with the first fold just outside the image (the image corners at 95 % of the
+// fold's distorted radius).
+
+// Interior error target for the per-vertex lens: the scene is tessellated by the docs' rule
+// (longest edge <= LensMaxEdgePx(camera, target)); the bound M L^2 / 6 then holds at every pixel,
+// plus the float budget kMaxPixelError.
+constexpr double kTessellationTargetPx = 0.01;
+
+// The issue's bound for a post-process warp (bilinear sampling of the pinhole render target) on a
+// smooth scene. What it allows for: the map's own interpolation (the STMap is exact per pixel,
+// the mesh within kLensMeshErrorPx = 0.01 px), bilinear interpolation of a projective map
+// (world position against pixel on a plane: |X''| h^2 / 8 with h = 1 texel, ~1e-5 px here) and
+// the sampler's fixed-point weights (GPUs use 8 bits: 1/512 texel, ~2e-3 px, times the lens
+// scale <= ~1.5). The undistortion samples the plate, where world position against pixel is bent
+// by the lens: bilinear interpolation then errs by |U''| h^2 / 8 (U = the inverse lens map, in
+// px, h = 1 texel), which grows without bound towards the fold: ~0.3 px^-1 at the corners of the
+// near-fold cases here, i.e. ~0.04 px. Measured (llvmpipe): STMap <= 2.9e-4 px, mesh <= 9.6e-3
+// px (its own interpolation error, <= kLensMeshErrorPx), undistortion <= 0.033 px (near the fold;
+// 7.5e-4 px for the pincushion).
+constexpr double kMaxWarpErrorPx = 0.05;
+
+struct LensCase {
+  const char* name;
+  Intrinsics intrinsics;  // kCenter
+};
+
+void PrintTo(const LensCase& lens, std::ostream* os) { *os << lens.name; }
+
+LensCase Lens(const char* name, double fx, double fy, double cx, double cy, double skew, double k1,
+              double k2) {
+  LensCase lens{name, {}};
+  lens.intrinsics.fx = fx;
+  lens.intrinsics.fy = fy;
+  lens.intrinsics.cx = cx;
+  lens.intrinsics.cy = cy;
+  lens.intrinsics.skew = skew;
+  lens.intrinsics.k1 = k1;
+  lens.intrinsics.k2 = k2;
+  return lens;
+}
+
+// Image corners at distorted normalized radius 0.667: k1 = -0.3 folds at r = 1.054 (distorted
+// 0.703), k1 = -0.35, k2 = 0.04 at r = 1.118 (distorted 0.699), k1 = 0.1, k2 = -0.3 at r = 0.961
+// (distorted 0.804); k1 = 0.25, k2 = 0.08 never folds.
+const LensCase kLensCases[] = {
+    Lens("BarrelNearFold", 150.0, 150.0, 79.5, 59.5, 0.0, -0.3, 0.0),
+    Lens("BarrelPositiveK2NearFold", 150.0, 150.0, 79.5, 59.5, 0.0, -0.35, 0.04),
+    Lens("Pincushion", 150.0, 156.0, 83.1, 57.4, 0.0, 0.25, 0.08),
+    Lens("PincushionNegativeK2Skewed", 150.0, 145.0, 77.2, 62.9, 8.0, 0.1, -0.3),
+};
+
+Camera LensCamera(const LensCase& lens) {
+  Camera camera;
+  camera.image_size = kImageSize;
+  camera.intrinsics = lens.intrinsics;
+  LookAt look_at;
+  look_at.eye = Eigen::Vector3d(3.0, 2.0, 2.6);
+  look_at.target = Eigen::Vector3d(0.1, -0.1, 0.05);
+  look_at.up = Eigen::Vector3d(0.15, 1.0, -0.1);
+  camera.cam_from_world = CamFromWorldFromLookAt(look_at);
+  camera.z_near = kZNear;
+  camera.z_far = kZFar;
+  return camera;
+}
+
+// The box's faces split into box_cells^2 quads each, and the background into
+// background_cells^2; either may be left out (0 cells).
+std::vector<float> TessellatedScene(int box_cells, int background_cells) {
+  std::vector<float> triangles;
+  for (int f = 0; f < 6 && box_cells > 0; ++f) {
+    const BoxFace& face = kBoxFaces[f];
+    const Eigen::Vector3d center = face.sign * kBoxHalfSize * Eigen::Vector3d::Unit(face.axis);
+    const Eigen::Vector3d a = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 1) % 3);
+    const Eigen::Vector3d b = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 2) % 3);
+    const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
+      return center + (2.0 * column / box_cells - 1.0) * a + (2.0 * row / box_cells - 1.0) * b;
+    };
+    for (int row = 0; row < box_cells; ++row) {
+      for (int column = 0; column < box_cells; ++column) {
+        AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
+                    vertex(row + 1, column)},
+                   &triangles);
+      }
+    }
+  }
+  const BackgroundFrame frame;
+  const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
+    const double s = (2.0 * column / background_cells - 1.0) * kBackgroundHalfSize;
+    const double t = (2.0 * row / background_cells - 1.0) * kBackgroundHalfSize;
+    return kBackgroundOffset * frame.normal + s * frame.a + t * frame.b;
+  };
+  for (int row = 0; row < background_cells; ++row) {
+    for (int column = 0; column < background_cells; ++column) {
+      AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
+                  vertex(row + 1, column)},
+                 &triangles);
+    }
+  }
+  return triangles;
+}
+
+// The longest triangle edge on the camera's pinhole image (px) among triangles with a vertex in
+// the lens render target's view (which holds the image's footprint); infinity if such a triangle
+// reaches behind the camera.
+double LongestVisibleEdgePx(const std::vector<float>& triangles, const Camera& camera) {
+  const LensRenderTarget target = LensRenderTargetOf(camera);
+  double longest = 0.0;
+  for (size_t t = 0; t + 9 <= triangles.size(); t += 9) {
+    std::array<Eigen::Vector2d, 3> pixels;
+    bool visible = false;
+    bool behind = false;
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d point_in_world(triangles[t + 3 * i], triangles[t + 3 * i + 1],
+                                           triangles[t + 3 * i + 2]);
+      const Eigen::Vector3d point_in_cam = camera.cam_from_world * point_in_world;
+      if (point_in_cam.z() <= 0.0) {
+        behind = true;
+        continue;
+      }
+      pixels[i] = PixelFromCam(target.intrinsics, point_in_cam);
+      visible = visible || (pixels[i].x() >= -0.5 && pixels[i].x() <= target.size.width - 0.5 &&
+                            pixels[i].y() >= -0.5 && pixels[i].y() <= target.size.height - 0.5);
+    }
+    if (!visible) continue;
+    if (behind) return std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i)
+      longest = std::max(longest, (pixels[i] - pixels[(i + 1) % 3]).norm());
+  }
+  return longest;
+}
+
+// The smallest number of cells (from `cells` up) whose scene has every visible edge <= max_edge.
+template <typename MakeScene>
+int CellsForEdge(int cells, double max_edge_px, const Camera& camera, MakeScene make_scene) {
+  for (;;) {
+    const double longest = LongestVisibleEdgePx(make_scene(cells), camera);
+    if (longest <= max_edge_px) return cells;
+    cells = static_cast<int>(std::ceil(cells * std::max(1.1, 1.02 * longest / max_edge_px)));
+  }
+}
+
+std::string LinkProgram(GLuint program) {
+  glLinkProgram(program);
+  GLint linked = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &linked);
+  if (linked == GL_TRUE) return "";
+  char log[2048] = "";
+  glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+  return std::string("program link failed: ") + log;
+}
+
+// Vertex and fragment shader linked into gl->program; with `feedback`, that varying is captured
+// by transform feedback (and the fragment shader may be null).
+std::string BuildProgram(const std::string& vertex_source, const char* fragment_source,
+                         GlObjects* gl, const char* feedback = nullptr) {
+  std::string error = CompileShader(GL_VERTEX_SHADER, vertex_source.c_str(), &gl->vertex_shader);
+  if (error.empty() && fragment_source != nullptr) {
+    error = CompileShader(GL_FRAGMENT_SHADER, fragment_source, &gl->fragment_shader);
+  }
+  if (!error.empty()) return error;
+  gl->program = glCreateProgram();
+  glAttachShader(gl->program, gl->vertex_shader);
+  if (fragment_source != nullptr) glAttachShader(gl->program, gl->fragment_shader);
+  if (feedback != nullptr) {
+    glTransformFeedbackVaryings(gl->program, 1, &feedback, GL_INTERLEAVED_ATTRIBS);
+  }
+  return LinkProgram(gl->program);
+}
+
+// Input textures of a pass, deleted with it.
+struct GlTextures {
+  std::vector<GLuint> ids;
+  GlTextures() = default;
+  GlTextures(const GlTextures&) = delete;
+  GlTextures& operator=(const GlTextures&) = delete;
+  ~GlTextures() {
+    if (!ids.empty()) glDeleteTextures(static_cast<GLsizei>(ids.size()), ids.data());
+  }
+  // An RGBA32F texture of `rgba` (row 0 = the bottom row, as GL stores textures), filtered
+  // bilinearly (GL_LINEAR, no mipmaps) and clamped to its edge.
+  GLuint Upload(int width, int height, const std::vector<float>& rgba) {
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    ids.push_back(id);
+    glBindTexture(GL_TEXTURE_2D, id);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, rgba.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return id;
+  }
+};
+
+// Rows of an image stored top row first (image files, StMap) in GL's order, bottom row first.
+std::vector<float> BottomRowFirst(int width, int height, const std::vector<float>& rgba) {
+  std::vector<float> flipped(rgba.size());
+  const size_t row = static_cast<size_t>(width) * 4;
+  for (int y = 0; y < height; ++y) {
+    std::copy(rgba.begin() + y * row, rgba.begin() + (y + 1) * row,
+              flipped.begin() + (height - 1 - y) * row);
+  }
+  return flipped;
+}
+
+// A width x height framebuffer (RGBA32F colour cleared to 0, DEPTH32F depth) made current with
+// the full viewport and the depth state of `depth`.
+std::string BindFramebuffer(int width, int height, const GlDepth& depth, GlObjects* gl) {
+  glGenTextures(1, &gl->color_texture);
+  glBindTexture(GL_TEXTURE_2D, gl->color_texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  glGenTextures(1, &gl->depth_texture);
+  glBindTexture(GL_TEXTURE_2D, gl->depth_texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT,
+               GL_FLOAT, nullptr);
+  for (const GLuint texture : {gl->color_texture, gl->depth_texture}) {
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glGenFramebuffers(1, &gl->framebuffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl->framebuffer);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, gl->color_texture, 0);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, gl->depth_texture, 0);
+  const GLenum draw_buffer = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &draw_buffer);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "framebuffer incomplete: 0x%04X", status);
+    return buffer;
+  }
+  glViewport(0, 0, width, height);
+  glDepthRange(0.0, 1.0);
+  glClipControl(GL_LOWER_LEFT, depth.clip_depth == ClipDepth::kZeroToOne ? GL_ZERO_TO_ONE
+                                                                         : GL_NEGATIVE_ONE_TO_ONE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_CLAMP);
+  glDisable(GL_MULTISAMPLE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(depth.reversed_z ? GL_GREATER : GL_LESS);
+  const float clear_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float clear_depth = depth.reversed_z ? 0.0f : 1.0f;
+  glClearBufferfv(GL_COLOR, 0, clear_color);
+  glClearBufferfv(GL_DEPTH, 0, &clear_depth);
+  return GlErrorText("creating the framebuffer");
+}
+
+std::string ReadFramebuffer(int width, int height, Readback* readback) {
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  readback->rgba.assign(static_cast<size_t>(width) * height * 4, -1.0f);
+  readback->depth.assign(static_cast<size_t>(width) * height, -1.0f);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, readback->rgba.data());
+  glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, readback->depth.data());
+  std::string error = GlErrorText("glReadPixels");
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glUseProgram(0);
+  glBindVertexArray(0);
+  return error.empty() ? GlErrorText("reading back") : error;
+}
+
+// Uploads vec3 triangles as attribute 0 of a new vertex array.
+void UploadTriangles(const std::vector<float>& triangles, GlObjects* gl) {
+  glGenVertexArrays(1, &gl->vertex_array);
+  glBindVertexArray(gl->vertex_array);
+  glGenBuffers(1, &gl->vertex_buffer);
+  glBindBuffer(GL_ARRAY_BUFFER, gl->vertex_buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(triangles.size() * sizeof(float)),
+               triangles.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+}
+
+// Draws world-position triangles with `vertex_source` (which writes v_world_position) into a
+// width x height framebuffer; u_projection and u_view are set where the shader has them.
+std::string RenderWorldPositions(const std::string& vertex_source,
+                                 const std::vector<float>& triangles, int width, int height,
+                                 const Eigen::Matrix4d& clip_from_gl_eye,
+                                 const Eigen::Matrix4d& gl_eye_from_world, const GlDepth& depth,
+                                 Readback* readback) {
+  GlObjects gl;
+  std::string error = BuildProgram(vertex_source, kFragmentShader, &gl);
+  if (!error.empty()) return error;
+  UploadTriangles(triangles, &gl);
+  if (error = BindFramebuffer(width, height, depth, &gl); !error.empty()) return error;
+  glUseProgram(gl.program);
+  const std::array<float, 16> projection = ToFloat(clip_from_gl_eye);
+  const std::array<float, 16> view = ToFloat(gl_eye_from_world);
+  glUniformMatrix4fv(glGetUniformLocation(gl.program, "u_projection"), 1, GL_FALSE,
+                     projection.data());
+  glUniformMatrix4fv(glGetUniformLocation(gl.program, "u_view"), 1, GL_FALSE, view.data());
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(triangles.size() / 3));
+  if (error = GlErrorText("drawing"); !error.empty()) return error;
+  return ReadFramebuffer(width, height, readback);
+}
+
+// gl_Position of every vertex as the GL computes it (transform feedback, rasterizer off).
+std::string CaptureClipPositions(const std::string& vertex_source,
+                                 const std::vector<float>& triangles, std::vector<float>* clip) {
+  GlObjects gl;
+  std::string error = BuildProgram(vertex_source, nullptr, &gl, "gl_Position");
+  if (!error.empty()) return error;
+  UploadTriangles(triangles, &gl);
+  // Drawing needs a complete framebuffer even with the rasterizer off (the surfaceless context's
+  // default one is not).
+  if (error = BindFramebuffer(1, 1, GlDepth{}, &gl); !error.empty()) return error;
+  const size_t count = triangles.size() / 3;
+  GLuint feedback = 0;
+  glGenBuffers(1, &feedback);
+  glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, feedback);
+  glBufferData(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLsizeiptr>(count * 4 * sizeof(float)),
+               nullptr, GL_STATIC_READ);
+  glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedback);
+  glUseProgram(gl.program);
+  glEnable(GL_RASTERIZER_DISCARD);
+  glBeginTransformFeedback(GL_POINTS);
+  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count));
+  glEndTransformFeedback();
+  glDisable(GL_RASTERIZER_DISCARD);
+  clip->assign(count * 4, 0.0f);
+  glGetBufferSubData(GL_TRANSFORM_FEEDBACK_BUFFER, 0,
+                     static_cast<GLsizeiptr>(count * 4 * sizeof(float)), clip->data());
+  error = GlErrorText("transform feedback");
+  glDeleteBuffers(1, &feedback);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glUseProgram(0);
+  glBindVertexArray(0);
+  return error;
+}
+
+// Over the covered pixels of a camera-image readback: the largest distance between the pixel's
+// centre and the lens's pixel (PixelFromWorld) of the world point read there.
+struct WarpErrors {
+  int covered = 0;
+  int not_in_scene = 0;
+  double max_pixel_error = 0.0;
+  double max_depth_error = 0.0;
+  Eigen::Vector2d worst_pixel = Eigen::Vector2d::Constant(-1.0);
+};
+
+// `depth`: also compare the depth buffer with the pinhole window depth of the point (renders).
+WarpErrors MeasureAgainstLens(const Camera& camera, const Readback& readback,
+                              const GlDepth* depth) {
+  const int width = camera.image_size.width;
+  const int height = camera.image_size.height;
+  const BackgroundFrame frame;
+  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
+  WarpErrors errors;
+  for (int j = 0; j < height; ++j) {
+    for (int i = 0; i < width; ++i) {
+      const size_t index = static_cast<size_t>(j) * width + i;
+      const float* rgba = &readback.rgba[4 * index];
+      if (rgba[3] != 1.0f) continue;  // uncovered, or a bilinear tap off the scene
+      ++errors.covered;
+      const Eigen::Vector3d point_in_world(rgba[0], rgba[1], rgba[2]);
+      int face_index = -1;
+      if (Classify(point_in_world, eye, frame, &face_index) == kNoSurface) ++errors.not_in_scene;
+      const Eigen::Vector2d pixel(i, height - 1 - j);
+      const std::optional<Eigen::Vector2d> projection = PixelFromWorld(camera, point_in_world);
+      const double error = projection ? (*projection - pixel).norm() : kInfinity;
+      if (!(error <= errors.max_pixel_error)) {
+        errors.max_pixel_error = error;
+        errors.worst_pixel = pixel;
+      }
+      if (depth != nullptr) {
+        const double z = (camera.cam_from_world * point_in_world).z();
+        errors.max_depth_error =
+            std::max(errors.max_depth_error,
+                     std::abs(readback.depth[index] -
+                              ExpectedWindowDepth(z, depth->reversed_z, Projection::kPerspective)));
+      }
+    }
+  }
+  return errors;
+}
+
+using LensShaderParam = std::tuple<LensCase, DepthCase>;
+
+class LensShaderRenderTest : public GlTest, public testing::WithParamInterface<LensShaderParam> {};
+
+// The per-vertex lens, as exported (--to glsl, the text verbatim): at every vertex the GL puts
+// world points within kMaxPixelError (1e-3 px) of the lens's pixel, with the pinhole's depth;
+// between vertices within the tessellation target the docs' rule promises.
+TEST_P(LensShaderRenderTest,
+       VerticesWithin1em3PxMeasured3em5_PixelsWithinTarget1em2PxMeasured6em3) {
+  const auto& [lens, depth_case] = GetParam();
+  const Camera camera = LensCamera(lens);
+  const std::string vertex_shader = "#version 330 core\n" + LensGlslText(camera, depth_case.depth) +
+                                    R"(layout(location = 0) in vec3 world_position;
+out vec3 v_world_position;
+void main() {
+  v_world_position = world_position;
+  gl_Position = camproj_projection * camproj_lens(camproj_view * vec4(world_position, 1.0));
+}
+)";
+  // Tessellate as docs/exports.md says: every visible edge <= LensMaxEdgePx(target).
+  const double max_edge_px = LensMaxEdgePx(camera, kTessellationTargetPx);
+  const int box_cells =
+      CellsForEdge(2, max_edge_px, camera, [](int cells) { return TessellatedScene(cells, 0); });
+  const int background_cells = CellsForEdge(kBackgroundGrid, max_edge_px, camera,
+                                            [](int cells) { return TessellatedScene(0, cells); });
+  const std::vector<float> triangles = TessellatedScene(box_cells, background_cells);
+
+  // 1. Vertices: gl_Position from the GL itself, against PixelFromWorld in double, for every
+  // vertex in front of the near plane whose pixel is in the image.
+  std::vector<float> clip;
+  std::string error = CaptureClipPositions(vertex_shader, triangles, &clip);
+  ASSERT_TRUE(error.empty()) << error;
+  const int width = kImageSize.width;
+  const int height = kImageSize.height;
+  // Beyond LensRadiusLimit (the fold, or twice the image's radius) the model is not a lens any
+  // more (past the fold it maps points back into the image); there the function must put every
+  // vertex outside the image instead.
+  const double r_limit = LensRadiusLimit(camera);
+  const auto in_image = [&](const Eigen::Vector2d& pixel) {
+    return pixel.x() >= -0.5 && pixel.x() <= width - 0.5 && pixel.y() >= -0.5 &&
+           pixel.y() <= height - 0.5;
+  };
+  int vertices_in_image = 0;
+  int beyond_limit = 0;
+  int beyond_limit_in_image = 0;
+  double max_vertex_error = 0.0;
+  double max_vertex_depth_error = 0.0;
+  for (size_t v = 0; v < triangles.size() / 3; ++v) {
+    const Eigen::Vector3d point_in_world(triangles[3 * v], triangles[3 * v + 1],
+                                         triangles[3 * v + 2]);
+    const Eigen::Vector3d point_in_cam = camera.cam_from_world * point_in_world;
+    if (point_in_cam.z() <= kZNear) continue;
+    const Eigen::Vector4d c(clip[4 * v], clip[4 * v + 1], clip[4 * v + 2], clip[4 * v + 3]);
+    const Eigen::Vector2d window((c.x() / c.w() + 1.0) * width / 2.0,
+                                 (c.y() / c.w() + 1.0) * height / 2.0);
+    const Eigen::Vector2d pixel(window.x() - 0.5, height - window.y() - 0.5);
+    if (point_in_cam.head<2>().norm() / point_in_cam.z() >= r_limit) {
+      ++beyond_limit;
+      beyond_limit_in_image += in_image(pixel);
+      continue;
+    }
+    const std::optional<Eigen::Vector2d> expected = PixelFromWorld(camera, point_in_world);
+    if (!expected || !in_image(*expected)) continue;
+    ++vertices_in_image;
+    max_vertex_error = std::max(max_vertex_error, (pixel - *expected).norm());
+    const double z_ndc = c.z() / c.w();
+    const double window_depth =
+        depth_case.depth.clip_depth == ClipDepth::kZeroToOne ? z_ndc : (z_ndc + 1.0) / 2.0;
+    max_vertex_depth_error = std::max(
+        max_vertex_depth_error,
+        std::abs(window_depth - ExpectedWindowDepth(point_in_cam.z(), depth_case.depth.reversed_z,
+                                                    Projection::kPerspective)));
+  }
+
+  // 2. Pixels: the rendered world point at every covered pixel.
+  Readback readback;
+  error = RenderWorldPositions(vertex_shader, triangles, width, height, Eigen::Matrix4d::Identity(),
+                               Eigen::Matrix4d::Identity(), depth_case.depth, &readback);
+  ASSERT_TRUE(error.empty()) << error;
+  const WarpErrors pixels = MeasureAgainstLens(camera, readback, &depth_case.depth);
+  const double covered_fraction = static_cast<double>(pixels.covered) / (width * height);
+
+  std::printf(
+      "[ lens     ] glsl %s/%s: %zu triangles (box %d, background %d cells a side, edges "
+      "<= %.3g px); %d vertices in the image, max vertex error %.3g px, depth %.3g; %d "
+      "beyond r_limit, %d of them drawn in the image; "
+      "pixels: covered %.4f, max error %.3g px (target %.3g), depth %.3g\n",
+      lens.name, depth_case.name, triangles.size() / 9, box_cells, background_cells, max_edge_px,
+      vertices_in_image, max_vertex_error, max_vertex_depth_error, beyond_limit,
+      beyond_limit_in_image, covered_fraction, pixels.max_pixel_error, kTessellationTargetPx,
+      pixels.max_depth_error);
+  RecordProperty("max_vertex_error_px", std::to_string(max_vertex_error));
+  RecordProperty("max_pixel_error_px", std::to_string(pixels.max_pixel_error));
+
+  EXPECT_GE(vertices_in_image, 1000);
+  EXPECT_LE(max_vertex_error, kMaxPixelError);
+  EXPECT_LE(max_vertex_depth_error, kMaxDepthError);
+  EXPECT_EQ(beyond_limit_in_image, 0) << "vertices beyond r_limit folded back into the image";
+  EXPECT_GE(covered_fraction, kMinCoveredFraction);
+  EXPECT_EQ(pixels.not_in_scene, 0);
+  EXPECT_LE(pixels.max_pixel_error, kTessellationTargetPx + kMaxPixelError)
+      << "at image pixel " << pixels.worst_pixel.transpose();
+  EXPECT_LE(pixels.max_depth_error, kMaxDepthError);
+}
+
+std::string LensShaderParamName(const testing::TestParamInfo<LensShaderParam>& info) {
+  return std::string(std::get<0>(info.param).name) + "_" + std::get<1>(info.param).name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    LensesAndDepths, LensShaderRenderTest,
+    testing::Combine(
+        testing::ValuesIn(kLensCases),
+        testing::Values(DepthCase{"NegativeOneToOne", {ClipDepth::kNegativeOneToOne, false}},
+                        DepthCase{"ZeroToOneReversed", {ClipDepth::kZeroToOne, true}})),
+    LensShaderParamName);
+
+constexpr char kFullScreenVertexShader[] = R"(#version 330 core
+void main() {  // one triangle covering the viewport
+  vec2 corner = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  gl_Position = vec4(corner, 0.0, 1.0);
+}
+)";
+
+// The STMap pass: the map is read at the output pixel, the source bilinearly where it says.
+// u_source_valid_alpha: with the undistortion map, alpha < 1 marks no source.
+constexpr char kStMapFragmentShader[] = R"(#version 330 core
+uniform sampler2D u_map;
+uniform sampler2D u_source;
+layout(location = 0) out vec4 color;
+void main() {
+  vec4 st = texelFetch(u_map, ivec2(gl_FragCoord.xy), 0);
+  color = st.a < 1.0 ? vec4(0.0) : texture(u_source, st.rg);
+}
+)";
+
+constexpr char kMeshVertexShader[] = R"(#version 330 core
+layout(location = 0) in vec2 distorted_uv;
+layout(location = 1) in vec2 undistorted_uv;
+noperspective out vec2 v_uv;
+void main() {
+  v_uv = undistorted_uv;
+  gl_Position = vec4(distorted_uv * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+constexpr char kMeshFragmentShader[] = R"(#version 330 core
+uniform sampler2D u_source;
+noperspective in vec2 v_uv;
+layout(location = 0) out vec4 color;
+void main() { color = texture(u_source, v_uv); }
+)";
+
+// A post-process pass into a width x height framebuffer: the full-screen STMap pass when `mesh`
+// is null, else the mesh's triangles. Textures unit 0 = source, unit 1 = map.
+std::string WarpPass(int width, int height, GLuint source, GLuint map, const nlohmann::json* mesh,
+                     Readback* readback) {
+  GlObjects gl;
+  std::string error = mesh ? BuildProgram(kMeshVertexShader, kMeshFragmentShader, &gl)
+                           : BuildProgram(kFullScreenVertexShader, kStMapFragmentShader, &gl);
+  if (!error.empty()) return error;
+  glGenVertexArrays(1, &gl.vertex_array);
+  glBindVertexArray(gl.vertex_array);
+  GLuint buffers[2] = {0, 0};
+  std::vector<unsigned> indices;
+  if (mesh != nullptr) {
+    glGenBuffers(2, buffers);
+    const std::vector<float> distorted = (*mesh)["distorted_uv"].get<std::vector<float>>();
+    const std::vector<float> undistorted = (*mesh)["undistorted_uv"].get<std::vector<float>>();
+    indices = (*mesh)["triangles"].get<std::vector<unsigned>>();
+    glGenBuffers(1, &gl.vertex_buffer);
+    std::vector<float> interleaved;
+    for (size_t i = 0; i < distorted.size() / 2; ++i) {
+      interleaved.insert(interleaved.end(), {distorted[2 * i], distorted[2 * i + 1],
+                                             undistorted[2 * i], undistorted[2 * i + 1]});
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, gl.vertex_buffer);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(interleaved.size() * sizeof(float)),
+                 interleaved.data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float),
+                          reinterpret_cast<const void*>(2 * sizeof(float)));
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[0]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(indices.size() * sizeof(unsigned)), indices.data(),
+                 GL_STATIC_DRAW);
+  }
+  error = BindFramebuffer(width, height, GlDepth{}, &gl);
+  if (!error.empty()) {
+    glDeleteBuffers(2, buffers);
+    return error;
+  }
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(gl.program);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, source);
+  glUniform1i(glGetUniformLocation(gl.program, "u_source"), 0);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, map);
+  glUniform1i(glGetUniformLocation(gl.program, "u_map"), 1);
+  glActiveTexture(GL_TEXTURE0);
+  if (mesh != nullptr) {
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, nullptr);
+  } else {
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  error = GlErrorText("warping");
+  glDeleteBuffers(2, buffers);
+  if (!error.empty()) return error;
+  return ReadFramebuffer(width, height, readback);
+}
+
+class LensWarpRenderTest : public GlTest, public testing::WithParamInterface<LensCase> {};
+
+// The post-process lens: the pinhole camera rendered (by GL) into LensRenderTargetOf's buffer
+// with its projection, then warped onto the image by the STMap (--to stmap) and by the
+// distortion mesh (--to distortion-mesh, its default step). The smooth scene: the background
+// plane alone (bilinear sampling across the box's silhouettes would mix surfaces).
+TEST_P(LensWarpRenderTest, StMapWithin0p05PxMeasured3em4_MeshWithin0p05PxMeasured1em2) {
+  const LensCase& lens = GetParam();
+  const Camera camera = LensCamera(lens);
+  const LensRenderTarget target = LensRenderTargetOf(camera);
+  Readback pinhole;
+  std::string error =
+      RenderWorldPositions(kVertexShader, TessellatedScene(0, kBackgroundGrid), target.size.width,
+                           target.size.height, LensRenderTargetClipFromGlEye(camera),
+                           GlEyeFromWorld(camera.cam_from_world), GlDepth{}, &pinhole);
+  ASSERT_TRUE(error.empty()) << error;
+  int target_covered = 0;
+  for (size_t i = 3; i < pinhole.rgba.size(); i += 4) target_covered += pinhole.rgba[i] == 1.0f;
+
+  GlTextures textures;
+  const GLuint source = textures.Upload(target.size.width, target.size.height, pinhole.rgba);
+  const StMap map = LensStMap(camera, LensMapDirection::kDistort);
+  ASSERT_EQ(map.width, kImageSize.width);
+  ASSERT_EQ(map.height, kImageSize.height);
+  const GLuint map_texture =
+      textures.Upload(map.width, map.height, BottomRowFirst(map.width, map.height, map.rgba));
+
+  Readback warped;
+  error = WarpPass(map.width, map.height, source, map_texture, nullptr, &warped);
+  ASSERT_TRUE(error.empty()) << error;
+  const WarpErrors stmap = MeasureAgainstLens(camera, warped, nullptr);
+
+  const nlohmann::json mesh = nlohmann::json::parse(LensDistortionMeshJson(camera, 0));
+  error = WarpPass(map.width, map.height, source, map_texture, &mesh, &warped);
+  ASSERT_TRUE(error.empty()) << error;
+  const WarpErrors meshed = MeasureAgainstLens(camera, warped, nullptr);
+
+  const double pixels = kImageSize.width * kImageSize.height;
+  std::printf(
+      "[ lens     ] warp %s: render target %d x %d (offset %d, %d), covered %.4f; stmap: "
+      "covered %.4f, max error %.3g px; mesh (step %d px, its interpolation error %.3g "
+      "px): covered %.4f, max error %.3g px\n",
+      lens.name, target.size.width, target.size.height, target.offset_x, target.offset_y,
+      target_covered / (1.0 * target.size.width * target.size.height), stmap.covered / pixels,
+      stmap.max_pixel_error, mesh["step_px"].get<int>(),
+      mesh["max_interpolation_error_px"].get<double>(), meshed.covered / pixels,
+      meshed.max_pixel_error);
+  RecordProperty("stmap_max_error_px", std::to_string(stmap.max_pixel_error));
+  RecordProperty("mesh_max_error_px", std::to_string(meshed.max_pixel_error));
+  EXPECT_EQ(target_covered, target.size.width * target.size.height)
+      << "the background must fill the render target";
+  for (const WarpErrors* errors : {&stmap, &meshed}) {
+    EXPECT_EQ(errors->covered, kImageSize.width * kImageSize.height)
+        << "every image pixel's bilinear taps lie in the render target";
+    EXPECT_EQ(errors->not_in_scene, 0);
+    EXPECT_LE(errors->max_pixel_error, kMaxWarpErrorPx)
+        << "at image pixel " << errors->worst_pixel.transpose();
+  }
+  EXPECT_LE(mesh["max_interpolation_error_px"].get<double>(), kLensMeshErrorPx);
+}
+
+// The inverse: a plate (what the real camera shot; here the background plane ray-cast in double
+// through CamRayFromPixel at every plate pixel) warped by the undistortion STMap
+// (--to undistort-stmap) onto the render target's pinhole image, where CG rendered with the
+// render target's projection overlays it: every pixel whose source lies inside the plate's
+// pixel centres must hold the world point that pinhole projects onto that pixel.
+TEST_P(LensWarpRenderTest, UndistortStMapWithin0p05PxMeasured0p033) {
+  const LensCase& lens = GetParam();
+  const Camera camera = LensCamera(lens);
+  const LensRenderTarget target = LensRenderTargetOf(camera);
+  const int width = kImageSize.width;
+  const int height = kImageSize.height;
+  const BackgroundFrame frame;
+  const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
+  const Eigen::Matrix3d world_from_cam = camera.cam_from_world.rotation.transpose();
+  std::vector<float> plate(static_cast<size_t>(width) * height * 4, 0.0f);  // row 0 = bottom
+  for (int j = 0; j < height; ++j) {
+    for (int i = 0; i < width; ++i) {
+      const Eigen::Vector3d ray =
+          world_from_cam * CamRayFromPixel(camera.intrinsics, {i, height - 1 - j});
+      const double t = (kBackgroundOffset - frame.normal.dot(eye)) / frame.normal.dot(ray);
+      ASSERT_GT(t, 0.0);
+      const Eigen::Vector3d point = eye + t * ray;
+      float* texel = &plate[(static_cast<size_t>(j) * width + i) * 4];
+      texel[0] = static_cast<float>(point.x());
+      texel[1] = static_cast<float>(point.y());
+      texel[2] = static_cast<float>(point.z());
+      texel[3] = 1.0f;
+    }
+  }
+  GlTextures textures;
+  const GLuint source = textures.Upload(width, height, plate);
+  const StMap map = LensStMap(camera, LensMapDirection::kUndistort);
+  ASSERT_EQ(map.width, target.size.width);
+  ASSERT_EQ(map.height, target.size.height);
+  const GLuint map_texture =
+      textures.Upload(map.width, map.height, BottomRowFirst(map.width, map.height, map.rgba));
+  Readback warped;
+  const std::string error = WarpPass(map.width, map.height, source, map_texture, nullptr, &warped);
+  ASSERT_TRUE(error.empty()) << error;
+
+  int inside = 0;
+  int off_plate = 0;
+  double max_error = 0.0;
+  Eigen::Vector2d worst(-1.0, -1.0);
+  for (int y = 0; y < map.height; ++y) {  // map row y = target pixel row v = y
+    for (int x = 0; x < map.width; ++x) {
+      const float* st = &map.rgba[(static_cast<size_t>(y) * map.width + x) * 4];
+      // The source in plate pixels (kCenter): window = st * size, pixel = window - 0.5 (y down).
+      const double u = st[0] * width - 0.5;
+      const double v = (1.0 - st[1]) * height - 0.5;
+      const bool taps_inside =
+          st[3] == 1.0f && u >= 0.0 && u <= width - 1.0 && v >= 0.0 && v <= height - 1.0;
+      const size_t index = static_cast<size_t>(map.height - 1 - y) * map.width + x;
+      const float* rgba = &warped.rgba[4 * index];
+      if (!taps_inside) {
+        off_plate += st[3] != 1.0f && rgba[3] != 0.0f;  // no source: the pass writes nothing
+        continue;
+      }
+      ++inside;
+      const Eigen::Vector3d point_in_cam =
+          camera.cam_from_world * Eigen::Vector3d(rgba[0], rgba[1], rgba[2]);
+      const double error =
+          (PixelFromCam(target.intrinsics, point_in_cam) - Eigen::Vector2d(x, y)).norm();
+      if (!(error <= max_error)) {
+        max_error = error;
+        worst = Eigen::Vector2d(x, y);
+      }
+    }
+  }
+  std::printf(
+      "[ lens     ] undistort %s: render target %d x %d, %d pixels from inside the plate, "
+      "max error %.3g px\n",
+      lens.name, map.width, map.height, inside, max_error);
+  RecordProperty("undistort_max_error_px", std::to_string(max_error));
+  // The plate's footprint on the render target is about the plate's area (the lens scales area
+  // by ~0.6 to ~1.6 over these images).
+  EXPECT_GE(inside, width * height / 2);
+  EXPECT_EQ(off_plate, 0) << "pixels without a source must stay empty (alpha 0)";
+  EXPECT_LE(max_error, kMaxWarpErrorPx) << "at render target pixel " << worst.transpose();
+}
+
+std::string LensParamName(const testing::TestParamInfo<LensCase>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(Lenses, LensWarpRenderTest, testing::ValuesIn(kLensCases), LensParamName);
 
 }  // namespace
 }  // namespace camproj

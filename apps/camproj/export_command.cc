@@ -1,4 +1,5 @@
 // camproj export: a camera file in another tool's terms.
+#include <cctype>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -9,6 +10,8 @@
 #include "camproj/depth_precision.h"
 #include "camproj/errors.h"
 #include "camproj/export.h"
+#include "camproj/file_io.h"
+#include "camproj/lens_gl.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -26,7 +29,19 @@ struct ExportArgs {
   bool row_major = false;
   std::string pixel_origin = "center";
   bool quiet = false;
+  std::string output_path;
+  int mesh_step_px = 0;
 };
+
+// The lower-case extension of `path` (".tif"), or "" without one.
+std::string ExtensionOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string extension = path.substr(dot);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
+}
 
 }  // namespace
 
@@ -40,13 +55,21 @@ Command AddExportCommand(CLI::App& root) {
       "  opencv-yaml  cv::FileStorage YAML: camera_matrix, distortion_coefficients, rvec, tvec\n"
       "  colmap       cameras.txt and images.txt lines (COLMAP's corner pixel convention)\n"
       "  three        JSON for a three.js PerspectiveCamera (projectionMatrix, matrixWorld)\n"
-      "  json         the camera file itself\n\n"
+      "  json         the camera file itself\n"
+      "  glsl         GLSL rendering the lens (k1, k2) per vertex: camproj_lens(), matrices\n"
+      "  distortion-mesh  JSON (or -o MESH.obj: OBJ) mesh warping a pinhole render target onto\n"
+      "               the image (--mesh-step)\n"
+      "  stmap        -o MAP.tif|.exr: Nuke STMap (32-bit float) warping the pinhole render\n"
+      "               target onto the image; stdout: the render target's size and matrices\n"
+      "  undistort-stmap  -o MAP.tif|.exr: STMap warping the plate onto the render target\n\n"
       "Examples:\n"
       "  camproj export camera.json --to gl --depth zo --reversed-z\n"
+      "  camproj export camera.json --to stmap -o lens.tif > render_target.txt\n"
       "  camproj export camera.json --to opencv-yaml > camera.yaml");
   app->add_option("CAMERA", args->camera_path, "camera file (docs/camera-file.md)")->required();
   app->add_option("--to", args->to, "format")
-      ->check(CLI::IsMember({"gl", "glm", "opencv-yaml", "colmap", "three", "json"}));
+      ->check(CLI::IsMember({"gl", "glm", "opencv-yaml", "colmap", "three", "json", "glsl",
+                             "distortion-mesh", "stmap", "undistort-stmap"}));
   app->add_option("--depth", args->depth, "clip depth: no = [-1,1] (GL default), zo = [0,1]")
       ->check(CLI::IsMember({"no", "zo"}));
   app->add_flag("--reversed-z", args->reversed_z, "near maps to 1, far to 0 (zo) or -1 (no)");
@@ -56,8 +79,16 @@ Command AddExportCommand(CLI::App& root) {
   app->add_flag("--row-major", args->row_major, "gl: print rows instead of column-major order");
   app->add_option("--pixel-origin", args->pixel_origin, "json: convention of cx, cy written")
       ->check(CLI::IsMember({"center", "corner"}));
+  app->add_option("-o,--output", args->output_path,
+                  "write the export here (atomically); required for stmap and undistort-stmap, "
+                  "whose extension (.tif, .tiff, .exr) picks the file type");
+  app->add_option("--mesh-step", args->mesh_step_px,
+                  "distortion-mesh: grid step in image px (default: the largest power of 2 up "
+                  "to 64 whose interpolation error is <= 0.01 px)")
+      ->check(CLI::Range(1, 1 << 20));
   app->add_flag("--quiet", args->quiet,
-                "gl, glm, three: no depth-precision notes on stderr (warnings still printed)");
+                "gl, glm, glsl, three: no depth-precision notes on stderr (warnings still "
+                "printed)");
   return {app, [args]() {
             Camera camera = ReadCameraFile(args->camera_path);
             if (args->z_near > 0.0) camera.z_near = args->z_near;
@@ -69,15 +100,52 @@ Command AddExportCommand(CLI::App& root) {
             if (!(camera.z_far > camera.z_near)) {
               throw UsageError("far must be greater than near");
             }
+            const bool stmap = args->to == "stmap" || args->to == "undistort-stmap";
+            if (stmap) {
+              if (args->output_path.empty()) {
+                throw UsageError("--to " + args->to + " writes an image file: give -o MAP.tif, "
+                                 "MAP.tiff or MAP.exr");
+              }
+              const std::string extension = ExtensionOf(args->output_path);
+              if (extension != ".tif" && extension != ".tiff" && extension != ".exr") {
+                throw UsageError("--to " + args->to + ": the output " + args->output_path +
+                                 " must end in .tif, .tiff or .exr (32-bit float RGBA)");
+              }
+            }
+            if (!args->output_path.empty()) {
+              RequireOutputIsNotAnInput(args->output_path, {args->camera_path});
+            }
             ExportOptions options;
+            options.mesh_step_px = args->mesh_step_px;
             options.depth.clip_depth = ClipDepthFromString(args->depth);
             options.depth.reversed_z = args->reversed_z;
             options.row_major = args->row_major;
             options.pixel_origin = PixelOriginFromString(args->pixel_origin);
+            if (stmap) {
+              const LensMapDirection direction = args->to == "stmap"
+                                                     ? LensMapDirection::kDistort
+                                                     : LensMapDirection::kUndistort;
+              std::string text;
+              std::string bytes;
+              try {
+                text = LensRenderTargetText(camera, direction, options.depth);
+                bytes = EncodeStMap(LensStMap(camera, direction), ExtensionOf(args->output_path));
+              } catch (const std::invalid_argument& e) {
+                throw InputError(args->camera_path + ": cannot export as " + args->to + ": " +
+                                 e.what());
+              }
+              WriteFileAtomically(args->output_path, bytes);
+              std::cout << text;
+              return kExitOk;
+            }
             const ExportFormat format = ExportFormatFromString(args->to);
             // Depth-precision advice (docs/exports.md) on stderr, so stdout stays the export.
             const bool gl_like = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
-                                 format == ExportFormat::kThree;
+                                 format == ExportFormat::kThree || format == ExportFormat::kGlsl;
+            // The exports whose projection matrix drops k1, k2 (glsl renders them).
+            const bool pinhole_only = format == ExportFormat::kGl ||
+                                      format == ExportFormat::kGlm ||
+                                      format == ExportFormat::kThree;
             if (gl_like && camera.projection == Projection::kOrthographic && !args->quiet) {
               // Orthographic depth is linear: the same step everywhere.
               std::cerr << "camproj: note: orthographic depth is linear in distance: the 24-bit "
@@ -98,25 +166,33 @@ Command AddExportCommand(CLI::App& root) {
                 }
               }
             }
-            if (gl_like && camera.intrinsics.HasDistortion()) {
+            if (pinhole_only && camera.intrinsics.HasDistortion()) {
               // Not only in the export's comment: the matrix is not this camera.
               char line[512];
               std::snprintf(line, sizeof line,
                             "camproj: warning: k1 = %.6g, k2 = %.6g: the %s export's projection "
                             "matrix is the pinhole part only and puts points up to %.3g px (worst "
-                            "image corner) from where the lens images them; opencv-yaml, colmap "
-                            "and json keep k1, k2 (docs/exports.md)\n",
+                            "image corner) from where the lens images them; to render the lens "
+                            "export glsl (per vertex), stmap or distortion-mesh (post-process "
+                            "warp); opencv-yaml, colmap and json keep k1, k2 (docs/exports.md)\n",
                             camera.intrinsics.k1, camera.intrinsics.k2, args->to.c_str(),
                             PinholeErrorAtWorstCornerPx(camera));
               std::cerr << line;
             }
+            const bool obj = format == ExportFormat::kDistortionMesh &&
+                             ExtensionOf(args->output_path) == ".obj";
             std::string text;
             try {
-              text = ExportCamera(camera, format, options);
+              text = obj ? LensDistortionMeshObj(camera, options.mesh_step_px, options.depth)
+                         : ExportCamera(camera, format, options);
             } catch (const std::invalid_argument& e) {
               throw InputError(args->camera_path + ": cannot export as " + args->to + ": " + e.what());
             }
-            std::cout << text;
+            if (args->output_path.empty()) {
+              std::cout << text;
+            } else {
+              WriteFileAtomically(args->output_path, text);
+            }
             return kExitOk;
           }};
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "camproj/camera_file.h"
+#include "camproj/lens_gl.h"
 #include "check.h"
 
 namespace camproj {
@@ -32,6 +33,8 @@ constexpr FormatName kFormatNames[] = {
     {ExportFormat::kColmap, "colmap"},
     {ExportFormat::kThree, "three"},
     {ExportFormat::kJson, "json"},
+    {ExportFormat::kGlsl, "glsl"},
+    {ExportFormat::kDistortionMesh, "distortion-mesh"},
 };
 
 // A stream that prints doubles so that they read back bit for bit.
@@ -67,7 +70,8 @@ std::string DistortionNote(const Camera& camera) {
   out << "k1 = " << camera.intrinsics.k1 << ", k2 = " << camera.intrinsics.k2
       << " are not in the projection matrix (GL projection is linear): it puts points up to "
       << std::setprecision(3) << PinholeErrorAtWorstCornerPx(camera)
-      << " px (worst image corner) from where the lens images them";
+      << " px (worst image corner) from where the lens images them; to render the lens: export "
+         "glsl (per vertex), distortion-mesh or stmap (post-process warp)";
   return out.str();
 }
 
@@ -425,6 +429,10 @@ std::string ExportCamera(const Camera& camera, ExportFormat format, const Export
       return ExportThreeText(camera, options);
     case ExportFormat::kJson:
       return CameraToJsonText(camera, CameraFileOptions{options.pixel_origin, 1.0, options.depth});
+    case ExportFormat::kGlsl:
+      return LensGlslText(camera, options.depth);
+    case ExportFormat::kDistortionMesh:
+      return LensDistortionMeshJson(camera, options.mesh_step_px, options.depth);
   }
   throw std::invalid_argument(internal::Concat("unknown export format ", static_cast<int>(format)));
 }

@@ -80,6 +80,25 @@ Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d
   return pixel;
 }
 
+double RadialFoldRadius(double k1, double k2) {
+  RequireFinite(k1, "k1");
+  RequireFinite(k2, "k2");
+  // Smallest positive root s = r^2 of 5 k2 s^2 + 3 k1 s + 1.
+  double s_fold = kInfinity;
+  if (k2 == 0.0) {
+    if (k1 < 0.0) s_fold = -1.0 / (3.0 * k1);
+  } else {
+    const double disc = 9.0 * k1 * k1 - 20.0 * k2;
+    if (disc >= 0.0) {
+      const double sq = std::sqrt(disc);
+      for (const double s : {(-3.0 * k1 - sq) / (10.0 * k2), (-3.0 * k1 + sq) / (10.0 * k2)}) {
+        if (s > 0.0) s_fold = std::min(s_fold, s);
+      }
+    }
+  }
+  return std::sqrt(s_fold);
+}
+
 Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vector2d& pixel) {
   intrinsics.Check();
   internal::RequireFiniteAll(pixel, "pixel");
@@ -94,23 +113,7 @@ Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vecto
   const double k1 = intrinsics.k1;
   const double k2 = intrinsics.k2;
   auto g = [&](double r) { return r * (1.0 + r * r * (k1 + r * r * k2)); };
-  double r_fold = kInfinity;
-  {
-    // Smallest positive root s = r^2 of 5 k2 s^2 + 3 k1 s + 1.
-    double s_fold = kInfinity;
-    if (k2 == 0.0) {
-      if (k1 < 0.0) s_fold = -1.0 / (3.0 * k1);
-    } else {
-      const double disc = 9.0 * k1 * k1 - 20.0 * k2;
-      if (disc >= 0.0) {
-        const double sq = std::sqrt(disc);
-        for (const double s : {(-3.0 * k1 - sq) / (10.0 * k2), (-3.0 * k1 + sq) / (10.0 * k2)}) {
-          if (s > 0.0) s_fold = std::min(s_fold, s);
-        }
-      }
-    }
-    r_fold = std::sqrt(s_fold);
-  }
+  const double r_fold = RadialFoldRadius(k1, k2);
   const double rd = std::hypot(xd, yd);
   if (rd == 0.0) return {0.0, 0.0, 1.0};
   if (std::isfinite(r_fold) && !(rd < g(r_fold))) {

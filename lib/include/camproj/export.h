@@ -23,8 +23,13 @@
 //                three's own updateProjectionMatrix() rebuild the same matrix; a `note` says when
 //                that is impossible (skew, infinite far, reversed-Z).
 //   json         the camera file (docs/camera-file.md), as CameraToJsonText writes it.
+//   glsl         GLSL rendering the lens per vertex (lens_gl.h LensGlslText): the pinhole
+//                projection and view as const mat4 and camproj_lens(), distorting gl_eye positions.
+//   distortion-mesh  JSON triangle mesh warping a pinhole render target onto the image
+//                (lens_gl.h LensDistortionMeshJson, ExportOptions::mesh_step_px).
 // gl, glm and three hold the pinhole part only: a comment or note says when k1, k2 are dropped
-// (a projection matrix is linear).
+// (a projection matrix is linear) and names the exports that render the lens (glsl,
+// distortion-mesh, and the STMap files of `camproj export --to stmap`, lens_gl.h).
 #ifndef CAMPROJ_EXPORT_H_
 #define CAMPROJ_EXPORT_H_
 
@@ -36,9 +41,9 @@
 
 namespace camproj {
 
-enum class ExportFormat { kGl, kGlm, kOpenCvYaml, kColmap, kThree, kJson };
+enum class ExportFormat { kGl, kGlm, kOpenCvYaml, kColmap, kThree, kJson, kGlsl, kDistortionMesh };
 
-// "gl" | "glm" | "opencv-yaml" | "colmap" | "three" | "json".
+// "gl" | "glm" | "opencv-yaml" | "colmap" | "three" | "json" | "glsl" | "distortion-mesh".
 const char* ToString(ExportFormat format);
 
 // The inverse of ToString; throws std::invalid_argument naming the text and listing the choices.
@@ -52,6 +57,9 @@ struct ExportOptions {
   bool row_major = false;
   // json: pixel origin of the cx, cy written (the other formats use their tool's own origin).
   PixelOrigin pixel_origin = PixelOrigin::kCenter;
+  // distortion-mesh: grid step in px of the camera's image (>= 1), or 0: the largest power of 2
+  // up to 64 keeping the mesh's interpolation error <= kLensMeshErrorPx (lens_gl.h).
+  int mesh_step_px = 0;
 };
 
 // How far (px) the pinhole projection matrix of the gl, glm and three exports puts a point from
@@ -66,7 +74,8 @@ double PinholeErrorAtWorstCornerPx(const Camera& camera);
 // Throws std::invalid_argument on an invalid camera, on one whose derived numbers overflow
 // (RequireFiniteViews: every format alike, nothing non-finite is ever written), or when the format
 // cannot represent it, saying why: opencv-yaml and colmap refuse skew != 0 (OpenCV's projectPoints ignores
-// camera_matrix(0,1), and no COLMAP camera model has skew).
+// camera_matrix(0,1), and no COLMAP camera model has skew); glsl and distortion-mesh refuse an
+// orthographic camera and a lens whose first fold lies inside the image (RequireLensCoversImage).
 std::string ExportCamera(const Camera& camera, ExportFormat format,
                          const ExportOptions& options = {});
 

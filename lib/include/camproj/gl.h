@@ -43,7 +43,8 @@ Eigen::Matrix4d ClipFromGlEye(const Perspective& perspective, const GlDepth& dep
 
 // The projection matrix of pinhole intrinsics for an image, skew included. `origin` is the
 // convention of cx, cy. Throws if the intrinsics have distortion (GL projection is linear: pass
-// intrinsics.Pinhole() to drop it knowingly), or on invalid arguments.
+// intrinsics.Pinhole() to drop it knowingly, and render it with lens_gl.h), or on invalid
+// arguments.
 Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& size, double z_near,
                               double z_far, const GlDepth& depth = {},
                               PixelOrigin origin = PixelOrigin::kCenter);

@@ -55,6 +55,13 @@ inline void PixelFromNormalized(const T* intrinsics, const T& x, const T& y, T* 
 // a non-finite point, or unless point_in_cam.z() > 0.
 Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d& point_in_cam);
 
+// The first fold of the radial map r -> g(r) = r (1 + k1 r^2 + k2 r^4) (r = normalized undistorted
+// radius): the smallest r > 0 where g'(r) = 1 + 3 k1 r^2 + 5 k2 r^4 = 0, i.e. the smallest positive
+// root s = r^2 of 5 k2 s^2 + 3 k1 s + 1; +infinity when there is none (g increases for ever, e.g.
+// k1, k2 >= 0). g is increasing on [0, r_fold): the model is a valid lens there only.
+// Example: k2 = 0, k1 < 0 gives r_fold = 1 / sqrt(-3 k1). Throws unless k1, k2 are finite.
+double RadialFoldRadius(double k1, double k2);
+
 // The ray through `pixel`, as (x, y, 1) in the cam frame: the inverse of PixelFromCam up to depth.
 // With distortion it inverts the radial map by safeguarded Newton to ~1e-15 in normalized units.
 // The map r -> r d(r) is invertible where it increases, up to its first fold r_fold (where
