@@ -35,7 +35,8 @@ trap cleanup EXIT
 
 if [[ -n "$baseline" ]]; then
   git -C "$root" worktree add --detach "$work/tree" "$baseline" >/dev/null
-  cp "$root/apps/bench/stage_cost.h" "$root/apps/bench/stage_cost.cc" "$work/tree/apps/bench/"
+  cp "$root/apps/bench/stage_cost.h" "$root/apps/bench/stage_cost.cc" \
+     "$root/apps/bench/point_counts.h" "$work/tree/apps/bench/"
   cat >>"$work/tree/apps/CMakeLists.txt" <<'CMAKE'
 add_executable(stage_cost_baseline bench/stage_cost.cc)
 target_compile_definitions(stage_cost_baseline PRIVATE CAMPROJ_STAGE_COST_MAIN)

@@ -17,6 +17,7 @@
 
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
+#include "point_counts.h"
 
 namespace camproj {
 namespace bench {
@@ -123,17 +124,7 @@ int StageCostMain(int argc, char** argv) {
       std::cout << kUsage;
       return 0;
     } else if (arg == "--n") {
-      counts.clear();
-      std::stringstream list(value());
-      std::string item;
-      while (std::getline(list, item, ',')) {
-        const int n = std::atoi(item.c_str());
-        if (n < 6) {
-          std::cerr << "bench: --n takes point counts >= 6, got \"" << item << "\"\n";
-          return 1;
-        }
-        counts.push_back(n);
-      }
+      if (!ParsePointCounts(value(), &counts)) return 1;
     } else if (arg == "--seeds") {
       seeds = std::atoi(value().c_str());
       if (seeds < 1) {
