@@ -9,6 +9,7 @@
 #include "camproj/depth_precision.h"
 #include "camproj/errors.h"
 #include "camproj/export.h"
+#include "camproj/world_origin.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -26,6 +27,7 @@ struct ExportArgs {
   bool row_major = false;
   std::string pixel_origin = "center";
   bool quiet = false;
+  std::string origin;  // auto | X,Y,Z | none; empty: the camera file's
 };
 
 }  // namespace
@@ -56,6 +58,11 @@ Command AddExportCommand(CLI::App& root) {
   app->add_flag("--row-major", args->row_major, "gl: print rows instead of column-major order");
   app->add_option("--pixel-origin", args->pixel_origin, "json: convention of cx, cy written")
       ->check(CLI::IsMember({"center", "corner"}));
+  app->add_option("--origin", args->origin,
+                  "gl, glm, three, json: the world origin vertices are given relative to (the "
+                  "view matrix becomes gl_eye_from_origin_world): X,Y,Z; auto = the camera centre "
+                  "rounded to a power of ten not above near; none = world coordinates as they "
+                  "are. Default: the camera file's world_origin");
   app->add_flag("--quiet", args->quiet,
                 "gl, glm, three: no depth-precision notes on stderr (warnings still printed)");
   return {app, [args]() {
@@ -68,6 +75,15 @@ Command AddExportCommand(CLI::App& root) {
             }
             if (!(camera.z_far > camera.z_near)) {
               throw UsageError("far must be greater than near");
+            }
+            if (args->origin == "none") {
+              camera.world_origin.reset();
+            } else if (args->origin == "auto") {
+              camera.world_origin = AutoOriginOfCamera(camera);
+            } else if (!args->origin.empty()) {
+              const std::vector<double> o =
+                  ParseNumbers(args->origin, 3, "--origin (auto, none or X,Y,Z)");
+              camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
             }
             ExportOptions options;
             options.depth.clip_depth = ClipDepthFromString(args->depth);
@@ -96,6 +112,32 @@ Command AddExportCommand(CLI::App& root) {
                 for (std::string line; std::getline(table, line);) {
                   std::cerr << "camproj: note: " << line << '\n';
                 }
+              }
+            }
+            if (gl_like) {
+              // Float32 precision of the vertices and the view matrix (world_origin.h): the
+              // error expected at the near plane, where it is largest, with and without the
+              // world origin; a warning when it is above kFloat32ErrorWarningPx without one.
+              const double without =
+                  Float32PixelError(camera, std::nullopt, camera.z_near);
+              const std::optional<Eigen::Vector3d> origin =
+                  camera.world_origin ? camera.world_origin : AutoOriginOfCamera(camera);
+              const double with = Float32PixelError(camera, origin, camera.z_near);
+              char line[512];
+              std::snprintf(line, sizeof line,
+                            "float32 vertices and view matrix: expected error at the near plane "
+                            "(depth %.6g) %.2g px without a world origin, %.2g px with %s "
+                            "%.17g,%.17g,%.17g",
+                            camera.z_near, without, with,
+                            camera.world_origin ? "the world origin" : "--origin auto =",
+                            origin->x(), origin->y(), origin->z());
+              if (!camera.world_origin && without > kFloat32ErrorWarningPx) {
+                std::cerr << "camproj: warning: " << line
+                          << ": the coordinates are too large for float32; export with --origin "
+                             "auto (or fit with --origin auto) and give vertices relative to it "
+                             "(docs/exports.md)\n";
+              } else if (!args->quiet) {
+                std::cerr << "camproj: note: " << line << '\n';
               }
             }
             if (gl_like && camera.intrinsics.HasDistortion()) {
