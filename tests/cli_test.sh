@@ -317,8 +317,11 @@ for row in rows[1:]:
     out.append("%.17g,%.17g,%.17g,%.17g,%.17g" % (412345.678 + 20 * X, 5612345.678 + 20 * Y, 123.456 + 20 * Z, u, v))
 open(sys.argv[2], "w").write("\n".join(out) + "\n")
 PY
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080
+    ! grep -q "float32" "$work/out" || fail "a unit-scale scene got the float32 note:\n$(cat "$work/out")"
     expect_exit 0 "$bin" fit "$work/utm.csv" --image-size 1920x1080 -o "$work/raw.json"
     ! grep -q world_origin "$work/raw.json" || fail "a fit without --origin wrote a world origin"
+    expect_in out "^note: the world coordinates are too large for float32: GL exports would draw points ~[0-9.e+]* px off at the near plane; fit with --origin auto"
     # Without an origin the export warns, with the expected float32 error at the near plane.
     expect_exit 0 "$bin" export "$work/raw.json" --to gl
     expect_in err "^camproj: warning: float32 vertices and view matrix: expected error at the near plane (depth [0-9.]*) [0-9.e+]* px without a world origin, [0-9.e-]* px with --origin auto = "

@@ -27,6 +27,7 @@
 #include "camproj/model_select.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
+#include "camproj/world_origin.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -426,6 +427,13 @@ Command AddFitCommand(CLI::App& root) {
                                                    : " (--origin)")
                      << ": GL exports' view matrix takes point_in_world minus it\n";
                 std::cout << line.str();
+              } else if (const double error = Float32PixelError(fit.camera, std::nullopt,
+                                                                fit.camera.z_near);
+                         error > kFloat32ErrorWarningPx) {
+                std::printf("note: the world coordinates are too large for float32: GL exports "
+                            "would draw points ~%.2g px off at the near plane; fit with --origin "
+                            "auto (docs/exports.md)\n",
+                            error);
               }
               if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
               // The summary's time is the fit's; reading and writing the files add to it.

@@ -35,7 +35,7 @@ struct Camera {
   // point_in_world - *world_origin (subtracted in double by the user), so that float32 vertices
   // and matrices hold small numbers. Absent: vertices in world coordinates as they are. Does not
   // change the camera: cam_from_world, PixelFromWorld and `camproj project` stay absolute.
-  std::optional<Eigen::Vector3d> world_origin;
+  std::optional<Eigen::Vector3d> world_origin = std::nullopt;
 
   // Throws std::invalid_argument naming the field on any invalid part.
   void Check() const;
