@@ -151,6 +151,13 @@ TEST(CameraFileTest, MalformedWorldOriginNamesTheKey) {
   EXPECT_NE(ExpectInputError(prefix + "\"auto\"}").find("world_origin: expected an array"),
             std::string::npos);
   EXPECT_NE(ExpectInputError(prefix + "[1, 2, 1e400]}").find("cam.json"), std::string::npos);
+  // Finite, but C - origin overflows a double: refused when read, naming the key (every number
+  // the file derives must be finite).
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "intrinsics": {"fx": 500, "fy": 500, "cx": 1, "cy": 2},
+      "cam_from_world": {"R": [[1,0,0],[0,1,0],[0,0,1]], "t": [-1e308, 0, 0]},
+      "frustum": {"near": 1, "far": 2}, "world_origin": [-1e308, 0, 0]})")
+                .find("cam.json: world_origin: the view matrix relative to it is not finite"),
+            std::string::npos);
 }
 
 TEST(CameraFileTest, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {

@@ -397,6 +397,9 @@ PY
     [[ ! -s "$work/out" ]] || fail "a refused export printed:\n$(cat "$work/out")"
     expect_exit 1 "$bin" export "$work/cam.json" --to gl --origin middle
     expect_in err '"middle" is not a finite number'
+    expect_exit 1 "$bin" export "$work/cam.json" --to gl --origin 1.7e308,-1.7e308,1.7e308
+    expect_in err "--origin: 1.7e308,-1.7e308,1.7e308 is too far from the camera"
+    [[ ! -s "$work/out" ]] || fail "a refused export printed:\n$(cat "$work/out")"
     expect_exit 1 "$bin" fit "$work/utm.csv" --image-size 1920x1080 --origin 1,2,nan -o "$work/bad.json"
     expect_in err "--origin (auto or X,Y,Z)"
     [[ ! -e "$work/bad.json" ]] || fail "a refused fit wrote a camera file"

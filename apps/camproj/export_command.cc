@@ -84,6 +84,16 @@ Command AddExportCommand(CLI::App& root) {
               const std::vector<double> o =
                   ParseNumbers(args->origin, 3, "--origin (auto, none or X,Y,Z)");
               camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
+              bool finite = false;
+              try {
+                finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
+              } catch (const std::invalid_argument&) {
+              }
+              if (!finite) {
+                throw UsageError("--origin: " + args->origin +
+                                 " is too far from the camera: the view matrix relative to it "
+                                 "overflows a double");
+              }
             }
             ExportOptions options;
             options.depth.clip_depth = ClipDepthFromString(args->depth);

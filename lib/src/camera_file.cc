@@ -6,6 +6,7 @@
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
+#include "camproj/world_origin.h"
 #include "check.h"
 
 namespace camproj {
@@ -233,6 +234,18 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
     camera.Check();
   } catch (const std::invalid_argument& e) {
     reader.Fail("frustum", e.what());
+  }
+  if (camera.world_origin) {
+    // C - origin can overflow (the view matrix's translation is built from it, then checked).
+    bool finite = false;
+    try {
+      finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
+    } catch (const std::invalid_argument&) {
+    }
+    if (!finite) {
+      reader.Fail("world_origin", "the view matrix relative to it is not finite: the values are "
+                                  "too large for a double");
+    }
   }
   try {
     RequireFiniteViews(camera);
