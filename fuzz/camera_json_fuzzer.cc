@@ -50,7 +50,9 @@ bool Same(const camproj::Camera& a, const camproj::Camera& b) {
          SameBits(ka.k2, kb.k2) &&
          SameBits(a.cam_from_world.rotation, b.cam_from_world.rotation) &&
          SameBits(a.cam_from_world.translation, b.cam_from_world.translation) &&
-         SameBits(a.z_near, b.z_near) && SameBits(a.z_far, b.z_far);
+         SameBits(a.z_near, b.z_near) && SameBits(a.z_far, b.z_far) &&
+         a.world_origin.has_value() == b.world_origin.has_value() &&
+         (!a.world_origin || SameBits(*a.world_origin, *b.world_origin));
 }
 
 }  // namespace

@@ -173,6 +173,10 @@ class Camera:
     def report(self) -> Optional[FitReport]:
         """The fit's report; None for a camera not made by fit()."""
     @property
+    def world_origin(self) -> Optional[Mat]:
+        """(3,): GL exports' view matrix takes point_in_world - world_origin; None: no origin
+        (fit(..., origin="auto" | [X, Y, Z]); docs/conventions.md, section 12)."""
+    @property
     def ids(self) -> list[str]: ...
     @property
     def outlier_ids(self) -> list[str]:
@@ -211,11 +215,12 @@ def fit(points_in_world: ArrayLike, pixels: ArrayLike, image_size: ImageSize, *,
         sigma: Optional[float] = None, max_uncertainty: Optional[float] = None,
         object_points_in_world: Optional[ArrayLike] = None, near: Optional[float] = None,
         far: Optional[float] = None, bounds: Optional[Sequence[float]] = None,
+        origin: Union[str, Sequence[float], None] = None,
         max_iterations: int = 100) -> Camera:
     """`camproj fit` on arrays: points_in_world (N, 3) seen at pixels (N, 2); every option is
     the command line's (`camproj fit --help`), with '-' as '_' (fovy -> fovy_deg, ransac ->
     ransac_px, intrinsics: a camera-file path or an Intrinsics in OpenCV's origin; bounds: the
-    6 numbers of --bounds). Same
+    6 numbers of --bounds; origin: "auto" or [X, Y, Z], as --origin). Same
     camera, same report, same refusals (SceneError subclasses) as the command line. Releases
     the GIL while fitting."""
 

@@ -135,6 +135,22 @@ FitArguments ArgumentsOf(const py::kwargs& kwargs) {
       }
       a.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
     }
+    else if (key == "origin") {
+      if (py::isinstance<py::str>(value)) {
+        if (value.cast<std::string>() != "auto") {
+          throw std::invalid_argument("origin: expected \"auto\" or 3 numbers X, Y, Z, got \"" +
+                                      value.cast<std::string>() + "\"");
+        }
+        a.auto_world_origin = true;
+      } else {
+        const auto o = value.cast<std::vector<double>>();
+        if (o.size() != 3) {
+          throw std::invalid_argument("origin: expected \"auto\" or 3 numbers X, Y, Z, got " +
+                                      std::to_string(o.size()) + " numbers");
+        }
+        a.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
+      }
+    }
     else if (key == "max_iterations") a.max_iterations = value.cast<int>();
     else throw std::invalid_argument("fit: unknown option \"" + key + "\" (see help(camproj.fit))");
   }
@@ -380,6 +396,9 @@ PYBIND11_MODULE(camproj, m) {
           py::return_value_policy::reference_internal, "cam_from_world translation (3,), world units, a read-only view")
       .def_property_readonly("near", [](const PyCamera& c) { return c.camera.z_near; })
       .def_property_readonly("far", [](const PyCamera& c) { return c.camera.z_far; })
+      .def_property_readonly("world_origin", [](const PyCamera& c) { return c.camera.world_origin; },
+                             "The world origin GL exports' view matrix is relative to (3,), or None "
+                             "(docs/conventions.md, section 11).")
       .def_property_readonly("projection", [](const PyCamera& c) {
         return c.camera.projection == Projection::kPerspective ? "perspective" : "orthographic";
       })

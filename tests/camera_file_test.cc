@@ -145,6 +145,48 @@ TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {
             "frustum": {"near": 1, "far": 2}})").find("left-handed"), std::string::npos);
 }
 
+// world_origin (docs/camera-file.md) is optional: absent stays absent, present round-trips bit
+// for bit (shortest round-trip printing), and gl.view_relative_to_origin is written with it.
+TEST(CameraFileTest, WorldOriginRoundTripsAndIsOptional) {
+  std::mt19937_64 rng(testing::Seed(10));
+  for (int i = 0; i < 50; ++i) {
+    Camera camera = RandomFileCamera(rng);
+    const std::string without = CameraToJsonText(camera);
+    EXPECT_EQ(without.find("world_origin"), std::string::npos);
+    EXPECT_EQ(without.find("view_relative_to_origin"), std::string::npos);
+    EXPECT_FALSE(CameraFromJsonText(without, "test").world_origin.has_value());
+    camera.world_origin = Eigen::Vector3d(testing::Uniform(rng, -1e7, 1e7),
+                                          testing::Uniform(rng, -1e7, 1e7), 412350.0);
+    const std::string with = CameraToJsonText(camera);
+    EXPECT_NE(with.find("\"view_relative_to_origin\""), std::string::npos);
+    const Camera back = CameraFromJsonText(with, "test");
+    ASSERT_TRUE(back.world_origin.has_value());
+    EXPECT_EQ(*back.world_origin, *camera.world_origin);
+    EXPECT_EQ(back.cam_from_world.translation, camera.cam_from_world.translation);
+  }
+}
+
+TEST(CameraFileTest, MalformedWorldOriginNamesTheKey) {
+  const std::string prefix =
+      R"({"image_size": [640, 480], "intrinsics": {"fx": 500, "fy": 500, "cx": 1, "cy": 2},
+          "look_at": {"eye": [0,0,1], "target": [0,0,0], "up": [0,1,0]},
+          "frustum": {"near": 1, "far": 2}, "world_origin": )";
+  EXPECT_NE(ExpectInputError(prefix + "[1, 2]}").find("world_origin: expected an array of 3 numbers"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(prefix + R"([1, "a", 3]})").find("world_origin[1]: expected a number"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(prefix + "\"auto\"}").find("world_origin: expected an array"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(prefix + "[1, 2, 1e400]}").find("cam.json"), std::string::npos);
+  // Finite, but C - origin overflows a double: refused when read, naming the key (every number
+  // the file derives must be finite).
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "intrinsics": {"fx": 500, "fy": 500, "cx": 1, "cy": 2},
+      "cam_from_world": {"R": [[1,0,0],[0,1,0],[0,0,1]], "t": [-1e308, 0, 0]},
+      "frustum": {"near": 1, "far": 2}, "world_origin": [-1e308, 0, 0]})")
+                .find("cam.json: world_origin: the view matrix relative to it is not finite"),
+            std::string::npos);
+}
+
 TEST(CameraFileTest, AtomicWriteReplacesWholeFilesAndLeavesNoTemporary) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
                                     ("camproj_atomic_" + std::to_string(getpid()));

@@ -305,6 +305,110 @@ PY
     expect_exit 0 "$bin" export "$work/lens.json" --to opencv-yaml
     ! grep -q "k1 = " "$work/err" || fail "opencv-yaml keeps k1 but warned:\n$(cat "$work/err")"
     ;;
+  world_origin)
+    # Survey-scale coordinates: the projector scene scaled to a 20 m building and moved to UTM-like
+    # E, N (float32 spacing 0.5 m at N = 5.6e6). The pixels are unchanged (a uniform scale and a
+    # shift of the world), so the fit is the same camera, 20x further away.
+    py - "$data/projector/points.csv" "$work/utm.csv" <<'PY'
+import sys
+rows = [l.strip() for l in open(sys.argv[1]) if l.strip() and not l.startswith("#")]
+out = [rows[0]]
+for row in rows[1:]:
+    X, Y, Z, u, v = map(float, row.split(","))
+    out.append("%.17g,%.17g,%.17g,%.17g,%.17g" % (412345.678 + 20 * X, 5612345.678 + 20 * Y, 123.456 + 20 * Z, u, v))
+open(sys.argv[2], "w").write("\n".join(out) + "\n")
+PY
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080
+    ! grep -q "float32" "$work/out" || fail "a unit-scale scene got the float32 note:\n$(cat "$work/out")"
+    expect_exit 0 "$bin" fit "$work/utm.csv" --image-size 1920x1080 -o "$work/raw.json"
+    ! grep -q world_origin "$work/raw.json" || fail "a fit without --origin wrote a world origin"
+    expect_in out "^note: the world coordinates are too large for float32: GL exports would draw points ~[0-9.e+]* px off at the near plane; fit with --origin auto"
+    # Without an origin the export warns, with the expected float32 error at the near plane.
+    expect_exit 0 "$bin" export "$work/raw.json" --to gl
+    expect_in err "^camproj: warning: float32 vertices and view matrix: expected error at the near plane (depth [0-9.]*) [0-9.e+]* px without a world origin, [0-9.e-]* px with --origin auto = "
+    expect_in out "^# world origin: none: the view matrix takes world coordinates as they are"
+    # --origin auto: the points' centroid rounded per axis to the largest power of ten not above
+    # the longest side of their bounding box (docs/conventions.md, section 11), computed here.
+    expect_exit 0 "$bin" fit "$work/utm.csv" --image-size 1920x1080 --origin auto -o "$work/cam.json"
+    py - "$work/utm.csv" "$work/cam.json" <<'PY' || fail "world_origin is not the rounded centroid"
+import json, math, sys
+rows = [list(map(float, l.split(",")[:3])) for l in open(sys.argv[1]).read().split("\n")[1:] if l]
+extent = max(max(r[a] for r in rows) - min(r[a] for r in rows) for a in range(3))
+step = 10 ** math.floor(math.log10(extent))
+want = [round(sum(r[a] for r in rows) / len(rows) / step) * step for a in range(3)]
+got = json.load(open(sys.argv[2]))["world_origin"]
+print(want, got)
+sys.exit(0 if got == want else 1)
+PY
+    origin=$(py -c 'import json,sys; print(",".join("%.17g" % x for x in json.load(open(sys.argv[1]))["world_origin"]))' "$work/cam.json")
+    expect_exit 0 "$bin" fit "$work/utm.csv" --image-size 1920x1080 --origin auto
+    expect_in out "^note: world origin $origin (--origin auto: the fitted points' centroid, rounded)"
+    # The camera is the same: camproj project works in absolute coordinates either way.
+    expect_exit 0 "$bin" project "$work/raw.json" "$work/utm.csv"; cp "$work/out" "$work/raw.csv"
+    expect_exit 0 "$bin" project "$work/cam.json" "$work/utm.csv"
+    cmp -s "$work/out" "$work/raw.csv" || fail "camproj project differs with a world origin"
+    # The gl export: header, no warning, and the matrices take point_in_world - origin: the
+    # projection * view of (X - origin), in double, lands on camproj project's pixels. Tolerance
+    # 1e-6 px: the pose's t (~5.6e6 m) holds the camera centre only to its double spacing
+    # (~1e-9 m), which C - origin keeps: ~f 1e-9 / depth ~ 1e-7 px (measured 7e-8 px).
+    expect_exit 0 "$bin" export "$work/cam.json" --to gl
+    ! grep -q "warning: float32" "$work/err" || fail "warned with a world origin:\n$(cat "$work/err")"
+    expect_in err "^camproj: note: float32 vertices and view matrix: expected error at the near plane .* px with the world origin $origin"
+    expect_in out "^# camproj GL export: projection = clip_from_gl_eye, view = gl_eye_from_origin_world"
+    expect_in out "^# world origin (${origin//,/, }): the view matrix is gl_eye_from_origin_world: give vertices as point_in_world - "
+    py - "$work/out" "$work/raw.csv" "$origin" <<'PY' || fail "the origin-relative GL matrices miss camproj project's pixels"
+import sys
+import numpy as np
+m = {l.split()[0]: np.array(list(map(float, l.split()[1:]))).reshape(4, 4).T
+     for l in open(sys.argv[1]) if l.split()[0] in ("projection", "view")}
+origin = np.array(list(map(float, sys.argv[3].split(","))))
+worst = 0
+for line in open(sys.argv[2]).read().split("\n")[1:]:
+    if not line: continue
+    _, X, Y, Z, u, v, _ = line.split(",")
+    p = np.append(np.array([float(X), float(Y), float(Z)]) - origin, 1.0)
+    clip = m["projection"] @ m["view"] @ p
+    ndc = clip[:3] / clip[3]
+    gu, gv = (ndc[0] + 1) / 2 * 1920 - 0.5, 1080 - (ndc[1] + 1) / 2 * 1080 - 0.5
+    worst = max(worst, np.hypot(gu - float(u), gv - float(v)))
+print("worst", worst)
+sys.exit(0 if worst < 1e-6 else 1)
+PY
+    # --origin none overrides the file's: world coordinates again, and the warning.
+    expect_exit 0 "$bin" export "$work/cam.json" --to gl --origin none
+    expect_in out "^# world origin: none"
+    expect_in err "^camproj: warning: float32 vertices"
+    # --origin auto at export: the camera centre rounded to a power of ten not above near.
+    expect_exit 0 "$bin" export "$work/raw.json" --to gl --origin auto
+    expect_in out "^# world origin ("
+    ! grep -q "warning: float32" "$work/err" || fail "warned with --origin auto:\n$(cat "$work/err")"
+    # glm, three and json carry it too.
+    expect_exit 0 "$bin" export "$work/cam.json" --to glm
+    expect_in out "^const glm::dvec3 world_origin("
+    expect_in out "^// world origin ("
+    expect_exit 0 "$bin" export "$work/cam.json" --to three
+    expect_in out '"world_origin": \['
+    expect_in out "give vertices as point_in_world - "
+    expect_exit 0 "$bin" export "$work/raw.json" --to json --origin 412000,5612000,100
+    py -c 'import json,sys; sys.exit(json.load(open(sys.argv[1]))["world_origin"] != [412000, 5612000, 100])' "$work/out" \
+      || fail "json export lacks the --origin"
+    # Bad values: exit 1 naming the option, nothing on stdout, no camera file.
+    expect_exit 1 "$bin" export "$work/cam.json" --to gl --origin 1,2
+    expect_in err "--origin (auto, none or X,Y,Z): expected 3 comma-separated numbers, got 2"
+    [[ ! -s "$work/out" ]] || fail "a refused export printed:\n$(cat "$work/out")"
+    expect_exit 1 "$bin" export "$work/cam.json" --to gl --origin middle
+    expect_in err '"middle" is not a finite number'
+    expect_exit 1 "$bin" export "$work/cam.json" --to gl --origin 1.7e308,-1.7e308,1.7e308
+    expect_in err "--origin: 1.7e308,-1.7e308,1.7e308 is too far from the camera"
+    [[ ! -s "$work/out" ]] || fail "a refused export printed:\n$(cat "$work/out")"
+    expect_exit 1 "$bin" fit "$work/utm.csv" --image-size 1920x1080 --origin 1,2,nan -o "$work/bad.json"
+    expect_in err "--origin (auto or X,Y,Z)"
+    [[ ! -e "$work/bad.json" ]] || fail "a refused fit wrote a camera file"
+    # A camera file's bad world_origin names the key.
+    py -c 'import json,sys; c = json.load(open(sys.argv[1])); c["world_origin"] = [1, 2]; json.dump(c, open(sys.argv[2], "w"))' "$work/cam.json" "$work/bad_origin.json"
+    expect_exit 2 "$bin" export "$work/bad_origin.json" --to gl
+    expect_in err "world_origin: expected an array of 3 numbers"
+    ;;
   project_points)
     expect_exit 0 "$bin" project "$data/projector/truth.json" "$data/projector/points.csv"
     expect_in out "^id,X,Y,Z,u,v,depth"

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iomanip>
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <map>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "camproj/camera_file.h"
+#include "camproj/world_origin.h"
 #include "seeds.h"
 #include "test_scenes.h"
 
@@ -626,6 +628,68 @@ TEST(ExportJsonTest, CameraFileReadsBackBitForBit) {
 
 // OpenCV's and COLMAP's camera models are perspective: an orthographic camera is refused by
 // name; the GL formats carry it (the matrix is tested in gl_test and render_test).
+// A camera at survey coordinates with a world origin O: gl, glm and three export the view matrix
+// for point_in_world - O (GlEyeFromOriginWorld, bit for bit) and say so in their header; the
+// formats without a view matrix stay absolute; without an origin the header says "none".
+TEST(ExportWorldOriginTest, GlFacingExportsAreRelativeToTheOriginAndSaySo) {
+  std::mt19937_64 rng(testing::Seed(1303));
+  for (int i = 0; i < 50; ++i) {
+    TestCamera test = MakeTestCamera(rng, i % 2 == 0, false, false);
+    Camera& camera = test.camera;
+    const Eigen::Vector3d offset(testing::Uniform(rng, 1e5, 9e5), testing::Uniform(rng, 1e6, 9e6),
+                                 testing::Uniform(rng, -100, 1000));
+    camera.cam_from_world = camera.cam_from_world * Rigid3{Eigen::Matrix3d::Identity(), -offset};
+    const std::string plain = ExportCamera(camera, ExportFormat::kGl);
+    EXPECT_NE(plain.find("\n# world origin: none: "), std::string::npos) << plain;
+    EXPECT_EQ(GlLineMatrix(plain, "view", false), GlEyeFromWorld(camera.cam_from_world));
+    EXPECT_EQ(nlohmann::json::parse(ExportCamera(camera, ExportFormat::kThree))["world_origin"],
+              nullptr);
+
+    camera.world_origin = RoundOrigin(offset, 100.0);
+    const Eigen::Vector3d& o = *camera.world_origin;
+    const Eigen::Matrix4d view = GlEyeFromOriginWorld(camera.cam_from_world, o);
+    std::ostringstream origin_text;
+    origin_text << std::setprecision(17) << "(" << o.x() << ", " << o.y() << ", " << o.z() << ")";
+    const std::string gl = ExportCamera(camera, ExportFormat::kGl);
+    EXPECT_NE(gl.find("view = gl_eye_from_origin_world\n"), std::string::npos) << gl;
+    EXPECT_NE(gl.find("\n# world origin " + origin_text.str() +
+                      ": the view matrix is gl_eye_from_origin_world: give vertices as "
+                      "point_in_world - " + origin_text.str()),
+              std::string::npos)
+        << gl;
+    EXPECT_EQ(GlLineMatrix(gl, "view", false), view);
+
+    const std::string glm_text = ExportCamera(camera, ExportFormat::kGlm);
+    EXPECT_NE(glm_text.find("// world origin " + origin_text.str()), std::string::npos);
+    EXPECT_NE(glm_text.find("const glm::dvec3 world_origin("), std::string::npos);
+    const std::vector<std::string> literals = GlmLiterals(glm_text, "view");
+    ASSERT_EQ(literals.size(), 16u);
+    for (int k = 0; k < 16; ++k) EXPECT_EQ(std::strtod(literals[k].c_str(), nullptr), view.data()[k]);
+
+    const nlohmann::json three = nlohmann::json::parse(ExportCamera(camera, ExportFormat::kThree));
+    EXPECT_EQ(three["world_origin"], nlohmann::json::array({o.x(), o.y(), o.z()}));
+    EXPECT_NE(three["note"].get<std::string>().find("world origin " + origin_text.str()),
+              std::string::npos);
+    // three's camera sits at C - O; its view matrix is `view` up to the rigid inverse's rounding
+    // (a few ulps of |C - O| <~ 1e3 here: 1e-9 covers it with room).
+    const Eigen::Vector3d position(three["position"][0].get<double>(),
+                                   three["position"][1].get<double>(),
+                                   three["position"][2].get<double>());
+    EXPECT_LE((position - (CameraCenterInWorld(camera.cam_from_world) - o)).norm(), 1e-9);
+    EXPECT_LE((JsonMatrix4(three["matrixWorld"]).inverse() - view).cwiseAbs().maxCoeff(), 1e-9);
+
+    // Absolute formats: opencv-yaml's tvec and colmap's T do not change with the origin.
+    if (camera.intrinsics.skew == 0.0) {
+      Camera no_origin = camera;
+      no_origin.world_origin.reset();
+      EXPECT_EQ(ExportCamera(camera, ExportFormat::kColmap),
+                ExportCamera(no_origin, ExportFormat::kColmap));
+      EXPECT_EQ(ExportCamera(camera, ExportFormat::kOpenCvYaml),
+                ExportCamera(no_origin, ExportFormat::kOpenCvYaml));
+    }
+  }
+}
+
 TEST(ExportCameraTest, OrthographicCameraOnlyWhereTheFormatHasIt) {
   Camera camera;
   camera.image_size = {640, 480};

@@ -12,6 +12,7 @@
 #include "camproj/export.h"
 #include "camproj/file_io.h"
 #include "camproj/lens_gl.h"
+#include "camproj/world_origin.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -31,6 +32,7 @@ struct ExportArgs {
   bool quiet = false;
   std::string output_path;
   int mesh_step_px = 0;
+  std::string origin;  // auto | X,Y,Z | none; empty: the camera file's
 };
 
 // The lower-case extension of `path` (".tif"), or "" without one.
@@ -86,6 +88,11 @@ Command AddExportCommand(CLI::App& root) {
                   "distortion-mesh: grid step in image px (default: the largest power of 2 up "
                   "to 64 whose interpolation error is <= 0.01 px)")
       ->check(CLI::Range(1, 1 << 20));
+  app->add_option("--origin", args->origin,
+                  "gl, glm, three, json: the world origin vertices are given relative to (the "
+                  "view matrix becomes gl_eye_from_origin_world): X,Y,Z; auto = the camera centre "
+                  "rounded to a power of ten not above near; none = world coordinates as they "
+                  "are. Default: the camera file's world_origin");
   app->add_flag("--quiet", args->quiet,
                 "gl, glm, glsl, three: no depth-precision notes on stderr (warnings still "
                 "printed)");
@@ -99,6 +106,25 @@ Command AddExportCommand(CLI::App& root) {
             }
             if (!(camera.z_far > camera.z_near)) {
               throw UsageError("far must be greater than near");
+            }
+            if (args->origin == "none") {
+              camera.world_origin.reset();
+            } else if (args->origin == "auto") {
+              camera.world_origin = AutoOriginOfCamera(camera);
+            } else if (!args->origin.empty()) {
+              const std::vector<double> o =
+                  ParseNumbers(args->origin, 3, "--origin (auto, none or X,Y,Z)");
+              camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
+              bool finite = false;
+              try {
+                finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
+              } catch (const std::invalid_argument&) {
+              }
+              if (!finite) {
+                throw UsageError("--origin: " + args->origin +
+                                 " is too far from the camera: the view matrix relative to it "
+                                 "overflows a double");
+              }
             }
             const bool stmap = args->to == "stmap" || args->to == "undistort-stmap";
             if (stmap) {
@@ -164,6 +190,32 @@ Command AddExportCommand(CLI::App& root) {
                 for (std::string line; std::getline(table, line);) {
                   std::cerr << "camproj: note: " << line << '\n';
                 }
+              }
+            }
+            if (gl_like) {
+              // Float32 precision of the vertices and the view matrix (world_origin.h): the
+              // error expected at the near plane, where it is largest, with and without the
+              // world origin; a warning when it is above kFloat32ErrorWarningPx without one.
+              const double without =
+                  Float32PixelError(camera, std::nullopt, camera.z_near);
+              const std::optional<Eigen::Vector3d> origin =
+                  camera.world_origin ? camera.world_origin : AutoOriginOfCamera(camera);
+              const double with = Float32PixelError(camera, origin, camera.z_near);
+              char line[512];
+              std::snprintf(line, sizeof line,
+                            "float32 vertices and view matrix: expected error at the near plane "
+                            "(depth %.6g) %.2g px without a world origin, %.2g px with %s "
+                            "%.17g,%.17g,%.17g",
+                            camera.z_near, without, with,
+                            camera.world_origin ? "the world origin" : "--origin auto =",
+                            origin->x(), origin->y(), origin->z());
+              if (!camera.world_origin && without > kFloat32ErrorWarningPx) {
+                std::cerr << "camproj: warning: " << line
+                          << ": the coordinates are too large for float32; export with --origin "
+                             "auto (or fit with --origin auto) and give vertices relative to it "
+                             "(docs/exports.md)\n";
+              } else if (!args->quiet) {
+                std::cerr << "camproj: note: " << line << '\n';
               }
             }
             if (pinhole_only && camera.intrinsics.HasDistortion()) {

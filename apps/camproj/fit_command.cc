@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -29,6 +30,7 @@
 #include "camproj/model_select.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
+#include "camproj/world_origin.h"
 #include "cli.h"
 
 namespace camproj::cli {
@@ -51,6 +53,7 @@ struct FitArgs {
   std::string object_points_path;
   std::string bounds;  // --bounds X0,Y0,Z0,X1,Y1,Z1
   std::string bounds_mesh_path;
+  std::string origin;  // --origin auto|X,Y,Z
 };
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
@@ -152,6 +155,12 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
   }
   if (!args.bounds_mesh_path.empty()) {
     arguments.bounds_in_world = ReadObjBoundingBox(args.bounds_mesh_path);
+  }
+  if (args.origin == "auto") {
+    arguments.auto_world_origin = true;
+  } else if (!args.origin.empty()) {
+    const std::vector<double> o = ParseNumbers(args.origin, 3, "--origin (auto or X,Y,Z)");
+    arguments.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
   }
   try {
     if (!args.object_points_path.empty()) {
@@ -414,6 +423,11 @@ Command AddFitCommand(CLI::App& root) {
                   "its 8 corners' depths + 10 %) instead of the fitted points only");
   app->add_option("--bounds-mesh", args->bounds_mesh_path,
                   "an OBJ file: near and far cover its vertices' bounding box, as --bounds");
+  app->add_option("--origin", args->origin,
+                  "auto or X,Y,Z: record a world origin in the camera file, so that GL exports' "
+                  "view matrix takes vertices relative to it (float32 precision for large, e.g. "
+                  "UTM, coordinates; docs/exports.md); auto: the fitted points' centroid rounded "
+                  "to a power of ten of their extent");
   app->add_option("--max-iterations", args->fit.max_iterations, "refinement iterations")
       ->check(CLI::NonNegativeNumber);
 
@@ -463,6 +477,24 @@ Command AddFitCommand(CLI::App& root) {
             } else {
               std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
               std::cout << "note: " << NearFarNote(request, fit);
+              if (fit.camera.world_origin) {
+                const Eigen::Vector3d& o = *fit.camera.world_origin;
+                std::ostringstream line;
+                line << std::setprecision(17) << "note: world origin " << o.x() << ',' << o.y()
+                     << ',' << o.z()
+                     << (request.auto_world_origin ? " (--origin auto: the fitted points' "
+                                                     "centroid, rounded)"
+                                                   : " (--origin)")
+                     << ": GL exports' view matrix takes point_in_world minus it\n";
+                std::cout << line.str();
+              } else if (const double error = Float32PixelError(fit.camera, std::nullopt,
+                                                                fit.camera.z_near);
+                         error > kFloat32ErrorWarningPx) {
+                std::printf("note: the world coordinates are too large for float32: GL exports "
+                            "would draw points ~%.2g px off at the near plane; fit with --origin "
+                            "auto (docs/exports.md)\n",
+                            error);
+              }
               if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
               // The summary's time is the fit's; reading and writing the files add to it.
               const double wall_ms = std::chrono::duration<double, std::milli>(

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "camproj/world_origin.h"
 #include "check.h"
 
 namespace camproj {
@@ -16,6 +17,7 @@ void Camera::Check() const {
                       intrinsics.k1, ", k2 = ", intrinsics.k2);
     internal::Require(std::isfinite(z_far), "an orthographic camera needs a finite far plane");
   }
+  if (world_origin) internal::RequireFiniteAll(*world_origin, "world origin");
 }
 
 CameraViews ViewsOfCamera(const Camera& camera, double target_distance, const GlDepth& depth) {
@@ -23,6 +25,9 @@ CameraViews ViewsOfCamera(const Camera& camera, double target_distance, const Gl
   CameraViews views;
   views.look_at = LookAtFromCamFromWorld(camera.cam_from_world, target_distance);
   views.gl_eye_from_world = GlEyeFromWorld(camera.cam_from_world);
+  views.gl_eye_from_origin_world =
+      camera.world_origin ? GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin)
+                          : views.gl_eye_from_world;
   if (camera.projection == Projection::kOrthographic) {
     const Intrinsics& k = camera.intrinsics;
     if (k.skew == 0.0) {
@@ -48,6 +53,8 @@ void RequireFiniteViews(const Camera& camera, const GlDepth& depth) {
   const char* what = "the values are too large for a double";
   internal::Require(views.clip_from_gl_eye.allFinite(), "the projection matrix is not finite: ", what);
   internal::Require(views.gl_eye_from_world.allFinite(), "the view matrix is not finite: ", what);
+  internal::Require(views.gl_eye_from_origin_world.allFinite(),
+                    "the view matrix relative to the world origin is not finite: ", what);
   internal::Require(views.look_at.eye.allFinite() && views.look_at.target.allFinite() &&
                         views.look_at.up.allFinite(),
                     "the look-at is not finite: ", what);

@@ -6,6 +6,7 @@
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
+#include "camproj/world_origin.h"
 #include "check.h"
 
 namespace camproj {
@@ -226,10 +227,25 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   } else {
     camera.z_far = reader.Number(far, "frustum.far");
   }
+  if (document.contains("world_origin")) {
+    camera.world_origin = reader.Vector(document.at("world_origin"), "world_origin", 3);
+  }
   try {
     camera.Check();
   } catch (const std::invalid_argument& e) {
     reader.Fail("frustum", e.what());
+  }
+  if (camera.world_origin) {
+    // C - origin can overflow (the view matrix's translation is built from it, then checked).
+    bool finite = false;
+    try {
+      finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
+    } catch (const std::invalid_argument&) {
+    }
+    if (!finite) {
+      reader.Fail("world_origin", "the view matrix relative to it is not finite: the values are "
+                                  "too large for a double");
+    }
   }
   try {
     RequireFiniteViews(camera);
@@ -319,6 +335,10 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
                     {"view", Matrix4Json(views.gl_eye_from_world)},
                     {"depth", ToString(options.depth.clip_depth)},
                     {"reversed_z", options.depth.reversed_z}};
+  if (camera.world_origin) {
+    document["world_origin"] = Vector3Json(*camera.world_origin);
+    document["gl"]["view_relative_to_origin"] = Matrix4Json(views.gl_eye_from_origin_world);
+  }
   if (camera.intrinsics.HasDistortion()) {
     document["gl"]["note"] = "the projection matrix is the pinhole part: k1, k2 are not in it";
   }

@@ -11,6 +11,7 @@
 
 #include "camproj/camera_file.h"
 #include "camproj/lens_gl.h"
+#include "camproj/world_origin.h"
 #include "check.h"
 
 namespace camproj {
@@ -82,6 +83,31 @@ std::string GlPixelNote(const Camera& camera) {
                           "section 2)");
 }
 
+// The world origin of the view matrix, what users subtract, and the float32 error with and without
+// it at the near plane (Float32PixelError), one sentence.
+std::string OriginNote(const Camera& camera) {
+  auto out = ExactStream();
+  const Eigen::Vector3d auto_origin = AutoOriginOfCamera(camera);
+  const double error_without = Float32PixelError(camera, std::nullopt, camera.z_near);
+  if (camera.world_origin) {
+    const Eigen::Vector3d& o = *camera.world_origin;
+    out << "world origin (" << o.x() << ", " << o.y() << ", " << o.z()
+        << "): the view matrix is gl_eye_from_origin_world: give vertices as point_in_world - ("
+        << o.x() << ", " << o.y() << ", " << o.z()
+        << "), subtracted in double before the cast to float; expected float32 error at the near "
+           "plane "
+        << std::setprecision(2) << Float32PixelError(camera, camera.world_origin, camera.z_near)
+        << " px (" << error_without << " px without the origin)";
+  } else {
+    out << "world origin: none: the view matrix takes world coordinates as they are; expected "
+           "float32 error at the near plane "
+        << std::setprecision(2) << error_without << " px ("
+        << Float32PixelError(camera, auto_origin, camera.z_near)
+        << " px with camproj export --origin auto)";
+  }
+  return out.str();
+}
+
 void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, bool row_major) {
   out << name;
   for (int i = 0; i < 16; ++i) {
@@ -95,7 +121,8 @@ void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, 
 std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
   const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
   auto out = ExactStream();
-  out << "# camproj GL export: projection = clip_from_gl_eye, view = gl_eye_from_world\n"
+  out << "# camproj GL export: projection = clip_from_gl_eye, view = "
+      << (camera.world_origin ? "gl_eye_from_origin_world" : "gl_eye_from_world") << "\n"
       << "# "
       << (options.row_major ? "row-major (transpose before a GL_FALSE upload)"
                             : "column-major: upload with transpose = GL_FALSE")
@@ -113,8 +140,9 @@ std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
   } else {
     out << "# distortion: none (k1 and k2 are 0): the matrices are the whole camera\n";
   }
+  out << "# " << OriginNote(camera) << '\n';
   PrintMatrix(out, "projection", views.clip_from_gl_eye, options.row_major);
-  PrintMatrix(out, "view", views.gl_eye_from_world, options.row_major);
+  PrintMatrix(out, "view", views.gl_eye_from_origin_world, options.row_major);
   return out.str();
 }
 
@@ -141,7 +169,8 @@ void PrintGlmMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& 
 std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
   const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
   auto out = ExactStream();
-  out << "// camproj glm export: projection = clip_from_gl_eye, view = gl_eye_from_world.\n"
+  out << "// camproj glm export: projection = clip_from_gl_eye, view = "
+      << (camera.world_origin ? "gl_eye_from_origin_world" : "gl_eye_from_world") << ".\n"
       << "// #include <glm/glm.hpp> and <glm/gtc/type_ptr.hpp>. glm is column-major: the\n"
       << "// 16-number glm::dmat4 constructor takes column 0 first, the order GL uploads.\n"
       << (camera.projection == Projection::kOrthographic
@@ -164,8 +193,15 @@ std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
   } else {
     out << "// Distortion: none (k1 and k2 are 0): the matrices are the whole camera.\n";
   }
+  out << "// " << OriginNote(camera) << ".\n";
+  if (camera.world_origin) {
+    const Eigen::Vector3d& o = *camera.world_origin;
+    out << "// Vertices: glm::vec3(glm::dvec3(point_in_world) - world_origin).\n"
+        << "const glm::dvec3 world_origin(" << CppDouble(o.x()) << ", " << CppDouble(o.y()) << ", "
+        << CppDouble(o.z()) << ");\n";
+  }
   PrintGlmMatrix(out, "projection", views.clip_from_gl_eye);
-  PrintGlmMatrix(out, "view", views.gl_eye_from_world);
+  PrintGlmMatrix(out, "view", views.gl_eye_from_origin_world);
   return out.str();
 }
 
@@ -278,7 +314,9 @@ ordered_json Matrix4Json(const Eigen::Matrix4d& m) {
 
 std::string ExportThreeText(const Camera& camera, const ExportOptions& options) {
   const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
-  const Rigid3 world_from_gl_eye = Inverse(Rigid3FromMatrix(views.gl_eye_from_world));
+  // With a world origin three's world is the origin-relative one: the scene's positions are
+  // point_in_world - world_origin (three's numbers are doubles until they reach the GPU).
+  const Rigid3 world_from_gl_eye = Inverse(Rigid3FromMatrix(views.gl_eye_from_origin_world));
   const Eigen::Quaterniond q(world_from_gl_eye.rotation);
   const Eigen::Vector3d& position = world_from_gl_eye.translation;
   const GlDepth& depth = options.depth;
@@ -341,6 +379,12 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
   document["depth"] = ToString(depth.clip_depth);
   document["reversed_z"] = depth.reversed_z;
   document["image_size"] = {camera.image_size.width, camera.image_size.height};
+  if (camera.world_origin) {
+    document["world_origin"] = {camera.world_origin->x(), camera.world_origin->y(),
+                                camera.world_origin->z()};
+  } else {
+    document["world_origin"] = nullptr;
+  }
 
   std::string note =
       "projectionMatrix is exact: camera.projectionMatrix.fromArray(projectionMatrix); "
@@ -373,10 +417,18 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
   note += camera.intrinsics.HasDistortion()
               ? " " + DistortionNote(camera) + "."
               : std::string(" Distortion: none (k1 and k2 are 0): projectionMatrix is the whole camera.");
-  note +=
-      " matrixWorld = world_from_gl_eye (three's camera looks down -z with y up); for a camera "
-      "without a parent set camera.position.fromArray(position) and "
-      "camera.quaternion.fromArray(quaternion), which the renderer turns into this matrixWorld.";
+  note += std::string(" matrixWorld = ") +
+          (camera.world_origin ? "world_from_gl_eye in the origin-relative world" : "world_from_gl_eye") +
+          " (three's camera looks down -z with y up); for a camera "
+          "without a parent set camera.position.fromArray(position) and "
+          "camera.quaternion.fromArray(quaternion), which the renderer turns into this matrixWorld.";
+  note += " " + OriginNote(camera) +
+          (camera.world_origin
+               ? ": positions in this three world are point_in_world - world_origin (objects' "
+                 "positions and geometry vertices alike; three multiplies the object and camera "
+                 "matrices in double, so vertices small around their object's position are "
+                 "precise either way)."
+               : ".");
   document["note"] = note;
   return document.dump(2) + "\n";
 }

@@ -8,6 +8,7 @@
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/fit_report.h"
+#include "camproj/world_origin.h"
 #include "check.h"
 #include "view/obj_mesh.h"
 
@@ -183,6 +184,17 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
     }
     request.bounds_in_world = args.bounds_in_world;
   }
+  if (args.world_origin && args.auto_world_origin) {
+    throw std::invalid_argument("--origin: give auto or X,Y,Z, not both");
+  }
+  if (args.world_origin) {
+    for (int axis = 0; axis < 3; ++axis) {
+      internal::Require(std::isfinite((*args.world_origin)[axis]),
+                        "--origin: coordinates must be finite, got ", (*args.world_origin)[axis]);
+    }
+  }
+  request.world_origin = args.world_origin;
+  request.auto_world_origin = args.auto_world_origin;
   options.max_iterations = args.max_iterations;
   if (!forced && options.loss != LossType::kNone) {
     throw std::invalid_argument(
@@ -222,6 +234,22 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
     AutoFitOptions options = request.auto_options;
     if (ids.size() == pixels.size()) options.point_names = ids;
     result = FitCameraAuto(points_in_world, pixels, size, options);
+  }
+  if (request.auto_world_origin) {
+    std::vector<Eigen::Vector3d> kept;
+    for (size_t i = 0; i < points_in_world.size(); ++i) {
+      if (std::find(result.outliers.begin(), result.outliers.end(), static_cast<int>(i)) ==
+          result.outliers.end()) {
+        kept.push_back(points_in_world[i]);
+      }
+    }
+    result.camera.world_origin = AutoOriginOfPoints(kept);
+  } else if (request.world_origin) {
+    result.camera.world_origin = request.world_origin;
+  }
+  if (result.camera.world_origin) {
+    result.views.gl_eye_from_origin_world =
+        GlEyeFromOriginWorld(result.camera.cam_from_world, *result.camera.world_origin);
   }
   if (!request.bounds_in_world) return result;
   const FitOptions& options = request.options();

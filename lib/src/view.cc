@@ -184,7 +184,10 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
                 {"points", points},
                 {"notes", notes}};
   ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
-  scene["three"] = json::parse(ExportCamera(camera, ExportFormat::kThree, export_options));
+  // The page draws the points in absolute world coordinates, so its camera is absolute too.
+  Camera absolute = camera;
+  absolute.world_origin.reset();
+  scene["three"] = json::parse(ExportCamera(absolute, ExportFormat::kThree, export_options));
   return scene;
 }
 

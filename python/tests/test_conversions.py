@@ -146,6 +146,27 @@ def test_camera_file_round_trip(tmp_path, data_dir):
     assert np.array_equal(back.K, camera.K)
 
 
+def test_world_origin_is_fitted_kept_and_exported(tmp_path, data_dir):
+    # The projector scene at survey coordinates: origin="auto" is the camera file's world_origin
+    # and the gl export's, as `camproj fit --origin auto` writes it; the pose stays absolute.
+    points, pixels, ids = camproj.read_points(os.path.join(data_dir, "projector/points.csv"))
+    shifted = np.array([412345.678, 5612345.678, 123.456]) + 20.0 * points
+    plain = camproj.fit(shifted, pixels, SIZE, ids=ids)
+    camera = camproj.fit(shifted, pixels, SIZE, ids=ids, origin="auto")
+    assert plain.world_origin is None
+    assert np.array_equal(camera.R, plain.R) and np.array_equal(camera.t, plain.t)
+    path = tmp_path / "camera.json"
+    camera.write(str(path))
+    back = camproj.read_camera(str(path))
+    assert np.array_equal(back.world_origin, camera.world_origin)
+    o = camera.world_origin
+    assert "# world origin (%.17g, %.17g, %.17g)" % tuple(o) in back.export("gl")
+    fixed = camproj.fit(shifted, pixels, SIZE, ids=ids, origin=[412000.0, 5612000.0, 100.0])
+    assert list(fixed.world_origin) == [412000.0, 5612000.0, 100.0]
+    with pytest.raises(ValueError, match="origin"):
+        camproj.fit(shifted, pixels, SIZE, origin="centre")
+
+
 def test_points_file_round_trip(tmp_path):
     rng = np.random.default_rng(1)
     points, pixels = rng.normal(size=(7, 3)) * 1e3, rng.normal(size=(7, 2)) * 1e-3

@@ -30,6 +30,12 @@ struct Camera {
   double z_near = 0.1;    // depth range of the GL export, > 0
   double z_far = 100.0;   // > z_near, or kInfinity (perspective only)
   Projection projection = Projection::kPerspective;
+  // Camera-relative rendering for large coordinates (docs/conventions.md, section 11): when set,
+  // GL-facing exports give the view matrix gl_eye_from_origin_world, which takes
+  // point_in_world - *world_origin (subtracted in double by the user), so that float32 vertices
+  // and matrices hold small numbers. Absent: vertices in world coordinates as they are. Does not
+  // change the camera: cam_from_world, PixelFromWorld and `camproj project` stay absolute.
+  std::optional<Eigen::Vector3d> world_origin = std::nullopt;
 
   // Throws std::invalid_argument naming the field on any invalid part.
   void Check() const;
@@ -43,6 +49,9 @@ struct CameraViews {
   std::optional<Ortho> ortho;              // orthographic camera without skew: the glOrtho box
   Eigen::Matrix4d clip_from_gl_eye;        // projection matrix (pinhole part, skew included)
   Eigen::Matrix4d gl_eye_from_world;       // view matrix
+  // The view matrix for vertices given relative to camera.world_origin (point_in_world - origin):
+  // GlEyeFromOriginWorld; equals gl_eye_from_world when the camera has no world origin.
+  Eigen::Matrix4d gl_eye_from_origin_world;
 };
 
 // Derives the views; the projection uses intrinsics.Pinhole() (a GL matrix is linear: distortion

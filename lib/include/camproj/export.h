@@ -29,7 +29,13 @@
 //                (lens_gl.h LensDistortionMeshJson, ExportOptions::mesh_step_px).
 // gl, glm and three hold the pinhole part only: a comment or note says when k1, k2 are dropped
 // (a projection matrix is linear) and names the exports that render the lens (glsl,
-// distortion-mesh, and the STMap files of `camproj export --to stmap`, lens_gl.h).
+// distortion-mesh, and the STMap files of `camproj export --to stmap`, lens_gl.h). With
+// Camera::world_origin set, their view matrix is
+// gl_eye_from_origin_world (vertices given as point_in_world - world_origin; world_origin.h),
+// glm also defines `const glm::dvec3 world_origin`, three's matrixWorld and position are in the
+// origin-relative world and its `world_origin` key holds it (null without); their header states
+// the origin (or "world origin: none") and Float32PixelError at the near plane with and without
+// it. json writes world_origin; opencv-yaml and colmap stay absolute.
 #ifndef CAMPROJ_EXPORT_H_
 #define CAMPROJ_EXPORT_H_
 

@@ -48,6 +48,11 @@ struct FitArguments {
   // --bounds / --bounds-mesh: near and far (those not given above) cover this box, e.g. the
   // whole model, instead of the fitted points only (DepthRangeCoveringBox, camera.h).
   std::optional<BoxInWorld> bounds_in_world;
+  // --origin: the camera's world_origin (world_origin.h): as given, or with auto_world_origin the
+  // fitted points' centroid rounded (AutoOriginOfPoints over the points the fit kept). Neither:
+  // no origin.
+  std::optional<Eigen::Vector3d> world_origin;
+  bool auto_world_origin = false;
   int max_iterations = 100;
 };
 
@@ -57,6 +62,8 @@ struct FitRequest {
   bool automatic = true;
   AutoFitOptions auto_options;  // its `fit` is the options in both cases
   std::optional<BoxInWorld> bounds_in_world;  // applied by RunFitRequest after the fit
+  std::optional<Eigen::Vector3d> world_origin;  // also applied after the fit (FitArguments)
+  bool auto_world_origin = false;
   const FitOptions& options() const { return auto_options.fit; }
 };
 
@@ -69,7 +76,9 @@ FitRequest FitRequestFrom(const FitArguments& arguments, const ImageSize& size);
 // With bounds_in_world, the fitted camera's near and far (those not given as --near / --far)
 // then cover the box (DepthRangeCoveringBox), and its views are rederived; a box that reaches
 // behind the camera without --near, or lies wholly behind it, throws std::invalid_argument
-// naming --bounds, the corner and its depth.
+// naming --bounds, the corner and its depth. With world_origin or auto_world_origin the camera
+// gets that world origin (auto: AutoOriginOfPoints of the points not among result.outliers) and
+// views.gl_eye_from_origin_world matches it; the fit itself does not depend on it.
 FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& pixels,
                         const std::vector<std::string>& ids, const ImageSize& size,
