@@ -239,6 +239,34 @@ ok = abs(near - want_near) <= 1e-12 * want_near and abs(far - want_far) <= 1e-12
 print(near, want_near, far, want_far)
 sys.exit(0 if ok else 1)
 PY
+    # The same box's corners as PLY meshes: ascii, and binary (little- and big-endian, a
+    # colour property between the coordinates, a face element before the vertices; x as float32,
+    # exact at +-0.5): the same near and far as --bounds.
+    py - "$work" <<'PY'
+import itertools, struct, sys
+corners = list(itertools.product((-0.5, 0.5), (-0.3, 0.3), (-0.4, 0.4)))
+head = "ply\nformat {}\ncomment a face first\nelement face 1\nproperty list uchar int vertex_indices\n" \
+       "element vertex 8\nproperty float x\nproperty uchar red\nproperty double y\nproperty double z\nend_header\n"
+with open(sys.argv[1] + "/box_ascii.ply", "w") as f:
+    f.write(head.format("ascii 1.0") + "3 0 1 2\n" + "".join(f"{x} 7 {y} {z}\n" for x, y, z in corners))
+for name, order in (("le", "<"), ("be", ">")):
+    fmt = "binary_little_endian 1.0" if order == "<" else "binary_big_endian 1.0"
+    data = struct.pack(order + "B3i", 3, 0, 1, 2) + b"".join(
+        struct.pack(order + "fBdd", x, 7, y, z) for x, y, z in corners)
+    open(f"{sys.argv[1]}/box_{name}.ply", "wb").write(head.format(fmt).encode() + data)
+PY
+    for ply in box_ascii box_le box_be; do
+      expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+        --bounds-mesh "$work/$ply.ply" -o "$work/$ply.json"
+      py -c "import json, sys; a, b = (json.load(open(f))['frustum'] for f in sys.argv[1:]); sys.exit(not (a['near'], a['far']) == (b['near'], b['far']))" \
+        "$work/$ply.json" "$work/box.json" || fail "--bounds-mesh $ply.ply and --bounds of its box differ"
+    done
+    head -c -10 "$work/box_le.ply" >"$work/cut.ply"  # the last vertex cut short
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds-mesh "$work/cut.ply"
+    expect_in err "cut.ply: PLY: the data ends before the header's elements do"
+    printf 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n' >"$work/noz.ply"
+    expect_exit 2 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --bounds-mesh "$work/noz.ply"
+    expect_in err "noz.ply: PLY: the vertex element has no scalar property z"
     # --near given: only far from the box.
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
       --bounds=-0.5,-0.3,-0.4,0.5,0.3,0.4 --near 0.5

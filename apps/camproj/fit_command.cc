@@ -154,7 +154,7 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
     arguments.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
   }
   if (!args.bounds_mesh_path.empty()) {
-    arguments.bounds_in_world = ReadObjBoundingBox(args.bounds_mesh_path);
+    arguments.bounds_in_world = ReadMeshBoundingBox(args.bounds_mesh_path);
   }
   if (args.origin == "auto") {
     arguments.auto_world_origin = true;
@@ -422,7 +422,8 @@ Command AddFitCommand(CLI::App& root) {
                   "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
                   "its 8 corners' depths + 10 %) instead of the fitted points only");
   app->add_option("--bounds-mesh", args->bounds_mesh_path,
-                  "an OBJ file: near and far cover its vertices' bounding box, as --bounds");
+                  "an OBJ or PLY file: near and far cover its vertices' bounding box, as "
+                  "--bounds");
   app->add_option("--origin", args->origin,
                   "auto or X,Y,Z: record a world origin in the camera file, so that GL exports' "
                   "view matrix takes vertices relative to it (float32 precision for large, e.g. "

@@ -1,8 +1,10 @@
 #include "camproj/fit_request.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
 #include "camproj/errors.h"
@@ -11,6 +13,7 @@
 #include "camproj/world_origin.h"
 #include "check.h"
 #include "view/obj_mesh.h"
+#include "view/ply_vertices.h"
 
 namespace camproj {
 
@@ -285,7 +288,7 @@ std::string NearFarNote(const FitRequest& request, const FitResult& fit) {
   }
   return range + std::string("cover the fitted points' depths only") + margin +
          "; the rest of the model may be clipped: give --bounds X0,Y0,Z0,X1,Y1,Z1 or "
-         "--bounds-mesh model.obj to cover it, or --near/--far\n";
+         "--bounds-mesh model.obj (or .ply) to cover it, or --near/--far\n";
 }
 
 BoxInWorld ReadObjBoundingBox(const std::string& path) {
@@ -296,6 +299,22 @@ BoxInWorld ReadObjBoundingBox(const std::string& path) {
       Eigen::Vector3d(mesh.positions[0], mesh.positions[1], mesh.positions[2]);
   for (size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
     const Eigen::Vector3d p(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]);
+    box.min_in_world = box.min_in_world.cwiseMin(p);
+    box.max_in_world = box.max_in_world.cwiseMax(p);
+  }
+  return box;
+}
+
+BoxInWorld ReadMeshBoundingBox(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".ply") return ReadObjBoundingBox(path);
+  const std::vector<Eigen::Vector3d> positions =
+      internal::PlyVertexPositions(ReadWholeFile(path), path);
+  if (positions.empty()) throw InputError(path + ": no vertices for a bounding box");
+  BoxInWorld box;
+  box.min_in_world = box.max_in_world = positions[0];
+  for (const Eigen::Vector3d& p : positions) {
     box.min_in_world = box.min_in_world.cwiseMin(p);
     box.max_in_world = box.max_in_world.cwiseMax(p);
   }

@@ -92,6 +92,11 @@ std::string NearFarNote(const FitRequest& request, const FitResult& fit);
 // InputError naming the file (and line) for an unreadable file, a bad vertex or no vertices.
 BoxInWorld ReadObjBoundingBox(const std::string& path);
 
+// --bounds-mesh: the bounding box of a mesh's vertices, a PLY file's (`.ply`, any case: ascii or
+// binary, the vertex element's x, y, z) or else an OBJ's (ReadObjBoundingBox). Throws InputError
+// naming the file and what is wrong.
+BoxInWorld ReadMeshBoundingBox(const std::string& path);
+
 // The camera file `camproj fit -o` writes for a fit: cx, cy in `pixel_origin`, the look-at target
 // at the fit's distance, and the `fit` record (fit_report.h).
 std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin);
