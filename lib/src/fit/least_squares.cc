@@ -429,6 +429,7 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   outcome.model = model;
   bool have_normal = false;
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
+    have_normal = false;
     if (options.refiner == Refiner::kCeres) {
       // The same residuals in a ceres::Problem; each round resumes from the last.
       const CeresSummary summary =
@@ -436,29 +437,25 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                             &outcome.center, &outcome.model, &outcome.trace);
       outcome.iterations += summary.iterations;
       outcome.termination = "ceres " + summary.termination;
-      have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
-                                           outcome.model, &outcome.normal);
-      if (!have_normal) break;
-      outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                            &outcome.model, &outcome.normal);
-      continue;
-    }
-    const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
-    ParamVector u = problem.Pack(outcome.center);
-    // The first round is TinySolver's LM; where its answer is short of the minimum (a curved
-    // valley), the next rounds add geodesic acceleration.
-    const LmSummary summary =
-        MinimizeLevenbergMarquardt(problem, options, start_time, round > 0, &u, &outcome.trace);
-    problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
-    outcome.iterations += summary.iterations;
-    outcome.termination = LmStatusText(summary.status);
-    // LM's last normal equations, when they are at its answer, are the polish's first (the local
-    // ones at the same camera: only the change of variables differs).
-    have_normal = summary.local_at_solution;
-    if (have_normal) {
-      outcome.normal = summary.local;
-      ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
     } else {
+      const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
+      ParamVector u = problem.Pack(outcome.center);
+      // The first round is TinySolver's LM; where its answer is short of the minimum (a curved
+      // valley), the next rounds add geodesic acceleration.
+      const LmSummary summary =
+          MinimizeLevenbergMarquardt(problem, options, start_time, round > 0, &u, &outcome.trace);
+      problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
+      outcome.iterations += summary.iterations;
+      outcome.termination = LmStatusText(summary.status);
+      // LM's last normal equations, when they are at its answer, are the polish's first (the
+      // local ones at the same camera: only the change of variables differs).
+      have_normal = summary.local_at_solution;
+      if (have_normal) {
+        outcome.normal = summary.local;
+        ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
+      }
+    }
+    if (!have_normal) {
       have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
                                            outcome.model, &outcome.normal);
     }

@@ -1,7 +1,5 @@
 #include "fit/selection.h"
 
-#include "fit/orthographic_fit.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
