@@ -88,7 +88,7 @@ constexpr double kBoxHalfSize = 0.5;  // the box is [-0.5, 0.5]^3 in world
 // box for cameras in the (+, +, +) octant, and tilted with respect to all of their gazes.
 constexpr double kBackgroundOffset = -2.0;
 constexpr double kBackgroundHalfSize = 12.0;
-constexpr int kBackgroundGrid = 32;  // quads per side; see SceneTriangles()
+constexpr int kBackgroundGrid = 32;  // quads per side; see TessellatedSceneInWorld()
 
 // ---------------------------------------------------------------------------------------------
 // Headless GL context.
@@ -466,36 +466,58 @@ std::vector<float> ToFloatVertices(const std::vector<Eigen::Vector3d>& vertices)
 }
 
 // Box faces in kBoxFaces order (the camera-facing ones first, so that a missing depth test
-// shows), then the background last (so that it would overwrite everything without one); in
-// double, three vertices per triangle.
-std::vector<Eigen::Vector3d> SceneTrianglesInWorld() {
+// shows), each split into box_cells^2 quads, then the background last (so that it would
+// overwrite everything without one), split into background_cells^2; either may be left out (0
+// cells). In double, three vertices per triangle.
+//
+// The background is a grid of small quads rather than two huge triangles. Big triangles that
+// cross the image border get clipped by the driver into thin slivers whose float plane
+// equations extrapolate badly along their long edge: measured max errors were 5e-4 px with a
+// single quad (llvmpipe) and 6.4e-4 px with 8 x 8 quads (softpipe), against <= 4e-5 px with
+// 32 x 32 on both. That is driver arithmetic, not the matrices, so the scene avoids it. Each
+// lattice vertex is computed once, so neighbouring quads share exact float corners (no cracks).
+std::vector<Eigen::Vector3d> TessellatedSceneInWorld(int box_cells, int background_cells) {
   std::vector<Eigen::Vector3d> triangles;
-  for (const BoxFace& face : kBoxFaces) {
+  for (int f = 0; f < 6 && box_cells > 0; ++f) {
+    const BoxFace& face = kBoxFaces[f];
     const Eigen::Vector3d center = face.sign * kBoxHalfSize * Eigen::Vector3d::Unit(face.axis);
     const Eigen::Vector3d a = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 1) % 3);
     const Eigen::Vector3d b = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 2) % 3);
-    AppendQuad({center - a - b, center + a - b, center + a + b, center - a + b}, &triangles);
+    const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
+      return center + (2.0 * column / box_cells - 1.0) * a + (2.0 * row / box_cells - 1.0) * b;
+    };
+    for (int row = 0; row < box_cells; ++row) {
+      for (int column = 0; column < box_cells; ++column) {
+        AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
+                    vertex(row + 1, column)},
+                   &triangles);
+      }
+    }
   }
-  // The background as a grid of small quads rather than two huge triangles. Big triangles that
-  // cross the image border get clipped by the driver into thin slivers whose float plane
-  // equations extrapolate badly along their long edge: measured max errors were 5e-4 px with a
-  // single quad (llvmpipe) and 6.4e-4 px with 8 x 8 quads (softpipe), against <= 4e-5 px with
-  // 32 x 32 on both. That is driver arithmetic, not the matrices, so the scene avoids it. Each
-  // lattice vertex is computed once, so neighbouring quads share exact float corners (no cracks).
   const BackgroundFrame frame;
   const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
-    const double s = (2.0 * column / kBackgroundGrid - 1.0) * kBackgroundHalfSize;
-    const double t = (2.0 * row / kBackgroundGrid - 1.0) * kBackgroundHalfSize;
+    const double s = (2.0 * column / background_cells - 1.0) * kBackgroundHalfSize;
+    const double t = (2.0 * row / background_cells - 1.0) * kBackgroundHalfSize;
     return kBackgroundOffset * frame.normal + s * frame.a + t * frame.b;
   };
-  for (int row = 0; row < kBackgroundGrid; ++row) {
-    for (int column = 0; column < kBackgroundGrid; ++column) {
+  for (int row = 0; row < background_cells; ++row) {
+    for (int column = 0; column < background_cells; ++column) {
       AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
                   vertex(row + 1, column)},
                  &triangles);
     }
   }
   return triangles;
+}
+
+// The render test's scene: one quad per box face (its corners exactly center -+ a -+ b) and the
+// 32 x 32 background.
+std::vector<Eigen::Vector3d> SceneTrianglesInWorld() {
+  return TessellatedSceneInWorld(1, kBackgroundGrid);
+}
+
+std::vector<float> TessellatedScene(int box_cells, int background_cells) {
+  return ToFloatVertices(TessellatedSceneInWorld(box_cells, background_cells));
 }
 
 std::vector<float> SceneTriangles() { return ToFloatVertices(SceneTrianglesInWorld()); }
@@ -840,41 +862,6 @@ Camera LensCamera(const LensCase& lens) {
   return camera;
 }
 
-// The box's faces split into box_cells^2 quads each, and the background into
-// background_cells^2; either may be left out (0 cells).
-std::vector<float> TessellatedScene(int box_cells, int background_cells) {
-  std::vector<Eigen::Vector3d> triangles;
-  for (int f = 0; f < 6 && box_cells > 0; ++f) {
-    const BoxFace& face = kBoxFaces[f];
-    const Eigen::Vector3d center = face.sign * kBoxHalfSize * Eigen::Vector3d::Unit(face.axis);
-    const Eigen::Vector3d a = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 1) % 3);
-    const Eigen::Vector3d b = kBoxHalfSize * Eigen::Vector3d::Unit((face.axis + 2) % 3);
-    const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
-      return center + (2.0 * column / box_cells - 1.0) * a + (2.0 * row / box_cells - 1.0) * b;
-    };
-    for (int row = 0; row < box_cells; ++row) {
-      for (int column = 0; column < box_cells; ++column) {
-        AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
-                    vertex(row + 1, column)},
-                   &triangles);
-      }
-    }
-  }
-  const BackgroundFrame frame;
-  const auto vertex = [&](int row, int column) -> Eigen::Vector3d {
-    const double s = (2.0 * column / background_cells - 1.0) * kBackgroundHalfSize;
-    const double t = (2.0 * row / background_cells - 1.0) * kBackgroundHalfSize;
-    return kBackgroundOffset * frame.normal + s * frame.a + t * frame.b;
-  };
-  for (int row = 0; row < background_cells; ++row) {
-    for (int column = 0; column < background_cells; ++column) {
-      AppendQuad({vertex(row, column), vertex(row, column + 1), vertex(row + 1, column + 1),
-                  vertex(row + 1, column)},
-                 &triangles);
-    }
-  }
-  return ToFloatVertices(triangles);
-}
 
 // The longest triangle edge on the camera's pinhole image (px) among triangles with a vertex in
 // the lens render target's view (which holds the image's footprint); infinity if such a triangle
