@@ -41,7 +41,8 @@ Eigen::Matrix3d ClosestRotation(const Eigen::Matrix3d& m) {
   return r;
 }
 
-// Planar homography (plane coordinates -> pixels) by the normalized DLT.
+}  // namespace
+
 Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
                                      const std::vector<Eigen::Vector2d>& pixels) {
   const Eigen::Matrix3d t_plane = HartleyTransform(plane);
@@ -60,6 +61,8 @@ Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
   hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
   return t_pixel.inverse() * hn * t_plane;
 }
+
+namespace {
 
 std::vector<cv::Point3d> ToCv(const std::vector<Eigen::Vector3d>& points) {
   std::vector<cv::Point3d> out;

@@ -33,6 +33,11 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
 Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
                                           const std::vector<Eigen::Vector2d>& pixels);
 
+// The planar homography H (plane coordinates -> pixels, scale arbitrary) by the Hartley-normalized
+// DLT, >= 4 points in general position.
+Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
+                                     const std::vector<Eigen::Vector2d>& pixels);
+
 // M = K R with K upper triangular with positive diagonal, K(2,2) = 1 and R orthogonal (its
 // determinant has the sign of det(M)).
 void RqDecomposition(const Eigen::Matrix3d& m, Eigen::Matrix3d* k, Eigen::Matrix3d* r);

@@ -1,0 +1,91 @@
+// Calibration from many views (issue #14): one camera or projector seen in several views of known
+// points — a chessboard moved in front of it, or a 3D rig — with its intrinsics shared by every
+// view and one pose per view, refined jointly by Ceres. Conventions: docs/conventions.md; the
+// intrinsics are the fitter's pinhole with two radial terms (intrinsics.h): OpenCV's model with
+// p1 = p2 = k3 = 0.
+//
+// What runs (docs/calibration.md):
+//   start      planar views: a homography each, then Zhang's closed form for K (pixels scaled to
+//              the image size first); 3D views: the normalized DLT each, K the median of theirs;
+//              mixtures: the planar views' K where there are >= 3 of them, else the 3D views'.
+//              Every view's pose from its points by SQPnP with that K.
+//   refinement one ceres::Problem: per point the analytic residual the single-view fitter uses,
+//              a pose block per view (quaternion + centre on a product manifold), one intrinsics
+//              block shared by all views (fixed entries on a SubsetManifold), DENSE_SCHUR with
+//              the poses eliminated.
+//   uncertainty ceres::Covariance of the shared intrinsics, scaled by the residual variance
+//              s^2 = sum |r|^2 / (2N - p).
+#ifndef CAMPROJ_CALIBRATE_H_
+#define CAMPROJ_CALIBRATE_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camproj/conventions.h"
+#include "camproj/fit.h"
+#include "camproj/intrinsics.h"
+#include "camproj/pose.h"
+
+namespace camproj {
+
+// One view: points in that view's world frame (a board's own frame is fine: each view has its own
+// pose) and their pixels (kCenter).
+struct CalibrationView {
+  std::string name;  // for messages and the result, e.g. the file's name
+  std::vector<Eigen::Vector3d> points_in_world;
+  std::vector<Eigen::Vector2d> pixels;
+};
+
+// Which intrinsics the views share and refine. The default is cv::calibrateCamera's model
+// without tangential distortion and k3: fx, fy, cx, cy, k1, k2 free, no skew.
+struct CalibrateOptions {
+  ImageSize image_size;
+  bool aspect_free = true;           // fy / fx; false: fy = fx
+  bool principal_point_free = true;  // false: the image centre, ((W - 1) / 2, (H - 1) / 2)
+  bool skew_free = false;
+  int num_radial = 2;                // 0 (none), 1 (k1) or 2 (k1, k2)
+  bool compute_uncertainty = true;
+  int max_iterations = 200;
+  double function_tolerance = 1e-15;   // relative cost change
+  double gradient_tolerance = 1e-15;
+  double parameter_tolerance = 1e-14;  // relative step
+
+  // Throws std::invalid_argument naming the field unless the image size is positive,
+  // num_radial is 0, 1 or 2, and the iteration count and tolerances are positive.
+  void Check() const;
+};
+
+struct CalibratedView {
+  std::string name;
+  Rigid3 cam_from_world;  // the view's world frame -> camera
+  int num_points = 0;
+  double rms_px = 0.0;    // sqrt(mean |r|^2) over this view's points
+};
+
+struct Calibration {
+  ImageSize image_size;
+  Intrinsics intrinsics;  // kCenter; entries not free hold their fixed values
+  std::vector<CalibratedView> views;  // in the order given
+  int num_points = 0;                 // over all views
+  int num_parameters = 0;             // 6 per view + the free intrinsics
+  double rms_px = 0.0;                // sqrt(sum |r|^2 / num_points), as cv::calibrateCamera's
+  // 1-sigma of each free intrinsic ("fx", "fy", "cx", "cy", "skew", "k1", "k2"), px or unitless,
+  // from the covariance above; empty unless compute_uncertainty.
+  std::vector<ParameterSigma> intrinsics_sigma;
+  Intrinsics start;                   // the closed-form start's intrinsics
+  int iterations = 0;
+  std::string termination;            // Ceres' words
+};
+
+// Calibrates the shared intrinsics and a pose per view. Throws std::invalid_argument on bad
+// options or on a view with fewer than 4 points, with non-finite numbers, or with points and
+// pixels of different counts (naming the view); SceneError kDegenerate when the views cannot
+// determine the free intrinsics (fewer equations than unknowns, or no closed-form start: say
+// which intrinsics to fix), kNumerical when the refinement fails.
+Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options);
+
+}  // namespace camproj
+
+#endif  // CAMPROJ_CALIBRATE_H_

@@ -1,0 +1,389 @@
+#include "camproj/calibrate.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include <ceres/ceres.h>
+#include <ceres/product_manifold.h>
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include "fit/closed_form.h"
+#include "fit/reprojection_error.h"
+#include "fit/zhang.h"
+
+namespace camproj {
+
+void CalibrateOptions::Check() const {
+  image_size.Check();
+  if (num_radial < 0 || num_radial > 2) {
+    throw std::invalid_argument("CalibrateOptions.num_radial must be 0, 1 or 2, got " +
+                                std::to_string(num_radial));
+  }
+  if (max_iterations <= 0) {
+    throw std::invalid_argument("CalibrateOptions.max_iterations must be positive");
+  }
+  if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) ||
+      !(parameter_tolerance > 0.0)) {
+    throw std::invalid_argument("CalibrateOptions tolerances must be positive");
+  }
+}
+
+namespace {
+
+using internal::kFitIntrinsicsSize;
+
+// Intrinsics block entries (reprojection_error.h): [f, aspect, cx, cy, skew, k1, k2].
+constexpr int kAspect = 1, kCx = 2, kCy = 3, kSkew = 4, kK1 = 5, kK2 = 6;
+// Pose block: cam_from_world as an Eigen quaternion (x, y, z, w), then the camera centre.
+constexpr int kPoseSize = 7;
+// A view is read as planar for the start when its points' thinnest extent is below this share of
+// their widest (the refinement always uses the points as given).
+constexpr double kPlanarShare = 1e-3;
+
+// One point of one view, analytic: the single-view fitter's residual with the rotation and the
+// centre in one block (DENSE_SCHUR eliminates a view's pose as one block).
+class ViewPointCost : public ceres::SizedCostFunction<2, kPoseSize, kFitIntrinsicsSize> {
+ public:
+  ViewPointCost(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
+      : point_(point), observed_(observed) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* pose = parameters[0];
+    double jq[8], jc[6];
+    const bool pose_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
+    if (!internal::ProjectPointWithJacobian(pose, pose + 4, parameters[1], point_, observed_,
+                                            residuals, pose_jacobian ? jq : nullptr,
+                                            pose_jacobian ? jc : nullptr,
+                                            jacobians != nullptr ? jacobians[1] : nullptr)) {
+      return false;  // behind the camera: an invalid step, not an infinite residual
+    }
+    if (pose_jacobian) {
+      for (int row = 0; row < 2; ++row) {
+        double* out = jacobians[0] + row * kPoseSize;
+        std::copy(jq + 4 * row, jq + 4 * row + 4, out);
+        std::copy(jc + 3 * row, jc + 3 * row + 3, out + 4);
+      }
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d point_;
+  Eigen::Vector2d observed_;
+};
+
+void CheckView(const CalibrationView& view, size_t index) {
+  const std::string name = "view " + std::to_string(index + 1) +
+                           (view.name.empty() ? "" : " (" + view.name + ")");
+  if (view.points_in_world.size() != view.pixels.size()) {
+    throw std::invalid_argument(name + " has " + std::to_string(view.points_in_world.size()) +
+                                " points but " + std::to_string(view.pixels.size()) + " pixels");
+  }
+  if (view.points_in_world.size() < 4) {
+    throw std::invalid_argument(name + " has " + std::to_string(view.points_in_world.size()) +
+                                " points; a view needs at least 4");
+  }
+  for (size_t i = 0; i < view.pixels.size(); ++i) {
+    if (!view.points_in_world[i].allFinite() || !view.pixels[i].allFinite()) {
+      throw std::invalid_argument(name + ": point " + std::to_string(i + 1) +
+                                  " has a non-finite coordinate");
+    }
+  }
+}
+
+std::string ViewName(const CalibrationView& view, size_t index) {
+  return view.name.empty() ? "view " + std::to_string(index + 1) : view.name;
+}
+
+// The view's points in the coordinates of their best-fitting plane, if they are planar (see
+// kPlanarShare).
+std::optional<std::vector<Eigen::Vector2d>> PlaneCoordinates(
+    const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) centroid += p;
+  centroid /= static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  // Eigenvalues ascending: extents are their square roots.
+  const Eigen::Vector3d extent = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  if (!(extent(2) > 0.0) || extent(0) > kPlanarShare * extent(2)) return std::nullopt;
+  const Eigen::Vector3d axis_u = eigen.eigenvectors().col(2);
+  const Eigen::Vector3d axis_v = eigen.eigenvectors().col(1);
+  std::vector<Eigen::Vector2d> plane;
+  plane.reserve(points.size());
+  for (const auto& p : points) plane.emplace_back((p - centroid).dot(axis_u), (p - centroid).dot(axis_v));
+  return plane;
+}
+
+double Median(std::vector<double> values) {
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double median = values[mid];
+  if (values.size() % 2 == 0) {
+    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
+  }
+  return median;
+}
+
+// The fixed entries of the intrinsics: their values where the options fix them.
+Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& options) {
+  if (!options.principal_point_free) {
+    intrinsics.cx = 0.5 * (options.image_size.width - 1);
+    intrinsics.cy = 0.5 * (options.image_size.height - 1);
+  }
+  if (!options.aspect_free) intrinsics.fx = intrinsics.fy = std::sqrt(intrinsics.fx * intrinsics.fy);
+  if (!options.skew_free) intrinsics.skew = 0.0;
+  intrinsics.k1 = intrinsics.k2 = 0.0;
+  return intrinsics;
+}
+
+// The closed-form intrinsics: Zhang's from the planar views when there are enough of them,
+// else the median of the 3D views' DLT. std::nullopt when neither determines K.
+std::optional<Intrinsics> StartIntrinsics(const std::vector<CalibrationView>& views,
+                                          const CalibrateOptions& options) {
+  const internal::ZhangModel model{options.aspect_free, options.principal_point_free,
+                                   options.skew_free};
+  std::vector<Eigen::Matrix3d> homographies;
+  std::vector<double> fx, fy, cx, cy, skew;
+  for (const CalibrationView& view : views) {
+    if (const auto plane = PlaneCoordinates(view.points_in_world)) {
+      homographies.push_back(internal::NormalizedHomography(*plane, view.pixels));
+      continue;
+    }
+    if (view.points_in_world.size() < 6) continue;
+    // The DLT in a world centred and scaled to unit RMS distance (K does not change).
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& p : view.points_in_world) centroid += p;
+    centroid /= static_cast<double>(view.points_in_world.size());
+    double sum_squares = 0.0;
+    for (const auto& p : view.points_in_world) sum_squares += (p - centroid).squaredNorm();
+    const double scale = std::sqrt(sum_squares / view.points_in_world.size());
+    std::vector<Eigen::Vector3d> normalized;
+    for (const auto& p : view.points_in_world) normalized.push_back((p - centroid) / scale);
+    try {
+      const internal::StartCamera start = internal::DltStart(normalized, view.pixels);
+      fx.push_back(start.intrinsics.fx);
+      fy.push_back(start.intrinsics.fy);
+      cx.push_back(start.intrinsics.cx);
+      cy.push_back(start.intrinsics.cy);
+      skew.push_back(start.intrinsics.skew);
+    } catch (const SceneError&) {
+      // This view starts nothing; the refinement still uses it.
+    }
+  }
+  if (!homographies.empty()) {
+    if (auto zhang = internal::ZhangIntrinsics(homographies, options.image_size, model)) {
+      return WithFixedEntries(*zhang, options);
+    }
+  }
+  if (!fx.empty()) {
+    Intrinsics intrinsics;
+    intrinsics.fx = Median(fx);
+    intrinsics.fy = Median(fy);
+    intrinsics.cx = Median(cx);
+    intrinsics.cy = Median(cy);
+    intrinsics.skew = Median(skew);
+    return WithFixedEntries(intrinsics, options);
+  }
+  // Last: the principal point at the centre, square pixels, the focal length alone.
+  if (!homographies.empty()) {
+    if (auto focal = internal::ZhangIntrinsics(homographies, options.image_size, {false, false, false})) {
+      return WithFixedEntries(*focal, options);
+    }
+  }
+  return std::nullopt;
+}
+
+std::vector<int> FixedIntrinsicEntries(const CalibrateOptions& options) {
+  std::vector<int> fixed;
+  if (!options.aspect_free) fixed.push_back(kAspect);
+  if (!options.principal_point_free) {
+    fixed.push_back(kCx);
+    fixed.push_back(kCy);
+  }
+  if (!options.skew_free) fixed.push_back(kSkew);
+  if (options.num_radial < 1) fixed.push_back(kK1);
+  if (options.num_radial < 2) fixed.push_back(kK2);
+  return fixed;
+}
+
+}  // namespace
+
+Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
+  options.Check();
+  if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
+  for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
+
+  const std::vector<int> fixed = FixedIntrinsicEntries(options);
+  const int free_intrinsics = kFitIntrinsicsSize - static_cast<int>(fixed.size());
+  int num_points = 0;
+  for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
+  const int num_parameters = 6 * static_cast<int>(views.size()) + free_intrinsics;
+  if (2 * num_points <= num_parameters) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     std::to_string(num_points) + " points in " + std::to_string(views.size()) +
+                         " views give " + std::to_string(2 * num_points) +
+                         " equations for " + std::to_string(num_parameters) +
+                         " unknowns (6 per view and " + std::to_string(free_intrinsics) +
+                         " intrinsics): add views or points, or fix intrinsics");
+  }
+
+  // A plane's homography gives two constraints on K (Zhang): planar views alone determine at
+  // most twice their number of K's entries, whatever distortion adds in theory.
+  int planar_views = 0;
+  for (const auto& view : views) planar_views += PlaneCoordinates(view.points_in_world) ? 1 : 0;
+  const int free_k_entries = 1 + (options.aspect_free ? 1 : 0) +
+                             (options.principal_point_free ? 2 : 0) + (options.skew_free ? 1 : 0);
+  if (planar_views == static_cast<int>(views.size()) && 2 * planar_views < free_k_entries) {
+    throw SceneError(SceneError::Reason::kPlanarUnderdetermined,
+                     std::to_string(planar_views) + " planar view" +
+                         (planar_views == 1 ? "" : "s") + " determine at most " +
+                         std::to_string(2 * planar_views) + " of the camera matrix's " +
+                         std::to_string(free_k_entries) +
+                         " free entries (a plane gives two constraints): add views of the "
+                         "board at other tilts, or fix the principal point and the aspect");
+  }
+
+  const std::optional<Intrinsics> start = StartIntrinsics(views, options);
+  if (!start) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the views do not determine the intrinsics in closed form (planar boards "
+                     "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
+                     "add views at other angles, or fix the principal point and the aspect");
+  }
+
+  // Blocks: a pose per view from SQPnP with the start's K, one shared intrinsics block.
+  std::vector<std::array<double, kPoseSize>> poses(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    internal::StartCamera camera;
+    if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, *start, &camera)) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       ViewName(views[i], i) + ": no pose from its points with the start's "
+                       "intrinsics (SQPnP failed); check the view's correspondences");
+    }
+    const Eigen::Quaterniond q(camera.rotation);
+    poses[i] = {q.x(), q.y(), q.z(), q.w(), camera.center.x(), camera.center.y(),
+                camera.center.z()};
+  }
+  double k[kFitIntrinsicsSize] = {start->fx, start->fy / start->fx, start->cx, start->cy,
+                                  start->skew, 0.0, 0.0};
+
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
+  std::unique_ptr<ceres::SubsetManifold> intrinsics_manifold;
+  for (size_t i = 0; i < views.size(); ++i) {
+    for (size_t j = 0; j < views[i].pixels.size(); ++j) {
+      problem.AddResidualBlock(new ViewPointCost(views[i].points_in_world[j], views[i].pixels[j]),
+                               nullptr, poses[i].data(), k);
+    }
+    problem.SetManifold(poses[i].data(), &pose_manifold);
+  }
+  if (!fixed.empty()) {
+    intrinsics_manifold = std::make_unique<ceres::SubsetManifold>(kFitIntrinsicsSize, fixed);
+    problem.SetManifold(k, intrinsics_manifold.get());
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (auto& pose : poses) ordering->AddElementToGroup(pose.data(), 0);
+  ordering->AddElementToGroup(k, 1);
+  solver_options.linear_solver_ordering = ordering;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
+    throw SceneError(SceneError::Reason::kNumerical,
+                     "the joint refinement failed: " + summary.message);
+  }
+
+  Calibration result;
+  result.image_size = options.image_size;
+  result.start = *start;
+  result.intrinsics.fx = k[0];
+  result.intrinsics.fy = k[kAspect] * k[0];
+  result.intrinsics.cx = k[kCx];
+  result.intrinsics.cy = k[kCy];
+  result.intrinsics.skew = k[kSkew];
+  result.intrinsics.k1 = k[kK1];
+  result.intrinsics.k2 = k[kK2];
+  result.num_points = num_points;
+  result.num_parameters = num_parameters;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.termination = summary.message;
+  double sum_squares = 0.0;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const Eigen::Map<const Eigen::Quaterniond> q(poses[i].data());
+    const Eigen::Vector3d center(poses[i][4], poses[i][5], poses[i][6]);
+    CalibratedView view;
+    view.name = ViewName(views[i], i);
+    view.cam_from_world = CamFromWorldFromCenter(q.normalized().toRotationMatrix(), center);
+    view.num_points = static_cast<int>(views[i].pixels.size());
+    double view_sum = 0.0;
+    for (size_t j = 0; j < views[i].pixels.size(); ++j) {
+      double residual[2];
+      if (!internal::ProjectPointWithJacobian(poses[i].data(), poses[i].data() + 4, k,
+                                              views[i].points_in_world[j], views[i].pixels[j],
+                                              residual, nullptr, nullptr, nullptr)) {
+        throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                         view.name + ": point " + std::to_string(j + 1) +
+                             " is behind the calibrated camera");
+      }
+      view_sum += residual[0] * residual[0] + residual[1] * residual[1];
+    }
+    view.rms_px = std::sqrt(view_sum / view.num_points);
+    sum_squares += view_sum;
+    result.views.push_back(view);
+  }
+  result.rms_px = std::sqrt(sum_squares / num_points);
+
+  if (options.compute_uncertainty) {
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.null_space_rank = 0;  // a rank-deficient problem is refused, not pseudo-inverted
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{k, k}};
+    if (!covariance.Compute(blocks, &problem)) {
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "the views do not determine every free intrinsic (the covariance is "
+                       "singular): add views at other angles, or fix the principal point, the "
+                       "aspect or the distortion");
+    }
+    Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize, Eigen::RowMajor> c;
+    covariance.GetCovarianceBlock(k, k, c.data());
+    c *= sum_squares / (2.0 * num_points - num_parameters);
+    auto add = [&](const std::string& name, double value, double variance, const std::string& unit) {
+      result.intrinsics_sigma.push_back({name, value, std::sqrt(std::max(variance, 0.0)), unit});
+    };
+    add("fx", k[0], c(0, 0), "px");
+    if (options.aspect_free) {
+      // fy = aspect * f: its gradient in (f, aspect) is (aspect, f).
+      const Eigen::Vector2d g(k[kAspect], k[0]);
+      add("fy", result.intrinsics.fy, g.dot(c.topLeftCorner<2, 2>() * g), "px");
+    }
+    if (options.principal_point_free) {
+      add("cx", k[kCx], c(kCx, kCx), "px");
+      add("cy", k[kCy], c(kCy, kCy), "px");
+    }
+    if (options.skew_free) add("skew", k[kSkew], c(kSkew, kSkew), "px");
+    if (options.num_radial >= 1) add("k1", k[kK1], c(kK1, kK1), "");
+    if (options.num_radial >= 2) add("k2", k[kK2], c(kK2, kK2), "");
+  }
+  return result;
+}
+
+}  // namespace camproj
