@@ -272,6 +272,33 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
                        ", --max-uncertainty). " + advice);
 }
 
+// The refusal of an orthographic camera chosen where the points show perspective
+// (fit/determination.h, TestPerspectiveStrength): it can only stand in for a perspective camera
+// the points did not determine, biased off the points (kDegenerate).
+void RefuseIfPerspectiveShows(const internal::PerspectiveTest& test, const std::string& left_out) {
+  if (!test.observable) return;
+  auto g3 = [](double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", value);
+    return std::string(buffer);
+  };
+  throw SceneError(
+      SceneError::Reason::kDegenerate,
+      "the points show perspective, which the orthographic camera chosen leaves out: freeing "
+      "its perspective strength would remove " + g3(test.removed_px2) + " of its " +
+          g3(test.sum_squares_px2) + " px^2 squared residuals, " + g3(test.statistic) +
+          " times the noise's square (" + Px(test.sigma_px) + " with it free; at most " +
+          g3(test.bound) + " where the depth spread is too small against the distance to "
+          "show perspective), and no perspective model was determined by them or fitted better. " +
+          (left_out.empty() ? std::string()
+                            : "Fix or drop " + left_out + " (left out: they disagree with the "
+                              "rest by far more than the noise); ") +
+          (left_out.empty() ? "Add" : "add") +
+          " points spread in depth and across the image, or give the intrinsics you know (e.g. "
+          "--principal-point for a projector's lens shift), so that a perspective camera can be "
+          "fitted");
+}
+
 // A selection with every point's residual against its camera, recomputed in world coordinates
 // from the camera as returned (and as the camera file stores it), and the gate on the points
 // kept: computed once per selection, read by the pipeline and by the assessment.
@@ -342,6 +369,12 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   if (mirrored) gated.selection.rivals.push_back(*mirrored);
   for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, kept_pixels, size)) {
     gated.selection.rivals.push_back(std::move(rival));
+  }
+  if (options.fit.projection == Projection::kPerspective) {
+    // Chosen, not forced: orthographic only where the perspective is not observable.
+    RefuseIfPerspectiveShows(
+        internal::TestPerspectiveStrength(gated.selection, kept_points, options),
+        LeftOutText(gated.residuals_px, left_out, names));
   }
   const DeterminationCheck determination =
       internal::CheckDetermination(gated.selection, kept_points, options);

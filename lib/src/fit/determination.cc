@@ -17,6 +17,7 @@
 #include "check.h"
 #include "fit/common.h"
 #include "fit/gate.h"
+#include "fit/statistics.h"
 
 namespace camproj {
 namespace internal {
@@ -248,6 +249,18 @@ class PixelUncertainty {
     return rows * rows.transpose();
   }
 
+  // r^T H r with H = J (J^T J)^-1 J^T, r the fitted points' residuals (pixel minus observed, in
+  // the order of fitted_points): by how much a Gauss-Newton step with every parameter free
+  // lowers their sum of squares. 0 where J^T J is singular.
+  double HatQuadratic(const std::vector<Eigen::Vector2d>& residuals) const {
+    if (singular_) return 0.0;
+    Eigen::VectorXd gradient = Eigen::VectorXd::Zero(whitening_.rows());
+    for (size_t i = 0; i < residuals.size(); ++i) {
+      gradient.noalias() += FittedRows(i).transpose() * residuals[i];
+    }
+    return (whitening_.transpose() * gradient).squaredNorm();
+  }
+
   // SigmaAt of fitted point i (J's rows 2i, 2i+1; in front of the camera, as the constructor
   // checked).
   double SigmaAtFitted(size_t i) const {
@@ -430,6 +443,45 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
   sigmas.reserve(test_points.size());
   for (const Eigen::Vector3d& x : test_points) sigmas.push_back(uncertainty.SigmaAt(x));
   return sigmas;
+}
+
+PerspectiveTest TestPerspectiveStrength(const Selection& selection,
+                                        const std::vector<Eigen::Vector3d>& kept_points,
+                                        const AutoFitOptions& options) {
+  PerspectiveTest test;
+  const std::vector<Eigen::Vector2d>& residuals = selection.fit.residuals_px;
+  if (selection.fit.camera.projection != Projection::kOrthographic ||
+      residuals.size() != kept_points.size() || kept_points.empty()) {
+    return test;
+  }
+  test.checked = true;
+  // In the points' centred, unit-RMS world, as CheckDetermination's.
+  const Eigen::Vector3d origin = Centroid(kept_points);
+  Eigen::MatrixXd centred(kept_points.size(), 3);
+  for (size_t i = 0; i < kept_points.size(); ++i) {
+    centred.row(i) = (kept_points[i] - origin).transpose();
+  }
+  const double unit = RmsRowLength(centred);
+  std::vector<Eigen::Vector3d> points(kept_points.size());
+  for (size_t i = 0; i < kept_points.size(); ++i) points[i] = centred.row(i).transpose() / unit;
+  const Camera camera = InUnitWorld(selection.fit.camera, origin, unit);
+  for (const Eigen::Vector2d& r : residuals) test.sum_squares_px2 += r.squaredNorm();
+  try {
+    test.removed_px2 = std::min(test.sum_squares_px2,
+                                PixelUncertainty(camera, selection.options, points, 1.0)
+                                    .HatQuadratic(residuals));
+  } catch (const std::invalid_argument&) {
+    return test;  // a point behind the camera: the determination check says so
+  }
+  const double dof = 2.0 * static_cast<double>(kept_points.size()) -
+                     static_cast<double>(selection.fit.free_parameters.size()) - 1.0;
+  test.sigma_px = options.fit.pixel_sigma
+                      ? *options.fit.pixel_sigma
+                      : CombinedNoise(options, test.sum_squares_px2 - test.removed_px2, dof);
+  test.statistic = test.removed_px2 / (test.sigma_px * test.sigma_px);
+  test.bound = ChiSquareQuantile(1.0, 1.0 - options.significance);
+  test.observable = test.statistic > test.bound;
+  return test;
 }
 
 DeterminationCheck CheckDetermination(const Selection& selection,

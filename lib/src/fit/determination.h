@@ -45,6 +45,30 @@ DeterminationCheck CheckDetermination(const Selection& selection,
                                       const std::vector<Eigen::Vector3d>& kept_points,
                                       const AutoFitOptions& options);
 
+// Whether an orthographic answer's perspective is observable: the test of "the depth spread is
+// small against the distance". The orthographic camera is the limit e = 0 of the perspective
+// strength e (pixel = c + (u_ortho - c) / (1 + e z_cam), ParametersOf in determination.cc);
+// freeing e would lower the kept points' sum of squares J by removed_px2 = r^T H r, linearized
+// (H the hat matrix of the Jacobian with e free, r the selection's residuals, kept points in
+// order). The statistic is that in units of the noise with e free: options.fit.pixel_sigma if
+// given, else the prior combined with J - removed_px2 over 2N - p - 1 degrees of freedom
+// (CombinedNoise: as the selection's noise comes from its richest model, and e is one parameter
+// richer than the orthographic camera). Above chi2_1(1 - significance) (10.83 at 0.1 %) the
+// points show a perspective the orthographic camera leaves out. Not checked (checked = false)
+// for a perspective answer.
+struct PerspectiveTest {
+  bool checked = false;
+  bool observable = false;  // statistic > bound
+  double sum_squares_px2 = 0.0;  // J
+  double removed_px2 = 0.0;
+  double sigma_px = 0.0;
+  double statistic = 0.0;
+  double bound = 0.0;
+};
+PerspectiveTest TestPerspectiveStrength(const Selection& selection,
+                                        const std::vector<Eigen::Vector3d>& kept_points,
+                                        const AutoFitOptions& options);
+
 }  // namespace internal
 }  // namespace camproj
 
