@@ -1014,6 +1014,33 @@ print("[ RATE ] fitted camera beyond 4 sigma of the truth: %d / %d (bound %d)" %
 sys.exit(0 if answered >= 15 and beyond <= bound else 1)
 PY
     ;;
+  calibrate_chessboard)
+    # OpenCV's left chessboard views: one calibration, the intrinsics at the top level of the file
+    # (fit --intrinsics takes it: a pose-only fit), each view a camera file export takes, the
+    # poses table one row per view; one view alone is refused and writes nothing.
+    boards="$data/real/opencv_chessboard"
+    expect_exit 0 "$bin" calibrate "$boards"/left*.csv --image-size 640x480 -o "$work/left.json" --poses "$work/poses.csv"
+    expect_in out "^calibrated 13 views, 702 points: rms 0.41"
+    expect_in out "^  k1 "
+    [[ $(wc -l <"$work/poses.csv") -eq 14 ]] || fail "poses.csv has not 13 rows:\n$(cat "$work/poses.csv")"
+    expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/left.json" -o "$work/v3.json"
+    expect_in out "model: pose, 6 free parameters"
+    py - "$work/left.json" "$work/view3.json" <<'PY' || fail "views[2].camera is not a camera file"
+import json, sys
+calibration = json.load(open(sys.argv[1]))
+assert calibration["views"][2]["name"] == "left03", calibration["views"][2]["name"]
+json.dump(calibration["views"][2]["camera"], open(sys.argv[2], "w"))
+PY
+    expect_exit 0 "$bin" export "$work/view3.json" --to json
+    expect_exit 0 "$bin" project "$work/view3.json" "$boards/left03.csv"
+    expect_exit 3 "$bin" calibrate "$boards/left01.csv" --image-size 640x480 -o "$work/one.json"
+    expect_in err "1 planar view determines at most 2 of the camera matrix's 4 free entries"
+    [[ ! -e "$work/one.json" ]] || fail "a refused calibration wrote its file"
+    mkdir "$work/right" && cp "$boards"/right*.csv "$work/right/"
+    expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --fix aspect,principal-point,k2 -o "$work/right.json"
+    expect_in out "^calibrated 13 views"
+    expect_not_in out "^  fy "
+    ;;
   *) fail "unknown case" ;;
 esac
 echo "ok [$case]"

@@ -1,7 +1,9 @@
 #include "cli.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 
 namespace camproj::cli {
 
@@ -52,6 +54,26 @@ std::vector<double> ParseNumbers(const std::string& text, size_t count, const st
                      text + "\"");
   }
   return numbers;
+}
+
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {
+  std::vector<std::string> inputs;
+  for (const std::string& path : paths) {
+    if (!std::filesystem::is_directory(path)) {
+      inputs.push_back(path);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (const auto& entry : std::filesystem::directory_iterator(path)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".csv") {
+        found.push_back(entry.path().string());
+      }
+    }
+    if (found.empty()) throw UsageError(path + ": a folder without *.csv files");
+    std::sort(found.begin(), found.end());
+    inputs.insert(inputs.end(), found.begin(), found.end());
+  }
+  return inputs;
 }
 
 }  // namespace camproj::cli

@@ -30,6 +30,10 @@ ImageSize ParseImageSize(const std::string& text, const std::string& option);
 // "a,b,c" -> exactly `count` finite numbers; throws UsageError naming `option`.
 std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option);
 
+// Files named on the command line, a folder standing for its *.csv files (sorted); throws
+// UsageError for a folder without any.
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths);
+
 // A registered subcommand: Run() is called when it was selected.
 struct Command {
   CLI::App* app = nullptr;
@@ -43,6 +47,7 @@ Command AddConvertCommand(CLI::App& root);
 Command AddSynthCommand(CLI::App& root);
 Command AddOverlayCommand(CLI::App& root);
 Command AddViewCommand(CLI::App& root);
+Command AddCalibrateCommand(CLI::App& root);
 
 }  // namespace camproj::cli
 

@@ -184,27 +184,6 @@ std::string CameraFileTextOf(const FitResult& fit, PixelOrigin pixel_origin) {
   return FitCameraFileText(fit, pixel_origin);
 }
 
-// Files named on the command line, a folder standing for its *.csv files (sorted).
-std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {
-  std::vector<std::string> inputs;
-  for (const std::string& path : paths) {
-    if (!std::filesystem::is_directory(path)) {
-      inputs.push_back(path);
-      continue;
-    }
-    std::vector<std::string> found;
-    for (const auto& entry : std::filesystem::directory_iterator(path)) {
-      if (entry.is_regular_file() && entry.path().extension() == ".csv") {
-        found.push_back(entry.path().string());
-      }
-    }
-    if (found.empty()) throw UsageError(path + ": a folder without *.csv files");
-    std::sort(found.begin(), found.end());
-    inputs.insert(inputs.end(), found.begin(), found.end());
-  }
-  return inputs;
-}
-
 // One row of the batch summary.
 struct BatchRow {
   std::string input;

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands = {AddFitCommand(app),     AddExportCommand(app),
                                          AddProjectCommand(app), AddConvertCommand(app),
                                          AddSynthCommand(app),   AddOverlayCommand(app),
-                                         AddViewCommand(app)};
+                                         AddViewCommand(app),
+                                         AddCalibrateCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -45,6 +46,8 @@ constexpr int kPoseSize = 7;
 // A view is read as planar for the start when its points' thinnest extent is below this share of
 // their widest (the refinement always uses the points as given).
 constexpr double kPlanarShare = 1e-3;
+// Each view's near / far planes sit this share outside its points' depths (FitOptions' default).
+constexpr double kDepthMargin = 0.1;
 
 // One point of one view, analytic: the single-view fitter's residual with the rotation and the
 // centre in one block (DENSE_SCHUR eliminates a view's pose as one block).
@@ -244,7 +247,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   if (planar_views == static_cast<int>(views.size()) && 2 * planar_views < free_k_entries) {
     throw SceneError(SceneError::Reason::kPlanarUnderdetermined,
                      std::to_string(planar_views) + " planar view" +
-                         (planar_views == 1 ? "" : "s") + " determine at most " +
+                         (planar_views == 1 ? " determines" : "s determine") + " at most " +
                          std::to_string(2 * planar_views) + " of the camera matrix's " +
                          std::to_string(free_k_entries) +
                          " free entries (a plane gives two constraints): add views of the "
@@ -331,9 +334,12 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     const Eigen::Vector3d center(poses[i][4], poses[i][5], poses[i][6]);
     CalibratedView view;
     view.name = ViewName(views[i], i);
-    view.cam_from_world = CamFromWorldFromCenter(q.normalized().toRotationMatrix(), center);
+    view.camera.image_size = options.image_size;
+    view.camera.intrinsics = result.intrinsics;
+    view.camera.cam_from_world = CamFromWorldFromCenter(q.normalized().toRotationMatrix(), center);
     view.num_points = static_cast<int>(views[i].pixels.size());
     double view_sum = 0.0;
+    double min_depth = std::numeric_limits<double>::infinity(), max_depth = 0.0;
     for (size_t j = 0; j < views[i].pixels.size(); ++j) {
       double residual[2];
       if (!internal::ProjectPointWithJacobian(poses[i].data(), poses[i].data() + 4, k,
@@ -344,7 +350,12 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
                              " is behind the calibrated camera");
       }
       view_sum += residual[0] * residual[0] + residual[1] * residual[1];
+      const double depth = (view.camera.cam_from_world * views[i].points_in_world[j]).z();
+      min_depth = std::min(min_depth, depth);
+      max_depth = std::max(max_depth, depth);
     }
+    view.camera.z_near = min_depth / (1.0 + kDepthMargin);
+    view.camera.z_far = max_depth * (1.0 + kDepthMargin);
     view.rms_px = std::sqrt(view_sum / view.num_points);
     sum_squares += view_sum;
     result.views.push_back(view);

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "camproj/camera.h"
 #include "camproj/conventions.h"
 #include "camproj/fit.h"
 #include "camproj/intrinsics.h"
@@ -59,7 +60,9 @@ struct CalibrateOptions {
 
 struct CalibratedView {
   std::string name;
-  Rigid3 cam_from_world;  // the view's world frame -> camera
+  // The shared intrinsics with this view's pose (cam_from_world: the view's world frame ->
+  // camera), and near / far around its points' depths (depth margin 0.1, as a fit's).
+  Camera camera;
   int num_points = 0;
   double rms_px = 0.0;    // sqrt(mean |r|^2) over this view's points
 };

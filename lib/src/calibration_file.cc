@@ -1,0 +1,74 @@
+#include "camproj/calibration_file.h"
+
+#include <charconv>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "camproj/look_at.h"
+
+namespace camproj {
+
+namespace {
+
+std::string Number(double value) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  (void)error;
+  return std::string(buffer, end);
+}
+
+}  // namespace
+
+std::string CalibrationToJsonText(const Calibration& calibration,
+                                  const CameraFileOptions& options) {
+  options.Check();
+  const Intrinsics k =
+      ConvertPixelOrigin(calibration.intrinsics, PixelOrigin::kCenter, options.pixel_origin);
+  nlohmann::ordered_json file;
+  file["calibration"] = "camproj calibrate: intrinsics shared by every view, a pose per view";
+  file["image_size"] = {calibration.image_size.width, calibration.image_size.height};
+  file["pixel_origin"] = ToString(options.pixel_origin);
+  file["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+                        {"skew", k.skew}, {"k1", k.k1}, {"k2", k.k2}};
+  nlohmann::ordered_json sigma = nlohmann::ordered_json::object();
+  for (const ParameterSigma& p : calibration.intrinsics_sigma) sigma[p.name] = p.sigma;
+  file["sigma"] = sigma;
+  file["rms_px"] = calibration.rms_px;
+  file["num_points"] = calibration.num_points;
+  file["num_parameters"] = calibration.num_parameters;
+  file["solver"] = {{"iterations", calibration.iterations},
+                    {"termination", calibration.termination}};
+  nlohmann::ordered_json views = nlohmann::ordered_json::array();
+  for (const CalibratedView& view : calibration.views) {
+    views.push_back({{"name", view.name},
+                     {"num_points", view.num_points},
+                     {"rms_px", view.rms_px},
+                     {"camera", nlohmann::ordered_json::parse(CameraToJsonText(view.camera, options))}});
+  }
+  file["views"] = views;
+  return file.dump(2) + "\n";
+}
+
+std::string CalibrationPosesCsvText(const Calibration& calibration,
+                                    const CameraFileOptions& options) {
+  options.Check();
+  std::ostringstream out;
+  out << "view,eye_x,eye_y,eye_z,target_x,target_y,target_z,up_x,up_y,up_z,"
+         "r00,r01,r02,r10,r11,r12,r20,r21,r22,t_x,t_y,t_z\n";
+  for (const CalibratedView& view : calibration.views) {
+    const Rigid3& pose = view.camera.cam_from_world;
+    const LookAt look_at = LookAtFromCamFromWorld(pose, options.target_distance);
+    out << view.name;
+    for (const Eigen::Vector3d* v : {&look_at.eye, &look_at.target, &look_at.up}) {
+      for (int i = 0; i < 3; ++i) out << ',' << Number((*v)(i));
+    }
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out << ',' << Number(pose.rotation(r, c));
+    for (int i = 0; i < 3; ++i) out << ',' << Number(pose.translation(i));
+    out << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace camproj
