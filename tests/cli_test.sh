@@ -1022,6 +1022,7 @@ PY
     expect_exit 0 "$bin" calibrate "$boards"/left*.csv --image-size 640x480 -o "$work/left.json" --poses "$work/poses.csv"
     expect_in out "^calibrated 13 views, 702 points: rms 0.41"
     expect_in out "^  k1 "
+    expect_in out "^cross-validation: the even and the odd views calibrated apart (7 and 6) put the image's pixels [0-9.]* px apart"
     [[ $(wc -l <"$work/poses.csv") -eq 14 ]] || fail "poses.csv has not 13 rows:\n$(cat "$work/poses.csv")"
     expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/left.json" -o "$work/v3.json"
     expect_in out "model: pose, 6 free parameters"

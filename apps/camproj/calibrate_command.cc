@@ -108,6 +108,21 @@ Command AddCalibrateCommand(CLI::App& root) {
               out << "  " << std::left << std::setw(5) << p.name << std::right << value << " +- "
                   << p.sigma << (p.unit.empty() ? "" : " " + p.unit) << '\n';
             }
+            const CrossValidation& cv = calibration.cross_validation;
+            if (cv.done) {
+              out << "cross-validation: the even and the odd views calibrated apart (" << cv.views_a
+                  << " and " << cv.views_b << ") put the image's pixels " << std::setprecision(3)
+                  << cv.rms_px << " px apart (RMS over a 16 x 12 grid; max " << cv.max_px
+                  << " px); their covariances predict " << cv.predicted_rms_px << " px";
+              if (cv.rms_px > 3.0 * cv.predicted_rms_px) {
+                out << ": more than 3 times that, so the views do not share one camera as this "
+                       "model describes it (a view that does not belong, or a lens that needs more "
+                       "than k1, k2)";
+              }
+              out << '\n' << std::setprecision(6);
+            } else {
+              out << "cross-validation: not done: " << cv.why_not << '\n';
+            }
             out << "views (rms px):";
             for (const CalibratedView& view : calibration.views) {
               out << ' ' << view.name << ' ' << std::setprecision(3) << view.rms_px;

@@ -217,6 +217,122 @@ std::vector<int> FixedIntrinsicEntries(const CalibrateOptions& options) {
   return fixed;
 }
 
+// The fit layout [f, aspect, cx, cy, skew, k1, k2] of intrinsics.
+Eigen::Matrix<double, kFitIntrinsicsSize, 1> FitLayout(const Intrinsics& k) {
+  Eigen::Matrix<double, kFitIntrinsicsSize, 1> p;
+  p << k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2;
+  return p;
+}
+
+Intrinsics FromFitLayout(const Eigen::Matrix<double, kFitIntrinsicsSize, 1>& p) {
+  Intrinsics k;
+  k.fx = p(0);
+  k.fy = p(1) * p(0);
+  k.cx = p(kCx);
+  k.cy = p(kCy);
+  k.skew = p(kSkew);
+  k.k1 = p(kK1);
+  k.k2 = p(kK2);
+  return k;
+}
+
+// pixel_B(ray_A(pixel)): the pixel half B's camera gives the ray half A's camera sees at `pixel`.
+// std::nullopt where A's lens folds before that pixel (no ray).
+std::optional<Eigen::Vector2d> Transfer(const Intrinsics& a, const Intrinsics& b,
+                                        const Eigen::Vector2d& pixel) {
+  try {
+    const Eigen::Vector3d ray = CamRayFromPixel(a, pixel);
+    return PixelFromCam(b, ray);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
+                              const CalibrateOptions& options) {
+  CrossValidation cv;
+  if (!options.compute_uncertainty) {
+    cv.why_not = "needs the covariance (compute_uncertainty)";
+    return cv;
+  }
+  if (views.size() < 4) {
+    cv.why_not = "needs at least 4 views (2 per half), got " + std::to_string(views.size());
+    return cv;
+  }
+  std::vector<CalibrationView> half[2];
+  for (size_t i = 0; i < views.size(); ++i) half[i % 2].push_back(views[i]);
+  CalibrateOptions half_options = options;
+  half_options.cross_validate = false;
+  Calibration c[2];
+  for (int h = 0; h < 2; ++h) {
+    try {
+      c[h] = Calibrate(half[h], half_options);
+    } catch (const SceneError& e) {
+      cv.why_not = std::string(h == 0 ? "the even" : "the odd") + " views alone: " + e.what();
+      return cv;
+    }
+  }
+  cv.views_a = static_cast<int>(half[0].size());
+  cv.views_b = static_cast<int>(half[1].size());
+  const Eigen::Matrix<double, kFitIntrinsicsSize, 1> pa = FitLayout(c[0].intrinsics);
+  const Eigen::Matrix<double, kFitIntrinsicsSize, 1> pb = FitLayout(c[1].intrinsics);
+  constexpr int kGridX = 16, kGridY = 12;
+  double sum_squares = 0.0, sum_predicted = 0.0;
+  int count = 0;
+  for (int gy = 0; gy < kGridY; ++gy) {
+    for (int gx = 0; gx < kGridX; ++gx) {
+      const Eigen::Vector2d pixel((options.image_size.width - 1) * gx / (kGridX - 1.0),
+                                  (options.image_size.height - 1) * gy / (kGridY - 1.0));
+      const std::optional<Eigen::Vector2d> moved = Transfer(c[0].intrinsics, c[1].intrinsics, pixel);
+      if (!moved) continue;
+      // d moved / d (each half's parameters) by central differences, steps relative to each
+      // parameter's sigma (the covariance's scale, where the map is linear enough).
+      Eigen::Matrix<double, 2, 2> predicted = Eigen::Matrix2d::Zero();
+      bool ok = true;
+      for (int h = 0; h < 2 && ok; ++h) {
+        const Eigen::Matrix<double, kFitIntrinsicsSize, 1>& p = h == 0 ? pa : pb;
+        const Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize>& cov =
+            c[h].intrinsics_covariance;
+        Eigen::Matrix<double, 2, kFitIntrinsicsSize> jacobian = Eigen::Matrix<double, 2, kFitIntrinsicsSize>::Zero();
+        for (int j = 0; j < kFitIntrinsicsSize && ok; ++j) {
+          const double sigma = std::sqrt(cov(j, j));
+          if (!(sigma > 0.0)) continue;
+          const double step = 1e-3 * sigma;
+          Eigen::Matrix<double, kFitIntrinsicsSize, 1> plus = p, minus = p;
+          plus(j) += step;
+          minus(j) -= step;
+          const Intrinsics a_plus = h == 0 ? FromFitLayout(plus) : c[0].intrinsics;
+          const Intrinsics a_minus = h == 0 ? FromFitLayout(minus) : c[0].intrinsics;
+          const Intrinsics b_plus = h == 1 ? FromFitLayout(plus) : c[1].intrinsics;
+          const Intrinsics b_minus = h == 1 ? FromFitLayout(minus) : c[1].intrinsics;
+          const auto up = Transfer(a_plus, b_plus, pixel);
+          const auto down = Transfer(a_minus, b_minus, pixel);
+          if (!up || !down) {
+            ok = false;
+            break;
+          }
+          jacobian.col(j) = (*up - *down) / (2.0 * step);
+        }
+        predicted += jacobian * cov * jacobian.transpose();
+      }
+      if (!ok) continue;
+      const double distance = (*moved - pixel).norm();
+      sum_squares += distance * distance;
+      sum_predicted += predicted.trace();
+      cv.max_px = std::max(cv.max_px, distance);
+      ++count;
+    }
+  }
+  if (count == 0) {
+    cv.why_not = "no pixel of the grid has a ray in both halves' lenses";
+    return cv;
+  }
+  cv.rms_px = std::sqrt(sum_squares / count);
+  cv.predicted_rms_px = std::sqrt(sum_predicted / count);
+  cv.done = true;
+  return cv;
+}
+
 }  // namespace
 
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
@@ -377,6 +493,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize, Eigen::RowMajor> c;
     covariance.GetCovarianceBlock(k, k, c.data());
     c *= sum_squares / (2.0 * num_points - num_parameters);
+    result.intrinsics_covariance = c;
     auto add = [&](const std::string& name, double value, double variance, const std::string& unit) {
       result.intrinsics_sigma.push_back({name, value, std::sqrt(std::max(variance, 0.0)), unit});
     };
@@ -394,6 +511,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     if (options.num_radial >= 1) add("k1", k[kK1], c(kK1, kK1), "");
     if (options.num_radial >= 2) add("k2", k[kK2], c(kK2, kK2), "");
   }
+  if (options.cross_validate) result.cross_validation = CrossValidate(views, options);
   return result;
 }
 

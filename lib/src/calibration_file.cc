@@ -37,6 +37,14 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   file["rms_px"] = calibration.rms_px;
   file["num_points"] = calibration.num_points;
   file["num_parameters"] = calibration.num_parameters;
+  const CrossValidation& cv = calibration.cross_validation;
+  if (cv.done) {
+    file["cross_validation"] = {{"views_a", cv.views_a}, {"views_b", cv.views_b},
+                                {"rms_px", cv.rms_px}, {"max_px", cv.max_px},
+                                {"predicted_rms_px", cv.predicted_rms_px}};
+  } else {
+    file["cross_validation"] = {{"not_done", cv.why_not}};
+  }
   file["solver"] = {{"iterations", calibration.iterations},
                     {"termination", calibration.termination}};
   nlohmann::ordered_json views = nlohmann::ordered_json::array();

@@ -48,6 +48,9 @@ struct CalibrateOptions {
   bool skew_free = false;
   int num_radial = 2;                // 0 (none), 1 (k1) or 2 (k1, k2)
   bool compute_uncertainty = true;
+  // Also calibrate the even and the odd views apart and compare them (Calibration::
+  // cross_validation); needs compute_uncertainty and >= 4 views.
+  bool cross_validate = true;
   int max_iterations = 200;
   double function_tolerance = 1e-15;   // relative cost change
   double gradient_tolerance = 1e-15;
@@ -67,6 +70,23 @@ struct CalibratedView {
   double rms_px = 0.0;    // sqrt(mean |r|^2) over this view's points
 };
 
+// Two calibrations from disjoint halves of the views (even and odd positions), compared where it
+// matters — in the image (as mrcal does): a grid of 16 x 12 pixels over the image is taken to rays
+// by half A's intrinsics and back to pixels by half B's; the distance is what using one half's
+// camera in place of the other's would cost there. Its RMS over the grid against the RMS that the
+// two halves' covariances predict for it (to first order, their sum pushed through the same map):
+// a ratio well above 1 says the halves differ by more than their noise — views that do not share
+// one camera, or a model too simple for the lens.
+struct CrossValidation {
+  bool done = false;
+  std::string why_not;      // when not done: the reason (too few views, a half refused, ...)
+  int views_a = 0;          // even positions: 1st, 3rd, ...
+  int views_b = 0;
+  double rms_px = 0.0;      // RMS over the grid of |pixel_B(ray_A(u)) - u|
+  double max_px = 0.0;
+  double predicted_rms_px = 0.0;  // sqrt(mean over the grid of trace(Cov_A + Cov_B) there)
+};
+
 struct Calibration {
   ImageSize image_size;
   Intrinsics intrinsics;  // kCenter; entries not free hold their fixed values
@@ -77,6 +97,10 @@ struct Calibration {
   // 1-sigma of each free intrinsic ("fx", "fy", "cx", "cy", "skew", "k1", "k2"), px or unitless,
   // from the covariance above; empty unless compute_uncertainty.
   std::vector<ParameterSigma> intrinsics_sigma;
+  // The covariance of the intrinsics block [fx, fy / fx, cx, cy, skew, k1, k2] (px, 1, px, px,
+  // px, 1, 1), zero rows and columns for fixed entries; zero unless compute_uncertainty.
+  Eigen::Matrix<double, 7, 7> intrinsics_covariance = Eigen::Matrix<double, 7, 7>::Zero();
+  CrossValidation cross_validation;
   Intrinsics start;                   // the closed-form start's intrinsics
   int iterations = 0;
   std::string termination;            // Ceres' words
