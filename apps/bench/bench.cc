@@ -5,6 +5,7 @@
 //   bench --clicks [--quick] [--out DIR] [--scenes N]     (the click benchmark: clicks.h)
 //   bench --stage-cost [--n N,N,...] [--seeds K]          (the default path's cost: stage_cost.h)
 //   bench --memory [--n N,N,...] [--out DIR]              (memory per point: memory.h)
+//   bench --calibrate [--views N,...] [--sets K] [--out DIR] (many views vs calibrateCamera)
 //
 // Writes DIR/results.csv, DIR/results.json and DIR/table.md. Single-threaded (OpenCV is set to
 // one thread, Ceres runs with one), so 1 / median time is fits per second per core.
@@ -36,6 +37,7 @@
 #include "camproj/synth.h"
 #include "common.h"
 #include "clicks.h"
+#include "calibrate_bench.h"
 #include "memory.h"
 #include "stage_cost.h"
 
@@ -100,7 +102,8 @@ const char* kUsage =
     "bench --clicks [...] runs the click benchmark of the default fitting path instead\n"
     "(bench --clicks --help); bench --stage-cost [...] what the default path costs on clean\n"
     "scenes (bench --stage-cost --help); bench --memory [...] the fit's memory per point\n"
-    "(bench --memory --help).\n"
+    "(bench --memory --help); bench --calibrate [...] many-view calibration against\n"
+    "cv::calibrateCamera (bench --calibrate --help).\n"
     "\n"
     "Example:\n"
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
@@ -977,6 +980,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--clicks") return camproj::bench::ClicksMain(argc, argv);
     if (std::string(argv[i]) == "--stage-cost") return camproj::bench::StageCostMain(argc, argv);
     if (std::string(argv[i]) == "--memory") return camproj::bench::MemoryMain(argc, argv);
+    if (std::string(argv[i]) == "--calibrate") return camproj::bench::CalibrateMain(argc, argv);
   }
   camproj::bench::BenchOptions options;
   options.command = "bench";

@@ -480,8 +480,9 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
 
   if (options.compute_uncertainty) {
     ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.null_space_rank = 0;  // a rank-deficient problem is refused, not pseudo-inverted
+    // SPARSE_QR fails on a rank-deficient Jacobian: refused below, never pseudo-inverted. (DENSE_SVD
+    // decomposes the whole 2N x (6 views + 7) Jacobian: 1.2 s at 50 views, bench --calibrate.)
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
     ceres::Covariance covariance(covariance_options);
     const std::vector<std::pair<const double*, const double*>> blocks = {{k, k}};
     if (!covariance.Compute(blocks, &problem)) {

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -144,6 +147,75 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
   camera.z_near = min_depth / 1.1;
   camera.z_far = max_depth * 1.1;
   return scene;
+}
+
+void CalibrationSynthOptions::Check() const {
+  if (num_views < 1) {
+    throw std::invalid_argument("CalibrationSynthOptions.num_views must be >= 1, got " +
+                                std::to_string(num_views));
+  }
+  if (!(noise_px >= 0.0) || !std::isfinite(noise_px)) {
+    throw std::invalid_argument("CalibrationSynthOptions.noise_px must be finite and >= 0");
+  }
+  image_size.Check();
+  intrinsics.Check();
+}
+
+std::vector<CalibrationView> SynthesizeCalibrationViews(const CalibrationSynthOptions& options) {
+  options.Check();
+  std::vector<Eigen::Vector3d> points;
+  if (options.planar) {
+    for (int y = 0; y < 6; ++y)
+      for (int x = 0; x < 9; ++x) points.emplace_back(x, y, 0.0);
+  } else {
+    for (int z = 0; z < 3; ++z)
+      for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) points.emplace_back(2.0 * x, 2.0 * y, 2.0 * z);
+  }
+  const Eigen::Vector3d center = options.planar ? Eigen::Vector3d(4.0, 2.5, 0.0) : Eigen::Vector3d(3.0, 3.0, 2.0);
+  const double width = options.image_size.width, height = options.image_size.height;
+  std::mt19937_64 rng(options.seed);
+  std::vector<CalibrationView> views;
+  // A camera that sees no pose with the whole target inside its image is a bad argument, not a
+  // hang: give up after many draws.
+  constexpr int kMaxDraws = 100000;
+  int draws = 0;
+  while (static_cast<int>(views.size()) < options.num_views) {
+    if (++draws > kMaxDraws) {
+      throw std::invalid_argument("SynthesizeCalibrationViews: no pose in " + std::to_string(kMaxDraws) +
+                                  " draws keeps the target inside the image; widen the field of view");
+    }
+    const double spin = Uniform(rng, -0.3, 0.3), tilt_x = Uniform(rng, -0.6, 0.6),
+                 tilt_y = Uniform(rng, -0.6, 0.6), distance = Uniform(rng, 13.0, 20.0);
+    const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(spin, Eigen::Vector3d::UnitZ()) *
+                                      Eigen::AngleAxisd(tilt_x, Eigen::Vector3d::UnitX()) *
+                                      Eigen::AngleAxisd(tilt_y, Eigen::Vector3d::UnitY()))
+                                         .toRotationMatrix();
+    const Eigen::Vector3d translation = Eigen::Vector3d(0.0, 0.0, distance) - rotation * center;
+    CalibrationView view;
+    view.name = "view" + std::to_string(views.size() + 1);
+    bool inside = true;
+    for (const auto& point : points) {
+      const Eigen::Vector3d in_cam = rotation * point + translation;
+      if (!(in_cam.z() > 0.0)) {
+        inside = false;
+        break;
+      }
+      const Eigen::Vector2d pixel = PixelFromCam(options.intrinsics, in_cam);
+      if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() <= width - 1 && pixel.y() <= height - 1)) {
+        inside = false;
+        break;
+      }
+      view.points_in_world.push_back(point);
+      view.pixels.push_back(pixel);
+    }
+    if (!inside) continue;
+    for (auto& pixel : view.pixels) {
+      pixel += options.noise_px * Eigen::Vector2d(Normal(rng), Normal(rng));
+    }
+    views.push_back(std::move(view));
+  }
+  return views;
 }
 
 }  // namespace camproj

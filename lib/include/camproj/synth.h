@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "camproj/calibrate.h"
 #include "camproj/camera.h"
 #include "camproj/points_file.h"
 
@@ -42,6 +44,22 @@ struct SynthScene {
 // the distance that keeps every point inside the image. Same options, same scene, on any machine
 // with IEEE doubles (std::mt19937_64 and this file's own distributions).
 SynthScene SynthesizeScene(const SynthOptions& options);
+
+// Views of a calibration target for Calibrate (calibrate.h): a 9 x 6 board's corners (unit
+// squares, Z = 0) or a 4 x 4 x 3 grid rig (spacing 2), each from a seeded pose — 13 to 20 units
+// from the target's centre, tilted up to 0.6 rad about x and y and turned up to 0.3 rad about the
+// axis — redrawn until every point is inside the image; Gaussian pixel noise. Reproducible as
+// SynthesizeScene. Names "view1", "view2", ...
+struct CalibrationSynthOptions {
+  uint64_t seed = 1;
+  int num_views = 5;
+  bool planar = true;
+  double noise_px = 0.0;  // Gaussian sigma per axis, px
+  ImageSize image_size{640, 480};
+  Intrinsics intrinsics;  // the true camera (kCenter), distortion included
+  void Check() const;     // throws std::invalid_argument naming the field
+};
+std::vector<CalibrationView> SynthesizeCalibrationViews(const CalibrationSynthOptions& options);
 
 // "cloud" | "box" | "plane"; throws std::invalid_argument otherwise.
 SynthObject SynthObjectFromString(const std::string& text);
