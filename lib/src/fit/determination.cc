@@ -138,7 +138,7 @@ std::optional<size_t> PixelJacobian(const Linearization& at,
     for (size_t j = 0; j < at.params.size(); ++j) {
       const Parameter& param = at.params[j];
       const Eigen::Vector3d axis = Eigen::Vector3d::Unit(param.axis);
-      Eigen::Vector2d column;
+      Eigen::Vector2d column = Eigen::Vector2d::Zero();  // every kind sets it below
       switch (param.kind) {
         case kRotation: column = by_point * axis.cross(p); break;
         case kEye: column = by_point * (-at.length_scale * axis); break;
