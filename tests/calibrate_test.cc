@@ -154,7 +154,9 @@ TEST(CalibrateTest, ChessboardEqualsCalibrateCamera) {
   for (const std::string camera : {"left", "right"}) {
     SCOPED_TRACE(camera);
     const std::vector<CalibrationView> views = ChessboardViews(camera);
-    const Calibration ours = Calibrate(views, Options());
+    CalibrateOptions options = Options();
+    options.refuse_inconsistent_views = false;  // calibrateCamera keeps every view
+    const Calibration ours = Calibrate(views, options);
 
     std::vector<std::vector<cv::Point3f>> object_points;
     std::vector<std::vector<cv::Point2f>> image_points;
@@ -208,6 +210,41 @@ TEST(CalibrateTest, CrossValidationMatchesTheCovariances) {
   std::printf("mean (rms / predicted)^2: %.3f, its standard deviation over the seeds %.3f\n", mean,
               std::sqrt((ratio_squares / kSeeds - mean * mean) / kSeeds));
   EXPECT_NEAR(ratio_sum / kSeeds, 1.0, 0.5);
+}
+
+// A view whose pixels belong to other corners (two rows of the board swapped: wrong
+// correspondences, ~34 px RMS) among 10 good ones, in each of 20 seeds: refused by name, and the
+// rest calibrated as the good views alone are.
+TEST(CalibrateTest, ViewsThatDoNotFitAreRefusedByName) {
+  for (int s = 0; s < 20; ++s) {
+    const std::vector<CalibrationView> good = Views(Seed(40 + 2 * s), 10, true, 0.3);
+    std::vector<CalibrationView> views = good;
+    CalibrationView swapped = Views(Seed(41 + 2 * s), 1, true, 0.3)[0];
+    swapped.name = "swapped";
+    for (int x = 0; x < 9; ++x) std::swap(swapped.pixels[x], swapped.pixels[9 + x]);
+    views.insert(views.begin() + 4, swapped);
+    CalibrateOptions options = Options();
+    options.cross_validate = false;
+    const Calibration c = Calibrate(views, options);
+    ASSERT_EQ(c.refused_views.size(), 1u) << "seed " << s;
+    EXPECT_EQ(c.refused_views[0].name, "swapped");
+    EXPECT_EQ(c.views.size(), 10u);
+    const Calibration alone = Calibrate(good, options);
+    EXPECT_NEAR(c.intrinsics.fx, alone.intrinsics.fx, 1e-9 * alone.intrinsics.fx);
+  }
+}
+
+// Clean sets are not cut: the chi-square part refuses a consistent view with probability at most
+// 0.001 per set (Bonferroni over its views), the RMS factor only makes that rarer.
+TEST(CalibrateTest, CleanViewsAreKept) {
+  constexpr int kSets = 100;
+  int cut = 0;
+  for (int s = 0; s < kSets; ++s) {
+    CalibrateOptions options = Options();
+    options.cross_validate = false;
+    cut += Calibrate(Views(Seed(900 + s), 6, true, 0.5), options).refused_views.empty() ? 0 : 1;
+  }
+  ExpectRate("clean sets with a view refused", cut, kSets, 0.001);
 }
 
 TEST(CalibrateTest, OnePlanarViewCannotDetermineEveryIntrinsic) {

@@ -1015,22 +1015,25 @@ sys.exit(0 if answered >= 15 and beyond <= bound else 1)
 PY
     ;;
   calibrate_chessboard)
-    # OpenCV's left chessboard views: one calibration, the intrinsics at the top level of the file
-    # (fit --intrinsics takes it: a pose-only fit), each view a camera file export takes, the
-    # poses table one row per view; one view alone is refused and writes nothing.
+    # OpenCV's left chessboard views: one calibration without left02 (1.24 px RMS, 5x the others:
+    # refused by name), the intrinsics at the top level of the file (fit --intrinsics takes it: a
+    # pose-only fit), each view a camera file export takes, the poses table one row per view; one
+    # view alone is refused and writes nothing.
     boards="$data/real/opencv_chessboard"
     expect_exit 0 "$bin" calibrate "$boards"/left*.csv --image-size 640x480 -o "$work/left.json" --poses "$work/poses.csv"
-    expect_in out "^calibrated 13 views, 702 points: rms 0.41"
+    expect_in out "^calibrated 12 views, 648 points: rms 0.24"
+    expect_in out "^refused view left02: its 54 points are 1.24 px RMS from the camera the other views share"
     expect_in out "^  k1 "
-    expect_in out "^cross-validation: the even and the odd views calibrated apart (7 and 6) put the image's pixels [0-9.]* px apart"
-    [[ $(wc -l <"$work/poses.csv") -eq 14 ]] || fail "poses.csv has not 13 rows:\n$(cat "$work/poses.csv")"
+    expect_in out "^cross-validation: the even and the odd views calibrated apart (6 and 6) put the image's pixels [0-9.]* px apart"
+    [[ $(wc -l <"$work/poses.csv") -eq 13 ]] || fail "poses.csv has not 12 rows:\n$(cat "$work/poses.csv")"
     expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/left.json" -o "$work/v3.json"
     expect_in out "model: pose, 6 free parameters"
     py - "$work/left.json" "$work/view3.json" <<'PY' || fail "views[2].camera is not a camera file"
 import json, sys
 calibration = json.load(open(sys.argv[1]))
-assert calibration["views"][2]["name"] == "left03", calibration["views"][2]["name"]
-json.dump(calibration["views"][2]["camera"], open(sys.argv[2], "w"))
+assert calibration["views"][1]["name"] == "left03", calibration["views"][1]["name"]
+assert [v["name"] for v in calibration["refused_views"]] == ["left02"], calibration["refused_views"]
+json.dump(calibration["views"][1]["camera"], open(sys.argv[2], "w"))
 PY
     expect_exit 0 "$bin" export "$work/view3.json" --to json
     expect_exit 0 "$bin" project "$work/view3.json" "$boards/left03.csv"
@@ -1039,8 +1042,11 @@ PY
     [[ ! -e "$work/one.json" ]] || fail "a refused calibration wrote its file"
     mkdir "$work/right" && cp "$boards"/right*.csv "$work/right/"
     expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --fix aspect,principal-point,k2 -o "$work/right.json"
-    expect_in out "^calibrated 13 views"
+    expect_in out "^calibrated 12 views"
     expect_not_in out "^  fy "
+    expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --keep-all-views -o "$work/right.json"
+    expect_in out "^calibrated 13 views, 702 points: rms 0.4"
+    expect_not_in out "^refused view"
     ;;
   *) fail "unknown case" ;;
 esac

@@ -22,6 +22,7 @@ struct CalibrateArgs {
   std::string poses_path;
   std::vector<std::string> fix;
   bool skew = false;
+  bool keep_all_views = false;
   std::string pixel_origin = "center";
 };
 
@@ -58,6 +59,9 @@ Command AddCalibrateCommand(CLI::App& root) {
       ->delimiter(',')
       ->check(CLI::IsMember({"aspect", "principal-point", "k1", "k2"}));
   app->add_flag("--skew", args->skew, "also estimate skew (default 0)");
+  app->add_flag("--keep-all-views", args->keep_all_views,
+                "keep views that do not fit the camera the others share (by default such a view, "
+                "more than 2.5x the others' RMS and beyond their noise, is left out and named)");
   app->add_option("--pixel-origin", args->pixel_origin,
                   "convention of the input pixels and the written cx, cy")
       ->check(CLI::IsMember({"center", "corner"}));
@@ -71,6 +75,7 @@ Command AddCalibrateCommand(CLI::App& root) {
               if (entry == "k1") options.num_radial = 0;
             }
             options.skew_free = args->skew;
+            options.refuse_inconsistent_views = !args->keep_all_views;
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             const std::vector<std::string> inputs = ExpandInputs(args->view_paths);
             RequireOutputIsNotAnInput(args->output_path, inputs);
@@ -107,6 +112,13 @@ Command AddCalibrateCommand(CLI::App& root) {
               if (p.name == "cy") value = k.cy;
               out << "  " << std::left << std::setw(5) << p.name << std::right << value << " +- "
                   << p.sigma << (p.unit.empty() ? "" : " " + p.unit) << '\n';
+            }
+            for (const RefusedView& view : calibration.refused_views) {
+              out << "refused view " << view.name << ": its " << view.num_points << " points are "
+                  << std::setprecision(3) << view.rms_px << " px RMS from the camera the other views share ("
+                  << view.others_rms_px << " px): another camera, a blurred image or wrong "
+                     "correspondences; calibrated without it (--keep-all-views keeps it)\n"
+                  << std::setprecision(6);
             }
             const CrossValidation& cv = calibration.cross_validation;
             if (cv.done) {

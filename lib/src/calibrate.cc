@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <sstream>
 #include <stdexcept>
 
@@ -16,6 +17,7 @@
 
 #include "fit/closed_form.h"
 #include "fit/reprojection_error.h"
+#include "fit/statistics.h"
 #include "fit/zhang.h"
 
 namespace camproj {
@@ -48,6 +50,13 @@ constexpr int kPoseSize = 7;
 constexpr double kPlanarShare = 1e-3;
 // Each view's near / far planes sit this share outside its points' depths (FitOptions' default).
 constexpr double kDepthMargin = 0.1;
+// A view is refused only if its RMS is also this many times the other views' (see
+// WorstInconsistentView). On OpenCV's sample chessboards the chi-square test alone refuses 3 of
+// 13 left views, at 0.30-1.24 px against 0.15-0.23 px; with 2.5x it refuses left02 alone (1.24 px,
+// 5x the rest), keeping left13 (0.47 px, 1.9x). A view of another lens is refused only where
+// it differs that much: one pincushion view (k1 +0.15) among barrel ones (-0.21) came out at
+// 1.7-2.8x, by where the board sat in the image (docs/calibration.md).
+constexpr double kViewRmsFactor = 2.5;
 
 // One point of one view, analytic: the single-view fitter's residual with the rotation and the
 // centre in one block (DENSE_SCHUR eliminates a view's pose as one block).
@@ -333,6 +342,46 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
   return cv;
 }
 
+// The view that fits the shared camera worst, if it fits beyond the noise of the others: its sum
+// of squares over the others' variance estimate s^2 = their sum / (their 2n - their share of
+// the parameters), against chi-square with 2n - 6 degrees of freedom (its pose; its share of the
+// shared intrinsics is small) at level 0.001 / views (Bonferroni over the views).
+// Returns the view's index into result.views with the record.
+std::optional<std::pair<size_t, RefusedView>> WorstInconsistentView(const Calibration& result,
+                                                                    double sum_squares,
+                                                                    int num_parameters) {
+  const int num_views = static_cast<int>(result.views.size());
+  const int shared = num_parameters - 6 * num_views;
+  std::optional<std::pair<size_t, RefusedView>> worst;
+  for (size_t index = 0; index < result.views.size(); ++index) {
+    const CalibratedView& view = result.views[index];
+    const double view_sum = view.rms_px * view.rms_px * view.num_points;
+    const double others_dof = 2.0 * (result.num_points - view.num_points) - 6.0 * (num_views - 1) - shared;
+    if (!(others_dof > 0.0)) continue;
+    const double others_variance = (sum_squares - view_sum) / others_dof;
+    if (!(others_variance > 0.0)) continue;
+    const double dof = 2.0 * view.num_points - 6.0;
+    if (!(dof > 0.0)) continue;
+    const double statistic = view_sum / others_variance;
+    const double bound = internal::ChiSquareQuantile(dof, 1.0 - 0.001 / num_views);
+    if (statistic <= bound) continue;
+    // And beyond kViewRmsFactor times the others' RMS: real views differ in noise (focus, blur)
+    // by more than one Gaussian allows, which the chi-square test alone would refuse.
+    const double others_rms = std::sqrt((sum_squares - view_sum) / (result.num_points - view.num_points));
+    if (view.rms_px <= kViewRmsFactor * others_rms) continue;
+    if (worst && statistic / bound <= worst->second.statistic / worst->second.bound) continue;
+    RefusedView refused;
+    refused.name = view.name;
+    refused.num_points = view.num_points;
+    refused.rms_px = view.rms_px;
+    refused.others_rms_px = others_rms;
+    refused.statistic = statistic;
+    refused.bound = bound;
+    worst = std::make_pair(index, refused);
+  }
+  return worst;
+}
+
 }  // namespace
 
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
@@ -477,6 +526,22 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     result.views.push_back(view);
   }
   result.rms_px = std::sqrt(sum_squares / num_points);
+
+  if (options.refuse_inconsistent_views && views.size() >= 4) {
+    if (auto refused = WorstInconsistentView(result, sum_squares, num_parameters)) {
+      std::vector<CalibrationView> kept;
+      for (size_t i = 0; i < views.size(); ++i) {
+        if (i != refused->first) kept.push_back(views[i]);
+      }
+      try {
+        Calibration rest = Calibrate(kept, options);
+        rest.refused_views.insert(rest.refused_views.begin(), refused->second);
+        return rest;
+      } catch (const SceneError&) {
+        // The others alone cannot determine the camera: keep every view (its RMS shows it).
+      }
+    }
+  }
 
   if (options.compute_uncertainty) {
     ceres::Covariance::Options covariance_options;

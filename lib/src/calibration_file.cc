@@ -55,6 +55,13 @@ std::string CalibrationToJsonText(const Calibration& calibration,
                      {"camera", nlohmann::ordered_json::parse(CameraToJsonText(view.camera, options))}});
   }
   file["views"] = views;
+  nlohmann::ordered_json refused = nlohmann::ordered_json::array();
+  for (const RefusedView& view : calibration.refused_views) {
+    refused.push_back({{"name", view.name}, {"num_points", view.num_points},
+                       {"rms_px", view.rms_px}, {"others_rms_px", view.others_rms_px},
+                       {"chi_square", view.statistic}, {"bound", view.bound}});
+  }
+  file["refused_views"] = refused;
   return file.dump(2) + "\n";
 }
 

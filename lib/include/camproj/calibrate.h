@@ -48,6 +48,12 @@ struct CalibrateOptions {
   bool skew_free = false;
   int num_radial = 2;                // 0 (none), 1 (k1) or 2 (k1, k2)
   bool compute_uncertainty = true;
+  // Refuse views that do not fit the shared camera: after the joint fit, the worst view whose
+  // sum of squared residuals, in units of the other views' noise estimate, exceeds the
+  // chi-square bound (2n - 6 degrees of freedom, level 0.001 / views) and whose RMS is more than
+  // 2.5 times the others' is left out and the rest calibrated again, until none is or 3 views
+  // remain. Needs >= 4 views.
+  bool refuse_inconsistent_views = true;
   // Also calibrate the even and the odd views apart and compare them (Calibration::
   // cross_validation); needs compute_uncertainty and >= 4 views.
   bool cross_validate = true;
@@ -87,10 +93,21 @@ struct CrossValidation {
   double predicted_rms_px = 0.0;  // sqrt(mean over the grid of trace(Cov_A + Cov_B) there)
 };
 
+// A view left out because it does not fit the camera the other views share.
+struct RefusedView {
+  std::string name;
+  int num_points = 0;
+  double rms_px = 0.0;         // against the camera calibrated with it
+  double others_rms_px = 0.0;  // the other views' RMS in that calibration
+  double statistic = 0.0;      // its sum of squares / the other views' noise variance
+  double bound = 0.0;          // the chi-square bound it exceeded
+};
+
 struct Calibration {
   ImageSize image_size;
   Intrinsics intrinsics;  // kCenter; entries not free hold their fixed values
-  std::vector<CalibratedView> views;  // in the order given
+  std::vector<CalibratedView> views;  // in the order given, without the refused ones
+  std::vector<RefusedView> refused_views;  // in the order they were refused
   int num_points = 0;                 // over all views
   int num_parameters = 0;             // 6 per view + the free intrinsics
   double rms_px = 0.0;                // sqrt(sum |r|^2 / num_points), as cv::calibrateCamera's
