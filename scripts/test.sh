@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # README command 2: build (if needed) and run the whole test suite with ctest.
-# With --sanitize, uses a separate build with -fsanitize=address,undefined.
+# With --sanitize, uses a separate build with ASan + UBSan (CAMPROJ_SANITIZE_FLAGS, CMakeLists.txt).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 if [[ "${1:-}" == "--sanitize" ]]; then
