@@ -109,7 +109,7 @@ const char* kUsage =
     "  bench --out docs/bench        (what scripts/bench.sh runs)\n";
 
 // The numbers of the grid.
-const std::vector<int> kNumPoints = {6, 10, 30, 100, 1000, 10000};
+const std::vector<int> kNumPoints = {6, 10, 20, 30, 100, 1000, 10000};
 const std::vector<double> kSigmas = {0.0, 0.5, 2.0};
 constexpr double kFovyDeg = 45.0;
 const ImageSize kImageSize{1920, 1080};

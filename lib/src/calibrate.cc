@@ -443,11 +443,12 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   double k[kFitIntrinsicsSize] = {start->fx, start->fy / start->fx, start->cx, start->cy,
                                   start->skew, 0.0, 0.0};
 
+  // The manifolds outlive the problem that uses them (declared first, destroyed last).
+  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
+  std::unique_ptr<ceres::SubsetManifold> intrinsics_manifold;
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
-  std::unique_ptr<ceres::SubsetManifold> intrinsics_manifold;
   for (size_t i = 0; i < views.size(); ++i) {
     for (size_t j = 0; j < views[i].pixels.size(); ++j) {
       problem.AddResidualBlock(new ViewPointCost(views[i].points_in_world[j], views[i].pixels[j]),
