@@ -66,29 +66,26 @@ CalibrateOptions Options() {
   return options;
 }
 
+void ExpectTrueIntrinsics(const Intrinsics& k) {
+  const Intrinsics& t = TrueIntrinsics();
+  EXPECT_NEAR(k.fx, t.fx, kExact * t.fx);
+  EXPECT_NEAR(k.fy, t.fy, kExact * t.fy);
+  EXPECT_NEAR(k.cx, t.cx, kExact * t.fx);
+  EXPECT_NEAR(k.cy, t.cy, kExact * t.fx);
+  EXPECT_NEAR(k.k1, t.k1, kExact);
+  EXPECT_NEAR(k.k2, t.k2, kExact);
+}
+
 TEST(CalibrateTest, NoiseFreePlanarViewsGiveTheCameraExactly) {
   const std::vector<CalibrationView> views = Views(Seed(1), 5, true, 0.0);
   const Calibration c = Calibrate(views, Options());
-  const Intrinsics& t = TrueIntrinsics();
-  EXPECT_NEAR(c.intrinsics.fx, t.fx, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.fy, t.fy, kExact * t.fy);
-  EXPECT_NEAR(c.intrinsics.cx, t.cx, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.cy, t.cy, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.k1, t.k1, kExact);
-  EXPECT_NEAR(c.intrinsics.k2, t.k2, kExact);
+  ExpectTrueIntrinsics(c.intrinsics);
   EXPECT_LT(c.rms_px, 1e-6);
 }
 
 TEST(CalibrateTest, NoiseFree3dViewsGiveTheCameraExactly) {
   const std::vector<CalibrationView> views = Views(Seed(2), 3, false, 0.0);
-  const Calibration c = Calibrate(views, Options());
-  const Intrinsics& t = TrueIntrinsics();
-  EXPECT_NEAR(c.intrinsics.fx, t.fx, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.fy, t.fy, kExact * t.fy);
-  EXPECT_NEAR(c.intrinsics.cx, t.cx, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.cy, t.cy, kExact * t.fx);
-  EXPECT_NEAR(c.intrinsics.k1, t.k1, kExact);
-  EXPECT_NEAR(c.intrinsics.k2, t.k2, kExact);
+  ExpectTrueIntrinsics(Calibrate(views, Options()).intrinsics);
 }
 
 // Zhang's closed form alone (no distortion in the views): the start is the camera to rounding.

@@ -1,9 +1,9 @@
 // camproj project: world points -> pixels (and depth) through a camera file.
-#include <charconv>
 #include <iostream>
 #include <memory>
 
 #include "camproj/camera_file.h"
+#include "camproj/number_text.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
 #include "cli.h"
@@ -11,13 +11,6 @@
 namespace camproj::cli {
 
 namespace {
-
-std::string Number(double value) {
-  char buffer[32];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  (void)error;
-  return std::string(buffer, end);
-}
 
 struct ProjectArgs {
   std::string camera_path;
@@ -52,15 +45,15 @@ Command AddProjectCommand(CLI::App& root) {
               const Eigen::Vector3d& x = points.points_in_world[i];
               const double depth = (camera.cam_from_world * x).z();
               const std::optional<Eigen::Vector2d> pixel = PixelFromWorld(camera, x);
-              std::cout << TerminalSafe(points.ids[i]) << ',' << Number(x.x()) << ',' << Number(x.y()) << ','
-                        << Number(x.z()) << ',';
+              std::cout << TerminalSafe(points.ids[i]) << ',' << ShortestDouble(x.x()) << ',' << ShortestDouble(x.y()) << ','
+                        << ShortestDouble(x.z()) << ',';
               if (pixel) {
                 const Eigen::Vector2d p = ConvertPixelOrigin(*pixel, PixelOrigin::kCenter, origin);
-                std::cout << Number(p.x()) << ',' << Number(p.y());
+                std::cout << ShortestDouble(p.x()) << ',' << ShortestDouble(p.y());
               } else {
                 std::cout << ',';
               }
-              std::cout << ',' << Number(depth) << '\n';
+              std::cout << ',' << ShortestDouble(depth) << '\n';
             }
             return kExitOk;
           }};

@@ -134,15 +134,6 @@ std::optional<std::vector<Eigen::Vector2d>> PlaneCoordinates(
   return plane;
 }
 
-double Median(std::vector<double> values) {
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double median = values[mid];
-  if (values.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
-  }
-  return median;
-}
 
 // The fixed entries of the intrinsics: their values where the options fix them.
 Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& options) {
@@ -197,11 +188,11 @@ std::optional<Intrinsics> StartIntrinsics(const std::vector<CalibrationView>& vi
   }
   if (!fx.empty()) {
     Intrinsics intrinsics;
-    intrinsics.fx = Median(fx);
-    intrinsics.fy = Median(fy);
-    intrinsics.cx = Median(cx);
-    intrinsics.cy = Median(cy);
-    intrinsics.skew = Median(skew);
+    intrinsics.fx = internal::Median(fx);
+    intrinsics.fy = internal::Median(fy);
+    intrinsics.cx = internal::Median(cx);
+    intrinsics.cy = internal::Median(cy);
+    intrinsics.skew = internal::Median(skew);
     return WithFixedEntries(intrinsics, options);
   }
   // Last: the principal point at the centre, square pixels, the focal length alone.

@@ -1,24 +1,13 @@
 #include "camproj/calibration_file.h"
 
-#include <charconv>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "camproj/look_at.h"
+#include "camproj/number_text.h"
 
 namespace camproj {
-
-namespace {
-
-std::string Number(double value) {
-  char buffer[32];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  (void)error;
-  return std::string(buffer, end);
-}
-
-}  // namespace
 
 std::string CalibrationToJsonText(const Calibration& calibration,
                                   const CameraFileOptions& options) {
@@ -76,11 +65,11 @@ std::string CalibrationPosesCsvText(const Calibration& calibration,
     const LookAt look_at = LookAtFromCamFromWorld(pose, options.target_distance);
     out << view.name;
     for (const Eigen::Vector3d* v : {&look_at.eye, &look_at.target, &look_at.up}) {
-      for (int i = 0; i < 3; ++i) out << ',' << Number((*v)(i));
+      for (int i = 0; i < 3; ++i) out << ',' << ShortestDouble((*v)(i));
     }
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out << ',' << Number(pose.rotation(r, c));
-    for (int i = 0; i < 3; ++i) out << ',' << Number(pose.translation(i));
+      for (int c = 0; c < 3; ++c) out << ',' << ShortestDouble(pose.rotation(r, c));
+    for (int i = 0; i < 3; ++i) out << ',' << ShortestDouble(pose.translation(i));
     out << '\n';
   }
   return out.str();

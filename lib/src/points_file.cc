@@ -17,6 +17,7 @@
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
+#include "camproj/number_text.h"
 #include "check.h"
 
 namespace camproj {
@@ -284,12 +285,7 @@ std::string IdProblem(const std::string& id) {
   return "";
 }
 
-void AppendNumber(double value, std::string& out) {
-  char buffer[32];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  (void)error;  // 32 bytes hold any double's shortest form (at most 24)
-  out.append(buffer, end);
-}
+void AppendNumber(double value, std::string& out) { out += ShortestDouble(value); }
 
 }  // namespace
 

@@ -177,6 +177,31 @@ Camera InUnitWorld(const Camera& camera, const Eigen::Vector3d& origin, double u
   return moved;
 }
 
+// The kept points in their centred, unit-RMS world (the fitter's: in world units squared
+// lengths overflow or underflow beyond ~1e+-154), and `camera` there.
+struct UnitWorld {
+  Eigen::Vector3d origin;  // the points' centroid, world
+  double unit = 1.0;       // their RMS distance from it, world units
+  std::vector<Eigen::Vector3d> points;
+  Camera camera;
+};
+
+UnitWorld ToUnitWorld(const Camera& camera, const std::vector<Eigen::Vector3d>& kept_points) {
+  UnitWorld world;
+  world.origin = Centroid(kept_points);
+  Eigen::MatrixXd centred(kept_points.size(), 3);
+  for (size_t i = 0; i < kept_points.size(); ++i) {
+    centred.row(i) = (kept_points[i] - world.origin).transpose();
+  }
+  world.unit = RmsRowLength(centred);
+  world.points.resize(kept_points.size());
+  for (size_t i = 0; i < kept_points.size(); ++i) {
+    world.points[i] = centred.row(i).transpose() / world.unit;
+  }
+  world.camera = InUnitWorld(camera, world.origin, world.unit);
+  return world;
+}
+
 // ReprojectionSigmaPx's linearization of one camera, prepared once: the Jacobi-scaled inverse
 // of J^T J; SigmaAt then costs one point's Jacobian. J is never held whole: J^T J is summed over
 // blocks of points, and a fitted point's rows are recomputed where they are asked for, so the
@@ -456,15 +481,9 @@ PerspectiveTest TestPerspectiveStrength(const Selection& selection,
   }
   test.checked = true;
   // In the points' centred, unit-RMS world, as CheckDetermination's.
-  const Eigen::Vector3d origin = Centroid(kept_points);
-  Eigen::MatrixXd centred(kept_points.size(), 3);
-  for (size_t i = 0; i < kept_points.size(); ++i) {
-    centred.row(i) = (kept_points[i] - origin).transpose();
-  }
-  const double unit = RmsRowLength(centred);
-  std::vector<Eigen::Vector3d> points(kept_points.size());
-  for (size_t i = 0; i < kept_points.size(); ++i) points[i] = centred.row(i).transpose() / unit;
-  const Camera camera = InUnitWorld(selection.fit.camera, origin, unit);
+  const UnitWorld unit_world = ToUnitWorld(selection.fit.camera, kept_points);
+  const std::vector<Eigen::Vector3d>& points = unit_world.points;
+  const Camera& camera = unit_world.camera;
   for (const Eigen::Vector2d& r : residuals) test.sum_squares_px2 += r.squaredNorm();
   try {
     test.removed_px2 = std::min(test.sum_squares_px2,
@@ -493,15 +512,11 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   // Everything below in the points' centred, unit-RMS world (as the fitter's): in world units
   // the squared lengths overflow or underflow beyond ~1e+-154, and at an offset of 1e10 scene
   // sizes the finite-difference steps (1e-6 of the scene) fall below the coordinates' rounding.
-  const Eigen::Vector3d origin = Centroid(kept_points);
-  Eigen::MatrixXd centred(kept_points.size(), 3);
-  for (size_t i = 0; i < kept_points.size(); ++i) {
-    centred.row(i) = (kept_points[i] - origin).transpose();
-  }
-  const double unit = RmsRowLength(centred);
-  std::vector<Eigen::Vector3d> points(kept_points.size());
-  for (size_t i = 0; i < kept_points.size(); ++i) points[i] = centred.row(i).transpose() / unit;
-  const Camera camera = InUnitWorld(selection.fit.camera, origin, unit);
+  const UnitWorld unit_world = ToUnitWorld(selection.fit.camera, kept_points);
+  const Eigen::Vector3d& origin = unit_world.origin;
+  const double unit = unit_world.unit;
+  const std::vector<Eigen::Vector3d>& points = unit_world.points;
+  const Camera& camera = unit_world.camera;
   std::vector<Eigen::Vector3d> object_points(options.object_points_in_world.size());
   for (size_t i = 0; i < object_points.size(); ++i) {
     object_points[i] = (options.object_points_in_world[i] - origin) / unit;
