@@ -7,14 +7,17 @@
 // What runs (docs/calibration.md):
 //   start      planar views: a homography each, then Zhang's closed form for K (pixels scaled to
 //              the image size first); 3D views: the normalized DLT each, K the median of theirs;
-//              mixtures: the planar views' K where there are >= 3 of them, else the 3D views'.
-//              Every view's pose from its points by SQPnP with that K.
+//              mixtures: the planar views' K where Zhang's form determines it, else the 3D
+//              views'. Every view's pose from its points by SQPnP with that K.
 //   refinement one ceres::Problem: per point the analytic residual the single-view fitter uses,
 //              a pose block per view (quaternion + centre on a product manifold), one intrinsics
 //              block shared by all views (fixed entries on a SubsetManifold), DENSE_SCHUR with
 //              the poses eliminated.
-//   uncertainty ceres::Covariance of the shared intrinsics, scaled by the residual variance
-//              s^2 = sum |r|^2 / (2N - p).
+//   views      a view that does not fit the camera the others share is left out by name and
+//              the rest calibrated again (CalibrateOptions::refuse_inconsistent_views).
+//   uncertainty ceres::Covariance of the shared intrinsics (sparse QR), scaled by the residual
+//              variance s^2 = sum |r|^2 / (2N - p); the even and the odd views calibrated apart
+//              and compared in the image (CrossValidation).
 #ifndef CAMPROJ_CALIBRATE_H_
 #define CAMPROJ_CALIBRATE_H_
 
