@@ -185,6 +185,37 @@ TEST(CalibrateTest, ChessboardEqualsCalibrateCamera) {
   }
 }
 
+// The same coverage for 3D rigs (4 views of the 4 x 4 x 3 grid: the DLT start) and for mixtures
+// (3 boards and 2 rig views: Zhang's start from the boards), 100 seeds each, bound as above.
+TEST(CalibrateTest, SigmasCoverTheTruthFor3dRigsAndMixtures) {
+  constexpr int kSeeds = 100;
+  for (const bool mixed : {false, true}) {
+    int failures = 0;
+    for (int s = 0; s < kSeeds; ++s) {
+      std::vector<CalibrationView> views = Views(Seed(2000 + s), mixed ? 2 : 4, false, 0.5);
+      if (mixed) {
+        for (CalibrationView& board : Views(Seed(3000 + s), 3, true, 0.5)) {
+          board.name = "board " + board.name;
+          views.push_back(std::move(board));
+        }
+      }
+      CalibrateOptions options = Options();
+      options.cross_validate = false;
+      const Calibration c = Calibrate(views, options);
+      const Intrinsics& t = TrueIntrinsics();
+      bool covered = true;
+      for (const ParameterSigma& p : c.intrinsics_sigma) {
+        const double truth = p.name == "fx" ? t.fx : p.name == "cx" ? t.cx : p.name == "k1" ? t.k1 : NAN;
+        if (!std::isnan(truth) && std::abs(p.value - truth) > 3.0 * p.sigma) covered = false;
+      }
+      failures += covered ? 0 : 1;
+    }
+    ExpectRate(std::string(mixed ? "mixed boards and rigs" : "3D rigs") +
+                   ": fx, cx or k1 beyond 3 sigma of the truth",
+               failures, kSeeds, 1.0 - std::pow(0.9973, 3));
+  }
+}
+
 // Cross-validation: two halves of views of one camera differ by what their covariances predict.
 // E|d|^2 = trace(J_A Cov_A J_A^T + J_B Cov_B J_B^T) to first order at each grid pixel, so the
 // ratio of the squared RMS to the predicted one averages 1 over seeds; per seed it is a weighted
