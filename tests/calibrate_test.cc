@@ -100,6 +100,16 @@ TEST(CalibrateTest, ZhangStartIsExactWithoutDistortion) {
   EXPECT_NEAR(c.start.cy, pinhole.cy, 1e-9 * pinhole.fx);
 }
 
+// fx, cx and k1 each within 3 of their sigmas of the truth.
+bool CoversTheTruth(const Calibration& c) {
+  const Intrinsics& t = TrueIntrinsics();
+  for (const ParameterSigma& p : c.intrinsics_sigma) {
+    const double truth = p.name == "fx" ? t.fx : p.name == "cx" ? t.cx : p.name == "k1" ? t.k1 : NAN;
+    if (!std::isnan(truth) && std::abs(p.value - truth) > 3.0 * p.sigma) return false;
+  }
+  return true;
+}
+
 // The reported sigmas are the spread of the estimates: each of fx, cx, k1 is within 3 of its
 // sigmas of the truth in 99.73 % of noisy calibrations (Gaussian, to first order), so a seed fails
 // with probability about 1 - 0.9973^3 = 0.8 %.
@@ -112,17 +122,7 @@ TEST(CalibrateTest, SigmasCoverTheTruth) {
     CalibrateOptions options = Options();
     options.cross_validate = false;
     const Calibration c = Calibrate(views, options);
-    const Intrinsics& t = TrueIntrinsics();
-    bool covered = true;
-    for (const ParameterSigma& p : c.intrinsics_sigma) {
-      double truth = 0.0;
-      if (p.name == "fx") truth = t.fx;
-      else if (p.name == "cx") truth = t.cx;
-      else if (p.name == "k1") truth = t.k1;
-      else continue;
-      if (std::abs(p.value - truth) > 3.0 * p.sigma) covered = false;
-    }
-    failures += covered ? 0 : 1;
+    failures += CoversTheTruth(c) ? 0 : 1;
     for (const ParameterSigma& p : c.intrinsics_sigma) {
       if (p.name == "fx") fx_squared_z += std::pow((p.value - TrueIntrinsics().fx) / p.sigma, 2);
     }
@@ -201,14 +201,7 @@ TEST(CalibrateTest, SigmasCoverTheTruthFor3dRigsAndMixtures) {
       }
       CalibrateOptions options = Options();
       options.cross_validate = false;
-      const Calibration c = Calibrate(views, options);
-      const Intrinsics& t = TrueIntrinsics();
-      bool covered = true;
-      for (const ParameterSigma& p : c.intrinsics_sigma) {
-        const double truth = p.name == "fx" ? t.fx : p.name == "cx" ? t.cx : p.name == "k1" ? t.k1 : NAN;
-        if (!std::isnan(truth) && std::abs(p.value - truth) > 3.0 * p.sigma) covered = false;
-      }
-      failures += covered ? 0 : 1;
+      failures += CoversTheTruth(Calibrate(views, options)) ? 0 : 1;
     }
     ExpectRate(std::string(mixed ? "mixed boards and rigs" : "3D rigs") +
                    ": fx, cx or k1 beyond 3 sigma of the truth",

@@ -1,4 +1,5 @@
 // camproj calibrate: one camera from many views (shared intrinsics, a pose per view).
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -25,13 +26,6 @@ struct CalibrateArgs {
   bool keep_all_views = false;
   std::string pixel_origin = "center";
 };
-
-std::string ViewNameOf(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  const size_t dot = name.rfind('.');
-  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
-}
 
 }  // namespace
 
@@ -84,7 +78,7 @@ Command AddCalibrateCommand(CLI::App& root) {
             std::vector<CalibrationView> views;
             for (const std::string& path : inputs) {
               const Correspondences file = ReadCorrespondencesFile(path);
-              CalibrationView view{ViewNameOf(path), file.points_in_world, {}};
+              CalibrationView view{std::filesystem::path(path).stem().string(), file.points_in_world, {}};
               for (const auto& pixel : file.pixels) {
                 view.pixels.push_back(ConvertPixelOrigin(pixel, origin, PixelOrigin::kCenter));
               }

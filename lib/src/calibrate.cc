@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include "fit/closed_form.h"
+#include "fit/common.h"
 #include "fit/reprojection_error.h"
 #include "fit/statistics.h"
 #include "fit/zhang.h"
@@ -117,9 +118,7 @@ std::string ViewName(const CalibrationView& view, size_t index) {
 // kPlanarShare).
 std::optional<std::vector<Eigen::Vector2d>> PlaneCoordinates(
     const std::vector<Eigen::Vector3d>& points) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : points) centroid += p;
-  centroid /= static_cast<double>(points.size());
+  const Eigen::Vector3d centroid = internal::Centroid(points);
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
@@ -149,22 +148,23 @@ Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& optio
 
 // The closed-form intrinsics: Zhang's from the planar views when there are enough of them,
 // else the median of the 3D views' DLT. std::nullopt when neither determines K.
-std::optional<Intrinsics> StartIntrinsics(const std::vector<CalibrationView>& views,
-                                          const CalibrateOptions& options) {
+std::optional<Intrinsics> StartIntrinsics(
+    const std::vector<CalibrationView>& views,
+    const std::vector<std::optional<std::vector<Eigen::Vector2d>>>& planes,
+    const CalibrateOptions& options) {
   const internal::ZhangModel model{options.aspect_free, options.principal_point_free,
                                    options.skew_free};
   std::vector<Eigen::Matrix3d> homographies;
   std::vector<double> fx, fy, cx, cy, skew;
-  for (const CalibrationView& view : views) {
-    if (const auto plane = PlaneCoordinates(view.points_in_world)) {
-      homographies.push_back(internal::NormalizedHomography(*plane, view.pixels));
+  for (size_t i = 0; i < views.size(); ++i) {
+    const CalibrationView& view = views[i];
+    if (planes[i]) {
+      homographies.push_back(internal::NormalizedHomography(*planes[i], view.pixels));
       continue;
     }
     if (view.points_in_world.size() < 6) continue;
     // The DLT in a world centred and scaled to unit RMS distance (K does not change).
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const auto& p : view.points_in_world) centroid += p;
-    centroid /= static_cast<double>(view.points_in_world.size());
+    const Eigen::Vector3d centroid = internal::Centroid(view.points_in_world);
     double sum_squares = 0.0;
     for (const auto& p : view.points_in_world) sum_squares += (p - centroid).squaredNorm();
     const double scale = std::sqrt(sum_squares / view.points_in_world.size());
@@ -298,15 +298,16 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views,
           const double sigma = std::sqrt(cov(j, j));
           if (!(sigma > 0.0)) continue;
           const double step = 1e-3 * sigma;
-          Eigen::Matrix<double, kFitIntrinsicsSize, 1> plus = p, minus = p;
-          plus(j) += step;
-          minus(j) -= step;
-          const Intrinsics a_plus = h == 0 ? FromFitLayout(plus) : c[0].intrinsics;
-          const Intrinsics a_minus = h == 0 ? FromFitLayout(minus) : c[0].intrinsics;
-          const Intrinsics b_plus = h == 1 ? FromFitLayout(plus) : c[1].intrinsics;
-          const Intrinsics b_minus = h == 1 ? FromFitLayout(minus) : c[1].intrinsics;
-          const auto up = Transfer(a_plus, b_plus, pixel);
-          const auto down = Transfer(a_minus, b_minus, pixel);
+          // Half h's parameter j moved by +-step, the other half as calibrated.
+          Intrinsics plus[2] = {c[0].intrinsics, c[1].intrinsics};
+          Intrinsics minus[2] = {c[0].intrinsics, c[1].intrinsics};
+          Eigen::Matrix<double, kFitIntrinsicsSize, 1> moved_p = p;
+          moved_p(j) += step;
+          plus[h] = FromFitLayout(moved_p);
+          moved_p(j) -= 2.0 * step;
+          minus[h] = FromFitLayout(moved_p);
+          const auto up = Transfer(plus[0], plus[1], pixel);
+          const auto down = Transfer(minus[0], minus[1], pixel);
           if (!up || !down) {
             ok = false;
             break;
@@ -373,18 +374,12 @@ std::optional<std::pair<size_t, RefusedView>> WorstInconsistentView(const Calibr
   return worst;
 }
 
-}  // namespace
 
-Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
-  options.Check();
-  if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
-  for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
-
-  const std::vector<int> fixed = FixedIntrinsicEntries(options);
-  const int free_intrinsics = kFitIntrinsicsSize - static_cast<int>(fixed.size());
-  int num_points = 0;
-  for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
-  const int num_parameters = 6 * static_cast<int>(views.size()) + free_intrinsics;
+// Throws SceneError unless the views can determine the free intrinsics: more equations than
+// unknowns, and (planar views alone) no more of K's entries free than twice their number.
+void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
+                     int num_parameters, int free_intrinsics, int planar_views,
+                     const CalibrateOptions& options) {
   if (2 * num_points <= num_parameters) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      std::to_string(num_points) + " points in " + std::to_string(views.size()) +
@@ -393,11 +388,8 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
                          " unknowns (6 per view and " + std::to_string(free_intrinsics) +
                          " intrinsics): add views or points, or fix intrinsics");
   }
-
   // A plane's homography gives two constraints on K (Zhang): planar views alone determine at
   // most twice their number of K's entries, whatever distortion adds in theory.
-  int planar_views = 0;
-  for (const auto& view : views) planar_views += PlaneCoordinates(view.points_in_world) ? 1 : 0;
   const int free_k_entries = 1 + (options.aspect_free ? 1 : 0) +
                              (options.principal_point_free ? 2 : 0) + (options.skew_free ? 1 : 0);
   if (planar_views == static_cast<int>(views.size()) && 2 * planar_views < free_k_entries) {
@@ -409,97 +401,93 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
                          " free entries (a plane gives two constraints): add views of the "
                          "board at other tilts, or fix the principal point and the aspect");
   }
+}
 
-  const std::optional<Intrinsics> start = StartIntrinsics(views, options);
-  if (!start) {
-    throw SceneError(SceneError::Reason::kDegenerate,
-                     "the views do not determine the intrinsics in closed form (planar boards "
-                     "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
-                     "add views at other angles, or fix the principal point and the aspect");
-  }
-
-  // Blocks: a pose per view from SQPnP with the start's K, one shared intrinsics block.
-  std::vector<std::array<double, kPoseSize>> poses(views.size());
-  for (size_t i = 0; i < views.size(); ++i) {
-    internal::StartCamera camera;
-    if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, *start, &camera)) {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       ViewName(views[i], i) + ": no pose from its points with the start's "
-                       "intrinsics (SQPnP failed); check the view's correspondences");
-    }
-    const Eigen::Quaterniond q(camera.rotation);
-    poses[i] = {q.x(), q.y(), q.z(), q.w(), camera.center.x(), camera.center.y(),
-                camera.center.z()};
-  }
-  double k[kFitIntrinsicsSize] = {start->fx, start->fy / start->fx, start->cx, start->cy,
-                                  start->skew, 0.0, 0.0};
-
-  // The manifolds outlive the problem that uses them (declared first, destroyed last).
+// The joint problem: a pose block per view (started by SQPnP with the start's K), one shared
+// intrinsics block (fixed entries on a SubsetManifold). Members in this order: the manifolds
+// outlive the problem that borrows them.
+struct JointProblem {
   ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
   std::unique_ptr<ceres::SubsetManifold> intrinsics_manifold;
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  for (size_t i = 0; i < views.size(); ++i) {
-    for (size_t j = 0; j < views[i].pixels.size(); ++j) {
-      problem.AddResidualBlock(new ViewPointCost(views[i].points_in_world[j], views[i].pixels[j]),
-                               nullptr, poses[i].data(), k);
+  std::vector<std::array<double, kPoseSize>> poses;
+  Eigen::Matrix<double, kFitIntrinsicsSize, 1> k;
+  ceres::Problem problem;
+
+  JointProblem(const std::vector<CalibrationView>& views, const Intrinsics& start,
+               const std::vector<int>& fixed)
+      : poses(views.size()), k(FitLayout(start)), problem(ProblemOptions()) {
+    for (size_t i = 0; i < views.size(); ++i) {
+      internal::StartCamera camera;
+      if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, start, &camera)) {
+        throw SceneError(SceneError::Reason::kDegenerate,
+                         ViewName(views[i], i) + ": no pose from its points with the start's "
+                         "intrinsics (SQPnP failed); check the view's correspondences");
+      }
+      const Eigen::Quaterniond q(camera.rotation);
+      poses[i] = {q.x(), q.y(), q.z(), q.w(), camera.center.x(), camera.center.y(),
+                  camera.center.z()};
+      for (size_t j = 0; j < views[i].pixels.size(); ++j) {
+        problem.AddResidualBlock(new ViewPointCost(views[i].points_in_world[j], views[i].pixels[j]),
+                                 nullptr, poses[i].data(), k.data());
+      }
+      problem.SetManifold(poses[i].data(), &pose_manifold);
     }
-    problem.SetManifold(poses[i].data(), &pose_manifold);
-  }
-  if (!fixed.empty()) {
-    intrinsics_manifold = std::make_unique<ceres::SubsetManifold>(kFitIntrinsicsSize, fixed);
-    problem.SetManifold(k, intrinsics_manifold.get());
-  }
-
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (auto& pose : poses) ordering->AddElementToGroup(pose.data(), 0);
-  ordering->AddElementToGroup(k, 1);
-  solver_options.linear_solver_ordering = ordering;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
-    throw SceneError(SceneError::Reason::kNumerical,
-                     "the joint refinement failed: " + summary.message);
+    if (!fixed.empty()) {
+      intrinsics_manifold = std::make_unique<ceres::SubsetManifold>(kFitIntrinsicsSize, fixed);
+      problem.SetManifold(k.data(), intrinsics_manifold.get());
+    }
   }
 
-  Calibration result;
-  result.image_size = options.image_size;
-  result.start = *start;
-  result.intrinsics.fx = k[0];
-  result.intrinsics.fy = k[kAspect] * k[0];
-  result.intrinsics.cx = k[kCx];
-  result.intrinsics.cy = k[kCy];
-  result.intrinsics.skew = k[kSkew];
-  result.intrinsics.k1 = k[kK1];
-  result.intrinsics.k2 = k[kK2];
-  result.num_points = num_points;
-  result.num_parameters = num_parameters;
-  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  result.termination = summary.message;
+  static ceres::Problem::Options ProblemOptions() {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    return options;
+  }
+
+  // DENSE_SCHUR with the poses eliminated first; throws kNumerical when Ceres fails.
+  ceres::Solver::Summary Solve(const CalibrateOptions& options) {
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (auto& pose : poses) ordering->AddElementToGroup(pose.data(), 0);
+    ordering->AddElementToGroup(k.data(), 1);
+    solver_options.linear_solver_ordering = ordering;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = options.function_tolerance;
+    solver_options.gradient_tolerance = options.gradient_tolerance;
+    solver_options.parameter_tolerance = options.parameter_tolerance;
+    solver_options.num_threads = 1;
+    solver_options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
+      throw SceneError(SceneError::Reason::kNumerical,
+                       "the joint refinement failed: " + summary.message);
+    }
+    return summary;
+  }
+};
+
+// Each view's camera, RMS and depth range at the joint optimum; returns the sum of squares over
+// every view.
+double AssembleViews(const std::vector<CalibrationView>& views, const JointProblem& joint,
+                     const CalibrateOptions& options, Calibration* result) {
   double sum_squares = 0.0;
   for (size_t i = 0; i < views.size(); ++i) {
-    const Eigen::Map<const Eigen::Quaterniond> q(poses[i].data());
-    const Eigen::Vector3d center(poses[i][4], poses[i][5], poses[i][6]);
+    const std::array<double, kPoseSize>& pose = joint.poses[i];
+    const Eigen::Map<const Eigen::Quaterniond> q(pose.data());
     CalibratedView view;
     view.name = ViewName(views[i], i);
     view.camera.image_size = options.image_size;
-    view.camera.intrinsics = result.intrinsics;
-    view.camera.cam_from_world = CamFromWorldFromCenter(q.normalized().toRotationMatrix(), center);
+    view.camera.intrinsics = result->intrinsics;
+    view.camera.cam_from_world = CamFromWorldFromCenter(
+        q.normalized().toRotationMatrix(), Eigen::Vector3d(pose[4], pose[5], pose[6]));
     view.num_points = static_cast<int>(views[i].pixels.size());
     double view_sum = 0.0;
     double min_depth = std::numeric_limits<double>::infinity(), max_depth = 0.0;
     for (size_t j = 0; j < views[i].pixels.size(); ++j) {
       double residual[2];
-      if (!internal::ProjectPointWithJacobian(poses[i].data(), poses[i].data() + 4, k,
+      if (!internal::ProjectPointWithJacobian(pose.data(), pose.data() + 4, joint.k.data(),
                                               views[i].points_in_world[j], views[i].pixels[j],
                                               residual, nullptr, nullptr, nullptr)) {
         throw SceneError(SceneError::Reason::kPointsBehindCamera,
@@ -515,8 +503,88 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     view.camera.z_far = max_depth * (1.0 + kDepthMargin);
     view.rms_px = std::sqrt(view_sum / view.num_points);
     sum_squares += view_sum;
-    result.views.push_back(view);
+    result->views.push_back(view);
   }
+  return sum_squares;
+}
+
+// The intrinsics' covariance (scaled by s^2) and the sigmas of the free ones into *result.
+void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOptions& options,
+                    Calibration* result) {
+  ceres::Covariance::Options covariance_options;
+  // SPARSE_QR fails on a rank-deficient Jacobian: refused below, never pseudo-inverted. (DENSE_SVD
+  // decomposes the whole 2N x (6 views + 7) Jacobian: 1.2 s at 50 views, bench --calibrate.)
+  covariance_options.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(covariance_options);
+  const double* k = joint.k.data();
+  const std::vector<std::pair<const double*, const double*>> blocks = {{k, k}};
+  if (!covariance.Compute(blocks, &joint.problem)) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the views do not determine every free intrinsic (the covariance is "
+                     "singular): add views at other angles, or fix the principal point, the "
+                     "aspect or the distortion");
+  }
+  Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize, Eigen::RowMajor> c;
+  covariance.GetCovarianceBlock(k, k, c.data());
+  c *= sum_squares / (2.0 * result->num_points - result->num_parameters);
+  result->intrinsics_covariance = c;
+  auto add = [&](const std::string& name, double value, double variance, const std::string& unit) {
+    result->intrinsics_sigma.push_back({name, value, std::sqrt(std::max(variance, 0.0)), unit});
+  };
+  add("fx", k[0], c(0, 0), "px");
+  if (options.aspect_free) {
+    // fy = aspect * f: its gradient in (f, aspect) is (aspect, f).
+    const Eigen::Vector2d g(k[kAspect], k[0]);
+    add("fy", result->intrinsics.fy, g.dot(c.topLeftCorner<2, 2>() * g), "px");
+  }
+  if (options.principal_point_free) {
+    add("cx", k[kCx], c(kCx, kCx), "px");
+    add("cy", k[kCy], c(kCy, kCy), "px");
+  }
+  if (options.skew_free) add("skew", k[kSkew], c(kSkew, kSkew), "px");
+  if (options.num_radial >= 1) add("k1", k[kK1], c(kK1, kK1), "");
+  if (options.num_radial >= 2) add("k2", k[kK2], c(kK2, kK2), "");
+}
+
+}  // namespace
+
+Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
+  options.Check();
+  if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
+  for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
+
+  const std::vector<int> fixed = FixedIntrinsicEntries(options);
+  const int free_intrinsics = kFitIntrinsicsSize - static_cast<int>(fixed.size());
+  int num_points = 0;
+  for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
+  const int num_parameters = 6 * static_cast<int>(views.size()) + free_intrinsics;
+  std::vector<std::optional<std::vector<Eigen::Vector2d>>> planes;
+  int planar_views = 0;
+  for (const auto& view : views) {
+    planes.push_back(PlaneCoordinates(view.points_in_world));
+    planar_views += planes.back() ? 1 : 0;
+  }
+  CheckDetermined(views, num_points, num_parameters, free_intrinsics, planar_views, options);
+
+  const std::optional<Intrinsics> start = StartIntrinsics(views, planes, options);
+  if (!start) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "the views do not determine the intrinsics in closed form (planar boards "
+                     "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
+                     "add views at other angles, or fix the principal point and the aspect");
+  }
+  JointProblem joint(views, *start, fixed);
+  const ceres::Solver::Summary summary = joint.Solve(options);
+
+  Calibration result;
+  result.image_size = options.image_size;
+  result.start = *start;
+  result.intrinsics = FromFitLayout(joint.k);
+  result.num_points = num_points;
+  result.num_parameters = num_parameters;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.termination = summary.message;
+  const double sum_squares = AssembleViews(views, joint, options, &result);
   result.rms_px = std::sqrt(sum_squares / num_points);
 
   if (options.refuse_inconsistent_views && views.size() >= 4) {
@@ -534,41 +602,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
       }
     }
   }
-
-  if (options.compute_uncertainty) {
-    ceres::Covariance::Options covariance_options;
-    // SPARSE_QR fails on a rank-deficient Jacobian: refused below, never pseudo-inverted. (DENSE_SVD
-    // decomposes the whole 2N x (6 views + 7) Jacobian: 1.2 s at 50 views, bench --calibrate.)
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    ceres::Covariance covariance(covariance_options);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{k, k}};
-    if (!covariance.Compute(blocks, &problem)) {
-      throw SceneError(SceneError::Reason::kDegenerate,
-                       "the views do not determine every free intrinsic (the covariance is "
-                       "singular): add views at other angles, or fix the principal point, the "
-                       "aspect or the distortion");
-    }
-    Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize, Eigen::RowMajor> c;
-    covariance.GetCovarianceBlock(k, k, c.data());
-    c *= sum_squares / (2.0 * num_points - num_parameters);
-    result.intrinsics_covariance = c;
-    auto add = [&](const std::string& name, double value, double variance, const std::string& unit) {
-      result.intrinsics_sigma.push_back({name, value, std::sqrt(std::max(variance, 0.0)), unit});
-    };
-    add("fx", k[0], c(0, 0), "px");
-    if (options.aspect_free) {
-      // fy = aspect * f: its gradient in (f, aspect) is (aspect, f).
-      const Eigen::Vector2d g(k[kAspect], k[0]);
-      add("fy", result.intrinsics.fy, g.dot(c.topLeftCorner<2, 2>() * g), "px");
-    }
-    if (options.principal_point_free) {
-      add("cx", k[kCx], c(kCx, kCx), "px");
-      add("cy", k[kCy], c(kCy, kCy), "px");
-    }
-    if (options.skew_free) add("skew", k[kSkew], c(kSkew, kSkew), "px");
-    if (options.num_radial >= 1) add("k1", k[kK1], c(kK1, kK1), "");
-    if (options.num_radial >= 2) add("k2", k[kK2], c(kK2, kK2), "");
-  }
+  if (options.compute_uncertainty) AddUncertainty(joint, sum_squares, options, &result);
   if (options.cross_validate) result.cross_validation = CrossValidate(views, options);
   return result;
 }
