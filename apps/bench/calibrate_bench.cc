@@ -50,7 +50,7 @@ Intrinsics TrueCamera() {
 
 struct Row {
   std::vector<double> ours_s, ours_full_s, opencv_s, ours_rms, opencv_rms, ours_focal_error,
-      opencv_focal_error, apart_sigmas;
+      opencv_focal_error, apart_sigmas, ours_iterations;
   int opencv_failed = 0;
 };
 
@@ -106,9 +106,9 @@ int CalibrateMain(int argc, char** argv) {
   const Intrinsics truth = TrueCamera();
   std::ostringstream table;
   table << "| views | sets | ours: calibrate (median) | ours: + covariance + cross-validation | "
-           "cv::calibrateCamera | OpenCV ÷ ours | RMS px (ours / OpenCV) | fx error % (ours / "
+           "cv::calibrateCamera | OpenCV ÷ ours | iterations (ours, median) | RMS px (ours / OpenCV) | fx error % (ours / "
            "OpenCV) | optima apart (max over fx..k2, in our sigmas) |\n"
-        << "|---:|---:|---:|---:|---:|---:|---|---|---:|\n";
+        << "|---:|---:|---:|---:|---:|---:|---:|---|---|---:|\n";
   for (const int num_views : view_counts) {
     Row row;
     for (int set = 1; set <= sets; ++set) {
@@ -126,6 +126,7 @@ int CalibrateMain(int argc, char** argv) {
       auto start = Clock::now();
       const Calibration ours = Calibrate(views, options);
       row.ours_s.push_back(Seconds(start));
+      row.ours_iterations.push_back(ours.iterations);
       options.compute_uncertainty = true;
       options.cross_validate = true;
       start = Clock::now();
@@ -171,7 +172,8 @@ int CalibrateMain(int argc, char** argv) {
     table << "| " << num_views << " | " << sets << " | " << Format(1e3 * ours_t, "%.3g") << " ms | "
           << Format(1e3 * Median(row.ours_full_s), "%.3g") << " ms | " << Format(1e3 * cv_t, "%.3g")
           << " ms" << (row.opencv_failed ? " (" + std::to_string(row.opencv_failed) + " failed)" : "")
-          << " | " << Format(cv_t / ours_t, "%.1f") << " | " << Format(Median(row.ours_rms), "%.4f")
+          << " | " << Format(cv_t / ours_t, "%.1f") << " | "
+          << Format(Median(row.ours_iterations), "%.0f") << " | " << Format(Median(row.ours_rms), "%.4f")
           << " / " << Format(Median(row.opencv_rms), "%.4f") << " | "
           << Format(Median(row.ours_focal_error), "%.3f") << " / "
           << Format(Median(row.opencv_focal_error), "%.3f") << " | "

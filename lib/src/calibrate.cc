@@ -11,7 +11,6 @@
 #include <stdexcept>
 
 #include <ceres/ceres.h>
-#include <ceres/product_manifold.h>
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
@@ -44,8 +43,10 @@ using internal::kFitIntrinsicsSize;
 
 // Intrinsics block entries (reprojection_error.h): [f, aspect, cx, cy, skew, k1, k2].
 constexpr int kAspect = 1, kCx = 2, kCy = 3, kSkew = 4, kK1 = 5, kK2 = 6;
-// Pose block: cam_from_world as an Eigen quaternion (x, y, z, w), then the camera centre.
-constexpr int kPoseSize = 7;
+// Pose block: a rotation vector w (cam_from_world = Exp(w) R0, R0 the view's start), then the
+// camera centre.
+constexpr int kPoseSize = 6;
+using IntrinsicsLayout = Eigen::Matrix<double, kFitIntrinsicsSize, 1>;
 // A view is read as planar for the start when its points' thinnest extent is below this share of
 // their widest (the refinement always uses the points as given).
 constexpr double kPlanarShare = 1e-3;
@@ -59,36 +60,94 @@ constexpr double kDepthMargin = 0.1;
 // 1.7-2.8x, by where the board sat in the image (docs/calibration.md).
 constexpr double kViewRmsFactor = 2.5;
 
-// One point of one view, analytic: the single-view fitter's residual with the rotation and the
-// centre in one block (DENSE_SCHUR eliminates a view's pose as one block).
-class ViewPointCost : public ceres::SizedCostFunction<2, kPoseSize, kFitIntrinsicsSize> {
+// The rotation Exp(w) of a rotation vector w (angle |w| about w / |w|) and the left Jacobian
+// J_l(w) of SO(3): d/dw (Exp(w) R0 v) = -[Exp(w) R0 v]x J_l(w).
+//   J_l(w) = I + (1 - cos a) / a^2 [w]x + (a - sin a) / a^3 [w]x^2,  a = |w|
+// (series below a = 1e-4, where the truncation is below 1e-17).
+void ExpWithLeftJacobian(const double* w, Eigen::Matrix3d* rotation, Eigen::Matrix3d* left_jacobian) {
+  const Eigen::Vector3d v(w[0], w[1], w[2]);
+  const double a2 = v.squaredNorm();
+  const double a = std::sqrt(a2);
+  Eigen::Matrix3d wx;
+  wx << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  double sin_term, cos_term, cube_term;  // sin a / a, (1 - cos a) / a^2, (a - sin a) / a^3
+  if (a < 1e-4) {
+    sin_term = 1.0 - a2 / 6.0;
+    cos_term = 0.5 - a2 / 24.0;
+    cube_term = 1.0 / 6.0 - a2 / 120.0;
+  } else {
+    sin_term = std::sin(a) / a;
+    cos_term = (1.0 - std::cos(a)) / a2;
+    cube_term = (a - std::sin(a)) / (a2 * a);
+  }
+  const Eigen::Matrix3d wx2 = wx * wx;
+  *rotation = Eigen::Matrix3d::Identity() + sin_term * wx + cos_term * wx2;
+  if (left_jacobian != nullptr) {
+    *left_jacobian = Eigen::Matrix3d::Identity() + cos_term * wx + cube_term * wx2;
+  }
+}
+
+// All points of one view, analytic: per point the single-view fitter's residual of the camera
+// point (ResidualOfCamPoint). Parameter blocks: the view's pose [w, C] (cam_from_world rotation
+// Exp(w) R0 about the start's R0, the camera centre C; |w| stays far below pi from a closed-form
+// start) and the free intrinsics (FitLayout entries at `free_slots`, the others held at their
+// values in `k`). Plain vectors, no manifolds, one block per view: Ceres' per-block costs (the
+// manifolds' Jacobian products, the evaluation bookkeeping) were 40 % of the joint solve
+// (bench --calibrate, callgrind).
+class ViewCost : public ceres::CostFunction {
  public:
-  ViewPointCost(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
-      : point_(point), observed_(observed) {}
+  ViewCost(const CalibrationView& view, const Eigen::Matrix3d& reference_rotation,
+           const IntrinsicsLayout& k, const std::vector<int>& free_slots)
+      : points_(view.points_in_world), pixels_(view.pixels),
+        reference_rotation_(reference_rotation), k_(k), free_slots_(free_slots) {
+    set_num_residuals(2 * static_cast<int>(pixels_.size()));
+    mutable_parameter_block_sizes()->assign({kPoseSize, static_cast<int>(free_slots.size())});
+  }
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const double* pose = parameters[0];
-    double jq[8], jc[6];
-    const bool pose_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
-    if (!internal::ProjectPointWithJacobian(pose, pose + 4, parameters[1], point_, observed_,
-                                            residuals, pose_jacobian ? jq : nullptr,
-                                            pose_jacobian ? jc : nullptr,
-                                            jacobians != nullptr ? jacobians[1] : nullptr)) {
-      return false;  // behind the camera: an invalid step, not an infinite residual
-    }
-    if (pose_jacobian) {
-      for (int row = 0; row < 2; ++row) {
-        double* out = jacobians[0] + row * kPoseSize;
-        std::copy(jq + 4 * row, jq + 4 * row + 4, out);
-        std::copy(jc + 3 * row, jc + 3 * row + 3, out + 4);
+    IntrinsicsLayout k = k_;
+    for (size_t i = 0; i < free_slots_.size(); ++i) k(free_slots_[i]) = parameters[1][i];
+    double* pose_jacobian = jacobians != nullptr ? jacobians[0] : nullptr;
+    double* k_jacobian = jacobians != nullptr ? jacobians[1] : nullptr;
+    Eigen::Matrix3d exp_w, left_jacobian;
+    ExpWithLeftJacobian(pose, &exp_w, pose_jacobian != nullptr ? &left_jacobian : nullptr);
+    const Eigen::Matrix3d rotation = exp_w * reference_rotation_;
+    const Eigen::Vector3d center(pose[3], pose[4], pose[5]);
+    const int num_free = static_cast<int>(free_slots_.size());
+    for (size_t j = 0; j < pixels_.size(); ++j) {
+      const Eigen::Vector3d p = rotation * (points_[j] - center);
+      if (!(p.z() > 0.0)) return false;  // behind the camera: an invalid step
+      Eigen::Matrix<double, 2, kFitIntrinsicsSize, Eigen::RowMajor> jk;
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> d_pixel_d_p;
+      internal::ResidualOfCamPoint(k.data(), p, pixels_[j], residuals + 2 * j,
+                                   k_jacobian != nullptr ? jk.data() : nullptr,
+                                   pose_jacobian != nullptr ? d_pixel_d_p.data() : nullptr);
+      if (k_jacobian != nullptr) {
+        for (int row = 0; row < 2; ++row) {
+          for (int i = 0; i < num_free; ++i) {
+            k_jacobian[(2 * j + row) * num_free + i] = jk(row, free_slots_[i]);
+          }
+        }
+      }
+      if (pose_jacobian != nullptr) {
+        Eigen::Map<Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor>> jp(
+            pose_jacobian + 2 * j * kPoseSize);
+        Eigen::Matrix3d p_cross;
+        p_cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
+        jp.leftCols<3>() = -d_pixel_d_p * p_cross * left_jacobian;
+        jp.rightCols<3>() = -d_pixel_d_p * rotation;
       }
     }
     return true;
   }
 
  private:
-  Eigen::Vector3d point_;
-  Eigen::Vector2d observed_;
+  const std::vector<Eigen::Vector3d>& points_;  // the view outlives the problem
+  const std::vector<Eigen::Vector2d>& pixels_;
+  Eigen::Matrix3d reference_rotation_;
+  const IntrinsicsLayout& k_;  // the joint problem's: fixed entries' values
+  std::vector<int> free_slots_;
 };
 
 void CheckView(const CalibrationView& view, size_t index) {
@@ -114,10 +173,18 @@ std::string ViewName(const CalibrationView& view, size_t index) {
   return view.name.empty() ? "view " + std::to_string(index + 1) : view.name;
 }
 
-// The view's points in the coordinates of their best-fitting plane, if they are planar (see
-// kPlanarShare).
-std::optional<std::vector<Eigen::Vector2d>> PlaneCoordinates(
-    const std::vector<Eigen::Vector3d>& points) {
+// A planar view read in its plane: point_in_plane = plane_from_world * (point_in_world -
+// centroid), the plane's normal along the third row; the homography from (u, v) to the pixels.
+struct PlanarView {
+  Eigen::Vector3d centroid;
+  Eigen::Matrix3d plane_from_world;  // rows: the widest axis, the second, their cross product
+  std::vector<Eigen::Vector2d> coordinates;
+  Eigen::Matrix3d homography;        // NormalizedHomography(coordinates, pixels)
+};
+
+// The view read in its best-fitting plane, if its points are planar (see kPlanarShare).
+std::optional<PlanarView> PlanarViewOf(const CalibrationView& view) {
+  const std::vector<Eigen::Vector3d>& points = view.points_in_world;
   const Eigen::Vector3d centroid = internal::Centroid(points);
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
@@ -125,14 +192,43 @@ std::optional<std::vector<Eigen::Vector2d>> PlaneCoordinates(
   // Eigenvalues ascending: extents are their square roots.
   const Eigen::Vector3d extent = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   if (!(extent(2) > 0.0) || extent(0) > kPlanarShare * extent(2)) return std::nullopt;
-  const Eigen::Vector3d axis_u = eigen.eigenvectors().col(2);
-  const Eigen::Vector3d axis_v = eigen.eigenvectors().col(1);
-  std::vector<Eigen::Vector2d> plane;
-  plane.reserve(points.size());
-  for (const auto& p : points) plane.emplace_back((p - centroid).dot(axis_u), (p - centroid).dot(axis_v));
+  PlanarView plane;
+  plane.centroid = centroid;
+  plane.plane_from_world.row(0) = eigen.eigenvectors().col(2).transpose();
+  plane.plane_from_world.row(1) = eigen.eigenvectors().col(1).transpose();
+  plane.plane_from_world.row(2) =
+      plane.plane_from_world.row(0).cross(plane.plane_from_world.row(1));
+  plane.coordinates.reserve(points.size());
+  for (const auto& p : points) {
+    plane.coordinates.push_back((plane.plane_from_world * (p - centroid)).head<2>());
+  }
+  plane.homography = internal::NormalizedHomography(plane.coordinates, view.pixels);
   return plane;
 }
 
+// A planar view's pose from its homography and K (Zhang, section 3.1): K^-1 H = lambda [r1 r2 t]
+// up to sign, the sign that puts the board's centroid in front; the rotation the nearest to
+// [r1 r2 r1 x r2]. The refinement starts from it, as cv::calibrateCamera's does: it costs a 3x3
+// SVD where SQPnP costs ~0.7 M instructions per view (bench --calibrate). std::nullopt when the
+// centroid would sit on the image plane.
+std::optional<internal::StartCamera> HomographyPose(const PlanarView& plane,
+                                                    const Intrinsics& intrinsics) {
+  Eigen::Matrix3d m = intrinsics.K().inverse() * plane.homography;
+  const double scale = 2.0 / (m.col(0).norm() + m.col(1).norm());
+  m *= m(2, 2) < 0.0 ? -scale : scale;
+  if (!(m(2, 2) > 0.0)) return std::nullopt;
+  Eigen::Matrix3d r;
+  r << m.col(0), m.col(1), m.col(0).cross(m.col(1));
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d cam_from_plane = svd.matrixU() * svd.matrixV().transpose();
+  if (cam_from_plane.determinant() < 0.0) return std::nullopt;
+  // point_in_cam = cam_from_plane * plane_from_world * (point_in_world - centroid) + t.
+  internal::StartCamera start;
+  start.rotation = cam_from_plane * plane.plane_from_world;
+  start.center = plane.centroid - start.rotation.transpose() * m.col(2);
+  start.intrinsics = intrinsics;
+  return start;
+}
 
 // The fixed entries of the intrinsics: their values where the options fix them.
 Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& options) {
@@ -150,7 +246,7 @@ Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& optio
 // else the median of the 3D views' DLT. std::nullopt when neither determines K.
 std::optional<Intrinsics> StartIntrinsics(
     const std::vector<CalibrationView>& views,
-    const std::vector<std::optional<std::vector<Eigen::Vector2d>>>& planes,
+    const std::vector<std::optional<PlanarView>>& planes,
     const CalibrateOptions& options) {
   const internal::ZhangModel model{options.aspect_free, options.principal_point_free,
                                    options.skew_free};
@@ -159,7 +255,7 @@ std::optional<Intrinsics> StartIntrinsics(
   for (size_t i = 0; i < views.size(); ++i) {
     const CalibrationView& view = views[i];
     if (planes[i]) {
-      homographies.push_back(internal::NormalizedHomography(*planes[i], view.pixels));
+      homographies.push_back(planes[i]->homography);
       continue;
     }
     if (view.points_in_world.size() < 6) continue;
@@ -403,45 +499,46 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
   }
 }
 
-// The joint problem: a pose block per view (started by SQPnP with the start's K), one shared
-// intrinsics block (fixed entries on a SubsetManifold). Members in this order: the manifolds
-// outlive the problem that borrows them.
+// The joint problem: a pose block per view (started from its homography if planar, else by
+// SQPnP, with the start's K) and one block of the free intrinsics shared by all views.
 struct JointProblem {
-  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
-  std::unique_ptr<ceres::SubsetManifold> intrinsics_manifold;
-  std::vector<std::array<double, kPoseSize>> poses;
-  Eigen::Matrix<double, kFitIntrinsicsSize, 1> k;
+  std::vector<Eigen::Matrix3d> reference_rotations;  // each view's start
+  std::vector<std::array<double, kPoseSize>> poses;  // [w, C], see ViewCost
+  IntrinsicsLayout k;                                 // every entry; free ones as of Solve
+  std::vector<int> free_slots;
+  std::vector<double> free_k;                         // the shared block
   ceres::Problem problem;
 
-  JointProblem(const std::vector<CalibrationView>& views, const Intrinsics& start,
+  JointProblem(const std::vector<CalibrationView>& views,
+               const std::vector<std::optional<PlanarView>>& planes, const Intrinsics& start,
                const std::vector<int>& fixed)
-      : poses(views.size()), k(FitLayout(start)), problem(ProblemOptions()) {
+      : reference_rotations(views.size()), poses(views.size()), k(FitLayout(start)) {
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (std::find(fixed.begin(), fixed.end(), slot) == fixed.end()) {
+        free_slots.push_back(slot);
+        free_k.push_back(k(slot));
+      }
+    }
     for (size_t i = 0; i < views.size(); ++i) {
       internal::StartCamera camera;
-      if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, start, &camera)) {
+      if (auto from_homography = planes[i] ? HomographyPose(*planes[i], start) : std::nullopt) {
+        camera = *from_homography;
+      } else if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, start, &camera)) {
         throw SceneError(SceneError::Reason::kDegenerate,
                          ViewName(views[i], i) + ": no pose from its points with the start's "
                          "intrinsics (SQPnP failed); check the view's correspondences");
       }
-      const Eigen::Quaterniond q(camera.rotation);
-      poses[i] = {q.x(), q.y(), q.z(), q.w(), camera.center.x(), camera.center.y(),
-                  camera.center.z()};
-      for (size_t j = 0; j < views[i].pixels.size(); ++j) {
-        problem.AddResidualBlock(new ViewPointCost(views[i].points_in_world[j], views[i].pixels[j]),
-                                 nullptr, poses[i].data(), k.data());
-      }
-      problem.SetManifold(poses[i].data(), &pose_manifold);
-    }
-    if (!fixed.empty()) {
-      intrinsics_manifold = std::make_unique<ceres::SubsetManifold>(kFitIntrinsicsSize, fixed);
-      problem.SetManifold(k.data(), intrinsics_manifold.get());
+      reference_rotations[i] = camera.rotation;
+      poses[i] = {0.0, 0.0, 0.0, camera.center.x(), camera.center.y(), camera.center.z()};
+      problem.AddResidualBlock(new ViewCost(views[i], reference_rotations[i], k, free_slots),
+                               nullptr, poses[i].data(), free_k.data());
     }
   }
 
-  static ceres::Problem::Options ProblemOptions() {
-    ceres::Problem::Options options;
-    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    return options;
+  Eigen::Matrix3d CamFromWorldRotation(size_t view) const {
+    Eigen::Matrix3d exp_w;
+    ExpWithLeftJacobian(poses[view].data(), &exp_w, nullptr);
+    return exp_w * reference_rotations[view];
   }
 
   // DENSE_SCHUR with the poses eliminated first; throws kNumerical when Ceres fails.
@@ -450,7 +547,7 @@ struct JointProblem {
     solver_options.linear_solver_type = ceres::DENSE_SCHUR;
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     for (auto& pose : poses) ordering->AddElementToGroup(pose.data(), 0);
-    ordering->AddElementToGroup(k.data(), 1);
+    ordering->AddElementToGroup(free_k.data(), 1);
     solver_options.linear_solver_ordering = ordering;
     solver_options.max_num_iterations = options.max_iterations;
     solver_options.function_tolerance = options.function_tolerance;
@@ -460,6 +557,7 @@ struct JointProblem {
     solver_options.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+    for (size_t i = 0; i < free_slots.size(); ++i) k(free_slots[i]) = free_k[i];
     if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
       throw SceneError(SceneError::Reason::kNumerical,
                        "the joint refinement failed: " + summary.message);
@@ -475,29 +573,29 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
   double sum_squares = 0.0;
   for (size_t i = 0; i < views.size(); ++i) {
     const std::array<double, kPoseSize>& pose = joint.poses[i];
-    const Eigen::Map<const Eigen::Quaterniond> q(pose.data());
+    const Eigen::Matrix3d rotation = joint.CamFromWorldRotation(i);
     CalibratedView view;
     view.name = ViewName(views[i], i);
     view.camera.image_size = options.image_size;
     view.camera.intrinsics = result->intrinsics;
-    view.camera.cam_from_world = CamFromWorldFromCenter(
-        q.normalized().toRotationMatrix(), Eigen::Vector3d(pose[4], pose[5], pose[6]));
+    const Eigen::Vector3d center(pose[3], pose[4], pose[5]);
+    view.camera.cam_from_world = CamFromWorldFromCenter(rotation, center);
     view.num_points = static_cast<int>(views[i].pixels.size());
     double view_sum = 0.0;
     double min_depth = std::numeric_limits<double>::infinity(), max_depth = 0.0;
     for (size_t j = 0; j < views[i].pixels.size(); ++j) {
       double residual[2];
-      if (!internal::ProjectPointWithJacobian(pose.data(), pose.data() + 4, joint.k.data(),
-                                              views[i].points_in_world[j], views[i].pixels[j],
-                                              residual, nullptr, nullptr, nullptr)) {
+      const Eigen::Vector3d point_in_cam = rotation * (views[i].points_in_world[j] - center);
+      if (!(point_in_cam.z() > 0.0)) {
         throw SceneError(SceneError::Reason::kPointsBehindCamera,
                          view.name + ": point " + std::to_string(j + 1) +
                              " is behind the calibrated camera");
       }
+      internal::ResidualOfCamPoint(joint.k.data(), point_in_cam, views[i].pixels[j], residual,
+                                   nullptr, nullptr);
       view_sum += residual[0] * residual[0] + residual[1] * residual[1];
-      const double depth = (view.camera.cam_from_world * views[i].points_in_world[j]).z();
-      min_depth = std::min(min_depth, depth);
-      max_depth = std::max(max_depth, depth);
+      min_depth = std::min(min_depth, point_in_cam.z());
+      max_depth = std::max(max_depth, point_in_cam.z());
     }
     view.camera.z_near = min_depth / (1.0 + kDepthMargin);
     view.camera.z_far = max_depth * (1.0 + kDepthMargin);
@@ -516,16 +614,23 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
   // decomposes the whole 2N x (6 views + 7) Jacobian: 1.2 s at 50 views, bench --calibrate.)
   covariance_options.algorithm_type = ceres::SPARSE_QR;
   ceres::Covariance covariance(covariance_options);
-  const double* k = joint.k.data();
-  const std::vector<std::pair<const double*, const double*>> blocks = {{k, k}};
+  const double* free_k = joint.free_k.data();
+  const std::vector<std::pair<const double*, const double*>> blocks = {{free_k, free_k}};
   if (!covariance.Compute(blocks, &joint.problem)) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the views do not determine every free intrinsic (the covariance is "
                      "singular): add views at other angles, or fix the principal point, the "
                      "aspect or the distortion");
   }
-  Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize, Eigen::RowMajor> c;
-  covariance.GetCovarianceBlock(k, k, c.data());
+  const int num_free = static_cast<int>(joint.free_slots.size());
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> free_c(num_free, num_free);
+  covariance.GetCovarianceBlock(free_k, free_k, free_c.data());
+  Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize> c =
+      Eigen::Matrix<double, kFitIntrinsicsSize, kFitIntrinsicsSize>::Zero();
+  for (int a = 0; a < num_free; ++a) {
+    for (int b = 0; b < num_free; ++b) c(joint.free_slots[a], joint.free_slots[b]) = free_c(a, b);
+  }
+  const double* k = joint.k.data();
   c *= sum_squares / (2.0 * result->num_points - result->num_parameters);
   result->intrinsics_covariance = c;
   auto add = [&](const std::string& name, double value, double variance, const std::string& unit) {
@@ -558,10 +663,10 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   int num_points = 0;
   for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
   const int num_parameters = 6 * static_cast<int>(views.size()) + free_intrinsics;
-  std::vector<std::optional<std::vector<Eigen::Vector2d>>> planes;
+  std::vector<std::optional<PlanarView>> planes;
   int planar_views = 0;
   for (const auto& view : views) {
-    planes.push_back(PlaneCoordinates(view.points_in_world));
+    planes.push_back(PlanarViewOf(view));
     planar_views += planes.back() ? 1 : 0;
   }
   CheckDetermined(views, num_points, num_parameters, free_intrinsics, planar_views, options);
@@ -573,7 +678,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
                      "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
                      "add views at other angles, or fix the principal point and the aspect");
   }
-  JointProblem joint(views, *start, fixed);
+  JointProblem joint(views, planes, *start, fixed);
   const ceres::Solver::Summary summary = joint.Solve(options);
 
   Calibration result;
