@@ -43,9 +43,10 @@ class InputError(ValueError):
 
 class Intrinsics:
     """Pinhole intrinsics in px (cx, cy in the pixel origin of the call that made them, OpenCV's by
-    default) with radial distortion k1, k2 on normalized coordinates (OpenCV's k1, k2)."""
+    default) with OpenCV's lens on normalized coordinates: radial k1, k2, k3, tangential p1, p2."""
     def __init__(self, fx: float, fy: float, cx: float, cy: float, skew: float = 0.0,
-                 k1: float = 0.0, k2: float = 0.0) -> None: ...
+                 k1: float = 0.0, k2: float = 0.0, p1: float = 0.0, p2: float = 0.0,
+                 k3: float = 0.0) -> None: ...
     fx: float
     fy: float
     cx: float
@@ -53,6 +54,9 @@ class Intrinsics:
     skew: float
     k1: float
     k2: float
+    p1: float
+    p2: float
+    k3: float
     @property
     def K(self) -> Mat:
         """[[fx, skew, cx], [0, fy, cy], [0, 0, 1]] (3x3, a new array)."""

@@ -240,15 +240,18 @@ PYBIND11_MODULE(camproj, m) {
     }
   });
 
-  py::class_<Intrinsics>(m, "Intrinsics", "Pinhole intrinsics (px) with radial k1, k2; cx, cy in "
-                                          "OpenCV's pixel origin (docs/conventions.md).")
-      .def(py::init([](double fx, double fy, double cx, double cy, double skew, double k1, double k2) {
-             Intrinsics k{fx, fy, cx, cy, skew, k1, k2};
+  py::class_<Intrinsics>(m, "Intrinsics", "Pinhole intrinsics (px) with OpenCV's lens k1, k2, p1, "
+                                          "p2, k3; cx, cy in OpenCV's pixel origin "
+                                          "(docs/conventions.md).")
+      .def(py::init([](double fx, double fy, double cx, double cy, double skew, double k1,
+                       double k2, double p1, double p2, double k3) {
+             Intrinsics k{fx, fy, cx, cy, skew, k1, k2, p1, p2, k3};
              k.Check();
              return k;
            }),
            py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("skew") = 0.0,
-           py::arg("k1") = 0.0, py::arg("k2") = 0.0)
+           py::arg("k1") = 0.0, py::arg("k2") = 0.0, py::arg("p1") = 0.0, py::arg("p2") = 0.0,
+           py::arg("k3") = 0.0)
       .def_readonly("fx", &Intrinsics::fx)
       .def_readonly("fy", &Intrinsics::fy)
       .def_readonly("cx", &Intrinsics::cx)
@@ -256,11 +259,19 @@ PYBIND11_MODULE(camproj, m) {
       .def_readonly("skew", &Intrinsics::skew)
       .def_readonly("k1", &Intrinsics::k1)
       .def_readonly("k2", &Intrinsics::k2)
+      .def_readonly("p1", &Intrinsics::p1)
+      .def_readonly("p2", &Intrinsics::p2)
+      .def_readonly("k3", &Intrinsics::k3)
       .def_property_readonly("K", &Intrinsics::K)
       .def_static("from_K", &IntrinsicsFromK, py::arg("K"))
       .def("__repr__", [](const Intrinsics& k) {
-        return py::str("Intrinsics(fx={}, fy={}, cx={}, cy={}, skew={}, k1={}, k2={})")
-            .format(k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2);
+        if (!k.HasBeyondTwoRadial()) {
+          return py::str("Intrinsics(fx={}, fy={}, cx={}, cy={}, skew={}, k1={}, k2={})")
+              .format(k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2);
+        }
+        return py::str("Intrinsics(fx={}, fy={}, cx={}, cy={}, skew={}, k1={}, k2={}, p1={}, "
+                       "p2={}, k3={})")
+            .format(k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3);
       });
 
   py::class_<Frustum>(m, "Frustum", "glFrustum's near-plane window and depth range (gl_eye units).")

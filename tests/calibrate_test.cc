@@ -289,7 +289,7 @@ TEST(CalibrateTest, BadViewsAreNamed) {
     EXPECT_NE(std::string(e.what()).find("left03"), std::string::npos) << e.what();
   }
   CalibrateOptions bad = Options();
-  bad.num_radial = 3;
+  bad.num_radial = 4;
   EXPECT_THROW(Calibrate(ChessboardViews("left"), bad), std::invalid_argument);
 }
 

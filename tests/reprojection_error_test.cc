@@ -22,10 +22,13 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
     const Eigen::Quaterniond q(testing::RandomRotation(rng));
     const Eigen::Vector3d center(testing::Uniform(rng, -2, 2), testing::Uniform(rng, -2, 2),
                                  testing::Uniform(rng, -2, 2));
-    double intrinsics[7] = {testing::Uniform(rng, 300, 3000), testing::Uniform(rng, 0.8, 1.2),
-                            testing::Uniform(rng, 0, 2000),   testing::Uniform(rng, 0, 2000),
-                            testing::Uniform(rng, -50, 50),   testing::Uniform(rng, -0.3, 0.3),
-                            testing::Uniform(rng, -0.1, 0.1)};
+    // Every slot non-zero, p1, p2 and k3 (OpenCV's lens) included.
+    double intrinsics[internal::kFitIntrinsicsSize] = {
+        testing::Uniform(rng, 300, 3000),  testing::Uniform(rng, 0.8, 1.2),
+        testing::Uniform(rng, 0, 2000),    testing::Uniform(rng, 0, 2000),
+        testing::Uniform(rng, -50, 50),    testing::Uniform(rng, -0.3, 0.3),
+        testing::Uniform(rng, -0.1, 0.1),  testing::Uniform(rng, -0.01, 0.01),
+        testing::Uniform(rng, -0.01, 0.01), testing::Uniform(rng, -0.05, 0.05)};
     const Eigen::Vector3d point_in_cam(testing::Uniform(rng, -1, 1), testing::Uniform(rng, -1, 1),
                                        testing::Uniform(rng, 1, 5));
     const Eigen::Vector3d point = q.inverse() * point_in_cam + center;
@@ -35,7 +38,8 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
     const internal::PointReprojectionCost analytic(point, observed);
     const double* parameters[3] = {q.coeffs().data(), center.data(), intrinsics};
     double residual_a[2], residual_b[2];
-    double jq_a[8], jc_a[6], jk_a[14], jq_b[8], jc_b[6], jk_b[14];
+    double jq_a[8], jc_a[6], jk_a[2 * internal::kFitIntrinsicsSize], jq_b[8], jc_b[6],
+        jk_b[2 * internal::kFitIntrinsicsSize];
     double* jacobians_a[3] = {jq_a, jc_a, jk_a};
     double* jacobians_b[3] = {jq_b, jc_b, jk_b};
     ASSERT_TRUE(automatic->Evaluate(parameters, residual_a, jacobians_a));
@@ -51,7 +55,7 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
     };
     expect_close(jq_a, jq_b, 8, "rotation");
     expect_close(jc_a, jc_b, 6, "center");
-    expect_close(jk_a, jk_b, 14, "intrinsics");
+    expect_close(jk_a, jk_b, 2 * internal::kFitIntrinsicsSize, "intrinsics");
   }
 }
 
@@ -59,7 +63,7 @@ TEST(ReprojectionErrorTest, PointBehindTheCameraIsAnInvalidEvaluation) {
   const internal::PointReprojectionCost cost(Eigen::Vector3d(0, 0, -1), Eigen::Vector2d(0, 0));
   const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   const double center[3] = {0, 0, 0};
-  const double intrinsics[7] = {500, 1, 320, 240, 0, 0, 0};
+  const double intrinsics[internal::kFitIntrinsicsSize] = {500, 1, 320, 240};
   const double* parameters[3] = {q.coeffs().data(), center, intrinsics};
   double residual[2];
   EXPECT_FALSE(cost.Evaluate(parameters, residual, nullptr));

@@ -370,7 +370,8 @@ FitOptions FocalOnly() {
 using Vector3l = Eigen::Matrix<long double, 3, 1>;
 
 Eigen::Matrix<long double, 2, 1> PixelLong(const Intrinsics& k, const Vector3l& p) {
-  const long double slots[7] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+  const long double slots[kIntrinsicsArraySize] = {k.fx,   k.fy, k.cx, k.cy, k.skew,
+                                                   k.k1,   k.k2, k.p1, k.p2, k.k3};
   long double pixel[2];
   PixelFromNormalized<long double>(slots, p.x() / p.z(), p.y() / p.z(), pixel);
   return {pixel[0], pixel[1]};
@@ -863,13 +864,8 @@ Scenario CameraInsideCloud() {
         Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
     const Eigen::Vector3d p = testing::Uniform(rng, 1.0, 2.0) * direction;  // in cam
     if (std::abs(p.z()) < 0.2) continue;
-    const double slots[7] = {s.truth.intrinsics.fx,
-                             s.truth.intrinsics.fy,
-                             s.truth.intrinsics.cx,
-                             s.truth.intrinsics.cy,
-                             0,
-                             0,
-                             0};
+    const double slots[kIntrinsicsArraySize] = {s.truth.intrinsics.fx, s.truth.intrinsics.fy,
+                                                s.truth.intrinsics.cx, s.truth.intrinsics.cy};
     Eigen::Vector2d pixel;
     PixelFromNormalized<double>(slots, p.x() / p.z(), p.y() / p.z(), pixel.data());
     if (pixel.x() < 0 || pixel.y() < 0 || pixel.x() > s.truth.size.width - 1 ||

@@ -63,7 +63,8 @@ inline double PerturbationNorm(const std::vector<Eigen::Vector3d>& points,
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& x : points) centroid += x;
   centroid /= static_cast<double>(points.size());
-  const long double slots[7] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+  const long double slots[kIntrinsicsArraySize] = {k.fx,   k.fy, k.cx, k.cy, k.skew,
+                                                   k.k1,   k.k2, k.p1, k.p2, k.k3};
   long double data = 0.0L;
   double eval = 0.0;
   for (size_t i = 0; i < points.size(); ++i) {

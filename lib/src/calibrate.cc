@@ -24,8 +24,8 @@ namespace camproj {
 
 void CalibrateOptions::Check() const {
   image_size.Check();
-  if (num_radial < 0 || num_radial > 2) {
-    throw std::invalid_argument("CalibrateOptions.num_radial must be 0, 1 or 2, got " +
+  if (num_radial < 0 || num_radial > 3) {
+    throw std::invalid_argument("CalibrateOptions.num_radial must be 0, 1, 2 or 3, got " +
                                 std::to_string(num_radial));
   }
   if (max_iterations <= 0) {
@@ -42,7 +42,8 @@ namespace {
 using internal::kFitIntrinsicsSize;
 
 // Intrinsics block entries (reprojection_error.h): [f, aspect, cx, cy, skew, k1, k2].
-constexpr int kAspect = 1, kCx = 2, kCy = 3, kSkew = 4, kK1 = 5, kK2 = 6;
+constexpr int kAspect = 1, kCx = 2, kCy = 3, kSkew = 4, kK1 = 5, kK2 = 6, kP1 = 7, kP2 = 8,
+              kK3 = 9;
 // Pose block: a rotation vector w (cam_from_world = Exp(w) R0, R0 the view's start), then the
 // camera centre.
 constexpr int kPoseSize = 6;
@@ -238,7 +239,7 @@ Intrinsics WithFixedEntries(Intrinsics intrinsics, const CalibrateOptions& optio
   }
   if (!options.aspect_free) intrinsics.fx = intrinsics.fy = std::sqrt(intrinsics.fx * intrinsics.fy);
   if (!options.skew_free) intrinsics.skew = 0.0;
-  intrinsics.k1 = intrinsics.k2 = 0.0;
+  intrinsics.k1 = intrinsics.k2 = intrinsics.p1 = intrinsics.p2 = intrinsics.k3 = 0.0;
   return intrinsics;
 }
 
@@ -310,13 +311,18 @@ std::vector<int> FixedIntrinsicEntries(const CalibrateOptions& options) {
   if (!options.skew_free) fixed.push_back(kSkew);
   if (options.num_radial < 1) fixed.push_back(kK1);
   if (options.num_radial < 2) fixed.push_back(kK2);
+  if (!options.tangential_free) {
+    fixed.push_back(kP1);
+    fixed.push_back(kP2);
+  }
+  if (options.num_radial < 3) fixed.push_back(kK3);
   return fixed;
 }
 
 // The fit layout [f, aspect, cx, cy, skew, k1, k2] of intrinsics.
 Eigen::Matrix<double, kFitIntrinsicsSize, 1> FitLayout(const Intrinsics& k) {
   Eigen::Matrix<double, kFitIntrinsicsSize, 1> p;
-  p << k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2;
+  p << k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3;
   return p;
 }
 
@@ -329,6 +335,9 @@ Intrinsics FromFitLayout(const Eigen::Matrix<double, kFitIntrinsicsSize, 1>& p) 
   k.skew = p(kSkew);
   k.k1 = p(kK1);
   k.k2 = p(kK2);
+  k.p1 = p(kP1);
+  k.p2 = p(kP2);
+  k.k3 = p(kK3);
   return k;
 }
 
@@ -649,6 +658,11 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
   if (options.skew_free) add("skew", k[kSkew], c(kSkew, kSkew), "px");
   if (options.num_radial >= 1) add("k1", k[kK1], c(kK1, kK1), "");
   if (options.num_radial >= 2) add("k2", k[kK2], c(kK2, kK2), "");
+  if (options.tangential_free) {
+    add("p1", k[kP1], c(kP1, kP1), "");
+    add("p2", k[kP2], c(kP2, kP2), "");
+  }
+  if (options.num_radial >= 3) add("k3", k[kK3], c(kK3, kK3), "");
 }
 
 }  // namespace

@@ -20,6 +20,11 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   file["pixel_origin"] = ToString(options.pixel_origin);
   file["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
                         {"skew", k.skew}, {"k1", k.k1}, {"k2", k.k2}};
+  if (k.HasBeyondTwoRadial()) {
+    file["intrinsics"]["p1"] = k.p1;
+    file["intrinsics"]["p2"] = k.p2;
+    file["intrinsics"]["k3"] = k.k3;
+  }
   nlohmann::ordered_json sigma = nlohmann::ordered_json::object();
   for (const ParameterSigma& p : calibration.intrinsics_sigma) sigma[p.name] = p.sigma;
   file["sigma"] = sigma;

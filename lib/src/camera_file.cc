@@ -116,6 +116,9 @@ Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
   intrinsics.skew = reader.NumberOr(k, "intrinsics", "skew", 0.0);
   intrinsics.k1 = reader.NumberOr(k, "intrinsics", "k1", 0.0);
   intrinsics.k2 = reader.NumberOr(k, "intrinsics", "k2", 0.0);
+  intrinsics.p1 = reader.NumberOr(k, "intrinsics", "p1", 0.0);
+  intrinsics.p2 = reader.NumberOr(k, "intrinsics", "p2", 0.0);
+  intrinsics.k3 = reader.NumberOr(k, "intrinsics", "k3", 0.0);
   try {
     intrinsics.Check();
   } catch (const std::invalid_argument& e) {
@@ -302,6 +305,11 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
   document["projection"] = orthographic ? "orthographic" : "perspective";
   document["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy},     {"cx", k.cx}, {"cy", k.cy},
                             {"skew", k.skew}, {"k1", k.k1}, {"k2", k.k2}};
+  if (k.HasBeyondTwoRadial()) {
+    document["intrinsics"]["p1"] = k.p1;
+    document["intrinsics"]["p2"] = k.p2;
+    document["intrinsics"]["k3"] = k.k3;
+  }
   json rows = json::array();
   for (int r = 0; r < 3; ++r) {
     rows.push_back(Vector3Json(camera.cam_from_world.rotation.row(r).transpose()));

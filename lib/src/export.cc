@@ -68,8 +68,7 @@ std::string DepthSummary(const GlDepth& depth) {
 
 std::string DistortionNote(const Camera& camera) {
   auto out = ExactStream();
-  out << "k1 = " << camera.intrinsics.k1 << ", k2 = " << camera.intrinsics.k2
-      << " are not in the projection matrix (GL projection is linear): it puts points up to "
+  out << DistortionText(camera.intrinsics) << " are not in the projection matrix (GL projection is linear): it puts points up to "
       << std::setprecision(3) << PinholeErrorAtWorstCornerPx(camera)
       << " px (worst image corner) from where the lens images them; to render the lens: export "
          "glsl (per vertex), distortion-mesh or stmap (post-process warp)";
@@ -138,7 +137,7 @@ std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
   if (camera.intrinsics.HasDistortion()) {
     out << "# note: " << DistortionNote(camera) << '\n';
   } else {
-    out << "# distortion: none (k1 and k2 are 0): the matrices are the whole camera\n";
+    out << "# distortion: none (k1, k2, p1, p2, k3 are 0): the matrices are the whole camera\n";
   }
   out << "# " << OriginNote(camera) << '\n';
   PrintMatrix(out, "projection", views.clip_from_gl_eye, options.row_major);
@@ -191,7 +190,7 @@ std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
   if (camera.intrinsics.HasDistortion()) {
     out << "// Note: " << DistortionNote(camera) << ".\n";
   } else {
-    out << "// Distortion: none (k1 and k2 are 0): the matrices are the whole camera.\n";
+    out << "// Distortion: none (k1, k2, p1, p2, k3 are 0): the matrices are the whole camera.\n";
   }
   out << "// " << OriginNote(camera) << ".\n";
   if (camera.world_origin) {
@@ -246,7 +245,7 @@ std::string ExportOpenCvYamlText(const Camera& camera) {
                 "OpenCV's camera model has no skew (cv::projectPoints ignores camera_matrix(0,1))");
   const Intrinsics& k = camera.intrinsics;
   Eigen::Matrix<double, 1, 5> distortion;
-  distortion << k.k1, k.k2, 0.0, 0.0, 0.0;
+  distortion << k.k1, k.k2, k.p1, k.p2, k.k3;
   cv::FileStorage storage(
       "", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   storage.writeComment(
@@ -255,7 +254,7 @@ std::string ExportOpenCvYamlText(const Camera& camera) {
   storage.writeComment(
       "rvec, tvec: cam_from_world (x_cam = R x_world + t, as cv::solvePnP returns it); "
       "R = cv::Rodrigues(rvec), also written as R.");
-  storage.writeComment("distortion_coefficients: k1 k2 p1 p2 k3 (p1 = p2 = k3 = 0).");
+  storage.writeComment("distortion_coefficients: k1 k2 p1 p2 k3 (cv::projectPoints' order).");
   storage << "image_width" << camera.image_size.width;
   storage << "image_height" << camera.image_size.height;
   storage << "camera_matrix" << CvMatrix(k.K());
@@ -285,9 +284,13 @@ std::string ExportColmapText(const Camera& camera) {
       << "# Camera list with one line of data per camera:\n"
       << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
       << "# Number of cameras: 1\n"
-      << "1 " << (k.HasDistortion() ? "OPENCV" : "PINHOLE") << ' ' << camera.image_size.width << ' '
-      << camera.image_size.height << ' ' << k.fx << ' ' << k.fy << ' ' << k.cx << ' ' << k.cy;
-  if (k.HasDistortion()) out << ' ' << k.k1 << ' ' << k.k2 << " 0 0";
+      << "1 " << (k.k3 != 0.0 ? "FULL_OPENCV" : k.HasDistortion() ? "OPENCV" : "PINHOLE") << ' '
+      << camera.image_size.width << ' ' << camera.image_size.height << ' ' << k.fx << ' ' << k.fy
+      << ' ' << k.cx << ' ' << k.cy;
+  // OPENCV: k1 k2 p1 p2; FULL_OPENCV: k1 k2 p1 p2 k3 k4 k5 k6 (k4..k6 the rational model's
+  // denominator, 0 here).
+  if (k.HasDistortion()) out << ' ' << k.k1 << ' ' << k.k2 << ' ' << k.p1 << ' ' << k.p2;
+  if (k.k3 != 0.0) out << ' ' << k.k3 << " 0 0 0";
   out << '\n'
       << "# ==> images.txt <==\n"
       << "# Image list with two lines of data per image:\n"
@@ -416,7 +419,7 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
       "section 2).";
   note += camera.intrinsics.HasDistortion()
               ? " " + DistortionNote(camera) + "."
-              : std::string(" Distortion: none (k1 and k2 are 0): projectionMatrix is the whole camera.");
+              : std::string(" Distortion: none (k1, k2, p1, p2, k3 are 0): projectionMatrix is the whole camera.");
   note += std::string(" matrixWorld = ") +
           (camera.world_origin ? "world_from_gl_eye in the origin-relative world" : "world_from_gl_eye") +
           " (three's camera looks down -z with y up); for a camera "

@@ -132,6 +132,10 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
       << Format("%.6g", k.cx) << " cy " << Format("%.6g", k.cy);
   if (k.skew != 0.0) out << " skew " << Format("%.6g", k.skew);
   if (k.HasDistortion()) out << " k1 " << Format("%.6g", k.k1) << " k2 " << Format("%.6g", k.k2);
+  if (k.HasBeyondTwoRadial()) {
+    out << " p1 " << Format("%.6g", k.p1) << " p2 " << Format("%.6g", k.p2) << " k3 "
+        << Format("%.6g", k.k3);
+  }
   out << " (px, pixel centres at integers)\n";
   const LookAt& look = fit.views.look_at;
   auto vec = [](const Eigen::Vector3d& v) {

@@ -24,8 +24,8 @@ void RequireNoSkewNoDistortion(const Intrinsics& intrinsics) {
   Require(intrinsics.skew == 0.0, "skew = ", intrinsics.skew,
           " has no glFrustum form (a frustum is an axis-aligned window): use the projection "
           "matrix, which carries skew");
-  Require(!intrinsics.HasDistortion(), "distortion (k1 = ", intrinsics.k1, ", k2 = ",
-          intrinsics.k2, ") has no frustum form: use Intrinsics::Pinhole() to drop it knowingly");
+  Require(!intrinsics.HasDistortion(), "distortion (", DistortionText(intrinsics),
+          ") has no frustum form: use Intrinsics::Pinhole() to drop it knowingly");
 }
 
 }  // namespace

@@ -90,8 +90,8 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
   size.Check();
   // Validates near and far with the frustum's messages; the frustum itself ignores skew.
   Frustum{-1.0, 1.0, -1.0, 1.0, z_near, z_far}.Check();
-  Require(!intrinsics.HasDistortion(), "distortion (k1 = ", intrinsics.k1, ", k2 = ",
-          intrinsics.k2, ") cannot be represented by a projection matrix: pass "
+  Require(!intrinsics.HasDistortion(), "distortion (", DistortionText(intrinsics),
+          ") cannot be represented by a projection matrix: pass "
           "intrinsics.Pinhole() to drop it knowingly");
   // Corner convention: x_win = u_corner, y_win = H - v_corner (docs/conventions.md).
   const Intrinsics k = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCorner);
@@ -127,8 +127,8 @@ Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const Im
                                           PixelOrigin origin) {
   intrinsics.Check();
   size.Check();
-  Require(!intrinsics.HasDistortion(), "an orthographic camera has no distortion, got k1 = ",
-          intrinsics.k1, ", k2 = ", intrinsics.k2);
+  Require(!intrinsics.HasDistortion(), "an orthographic camera has no distortion, got ",
+          DistortionText(intrinsics));
   Require(std::isfinite(z_near) && std::isfinite(z_far) && z_far > z_near,
           "an orthographic projection needs finite near < far, got near ", z_near, ", far ", z_far);
   // Corner convention, x_eye = x_cam, y_eye = -y_cam, z_eye = -z_cam:

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/LU>
 
 #include "check.h"
 
@@ -18,7 +22,9 @@ using internal::RequireFinite;
 void Intrinsics::Check() const {
   // Every projection checks its intrinsics: one test for the valid case first (a sum is finite
   // only if every term is), the named refusals below otherwise.
-  if (std::isfinite(fx + fy + cx + cy + skew + k1 + k2) && fx > 0.0 && fy > 0.0) return;
+  if (std::isfinite(fx + fy + cx + cy + skew + k1 + k2 + p1 + p2 + k3) && fx > 0.0 && fy > 0.0) {
+    return;
+  }
   RequireFinite(fx, "fx");
   RequireFinite(fy, "fy");
   RequireFinite(cx, "cx");
@@ -26,6 +32,9 @@ void Intrinsics::Check() const {
   RequireFinite(skew, "skew");
   RequireFinite(k1, "k1");
   RequireFinite(k2, "k2");
+  RequireFinite(p1, "p1");
+  RequireFinite(p2, "p2");
+  RequireFinite(k3, "k3");
   Require(fx > 0.0, "fx must be positive, got ", fx);
   Require(fy > 0.0, "fy must be positive, got ", fy);
 }
@@ -38,9 +47,20 @@ Eigen::Matrix3d Intrinsics::K() const {
 
 Intrinsics Intrinsics::Pinhole() const {
   Intrinsics pinhole = *this;
-  pinhole.k1 = 0.0;
-  pinhole.k2 = 0.0;
+  pinhole.k1 = pinhole.k2 = pinhole.p1 = pinhole.p2 = pinhole.k3 = 0.0;
   return pinhole;
+}
+
+std::string DistortionText(const Intrinsics& k) {
+  std::string text = internal::Concat("k1 = ", k.k1, ", k2 = ", k.k2);
+  if (k.HasBeyondTwoRadial()) {
+    text += internal::Concat(", p1 = ", k.p1, ", p2 = ", k.p2, ", k3 = ", k.k3);
+  }
+  return text;
+}
+
+std::array<double, kIntrinsicsArraySize> IntrinsicsArray(const Intrinsics& k) {
+  return {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3};
 }
 
 Intrinsics IntrinsicsFromK(const Eigen::Matrix3d& K) {
@@ -72,17 +92,58 @@ Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d
   intrinsics.Check();
   internal::RequireFiniteAll(point_in_cam, "point_in_cam");
   Require(point_in_cam.z() > 0.0, "point is not in front of the camera: z = ", point_in_cam.z());
-  const double params[7] = {intrinsics.fx, intrinsics.fy,   intrinsics.cx, intrinsics.cy,
-                            intrinsics.skew, intrinsics.k1, intrinsics.k2};
+  const std::array<double, kIntrinsicsArraySize> params = IntrinsicsArray(intrinsics);
   Eigen::Vector2d pixel;
-  PixelFromNormalized(params, point_in_cam.x() / point_in_cam.z(),
+  PixelFromNormalized(params.data(), point_in_cam.x() / point_in_cam.z(),
                       point_in_cam.y() / point_in_cam.z(), pixel.data());
   return pixel;
 }
 
-double RadialFoldRadius(double k1, double k2) {
+namespace {
+
+// The smallest root s > 0 of h(s) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 (h(0) = 1), k3 != 0: h is
+// monotone between its critical points (the roots of h'(s) = 3 k1 + 10 k2 s + 21 k3 s^2), so the
+// first interval whose end has h <= 0 holds the root, found by bisection to the last bit.
+double SmallestCubicFoldRoot(double k1, double k2, double k3) {
+  auto h = [&](double s) { return 1.0 + s * (3.0 * k1 + s * (5.0 * k2 + s * 7.0 * k3)); };
+  std::vector<double> ends;
+  const double disc = 100.0 * k2 * k2 - 252.0 * k1 * k3;
+  if (disc >= 0.0) {
+    const double sq = std::sqrt(disc);
+    for (const double s : {(-10.0 * k2 - sq) / (42.0 * k3), (-10.0 * k2 + sq) / (42.0 * k3)}) {
+      if (s > 0.0) ends.push_back(s);
+    }
+    std::sort(ends.begin(), ends.end());
+  }
+  double lo = 0.0;
+  for (const double end : ends) {
+    if (h(end) <= 0.0) {
+      double hi = end;
+      while (hi - lo > 0.0 && std::nextafter(lo, hi) < hi) {
+        const double mid = 0.5 * (lo + hi);
+        (h(mid) > 0.0 ? lo : hi) = mid;
+      }
+      return hi;
+    }
+    lo = end;
+  }
+  if (k3 > 0.0) return kInfinity;  // h > 0 beyond the last critical point
+  double hi = std::max(1.0, 2.0 * lo);
+  while (h(hi) > 0.0) hi *= 2.0;
+  while (hi - lo > 0.0 && std::nextafter(lo, hi) < hi) {
+    const double mid = 0.5 * (lo + hi);
+    (h(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+}  // namespace
+
+double RadialFoldRadius(double k1, double k2, double k3) {
   RequireFinite(k1, "k1");
   RequireFinite(k2, "k2");
+  RequireFinite(k3, "k3");
+  if (k3 != 0.0) return std::sqrt(SmallestCubicFoldRoot(k1, k2, k3));
   // Smallest positive root s = r^2 of 5 k2 s^2 + 3 k1 s + 1.
   double s_fold = kInfinity;
   if (k2 == 0.0) {
@@ -107,43 +168,84 @@ Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vecto
   const double xd = (pixel.x() - intrinsics.cx - intrinsics.skew * yd) / intrinsics.fx;
   if (!intrinsics.HasDistortion()) return {xd, yd, 1.0};
 
-  // Radial distortion scales the radius: rd = g(r) = r (1 + k1 r^2 + k2 r^4). g is invertible
-  // where it is increasing, on [0, r_fold) with r_fold the first zero of
-  // g'(r) = 1 + 3 k1 r^2 + 5 k2 r^4; beyond g(r_fold) the image folds over and is refused.
-  const double k1 = intrinsics.k1;
-  const double k2 = intrinsics.k2;
-  auto g = [&](double r) { return r * (1.0 + r * r * (k1 + r * r * k2)); };
-  const double r_fold = RadialFoldRadius(k1, k2);
-  const double rd = std::hypot(xd, yd);
-  if (rd == 0.0) return {0.0, 0.0, 1.0};
-  if (std::isfinite(r_fold) && !(rd < g(r_fold))) {
+  // Radial distortion scales the radius: rd = g(r) = r d(r), d = 1 + k1 r^2 + k2 r^4 + k3 r^6.
+  // g is invertible where it is increasing, on [0, r_fold) with r_fold the first zero of
+  // g'(r) = 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6; beyond g(r_fold) the image folds over and is
+  // refused.
+  const double k1 = intrinsics.k1, k2 = intrinsics.k2, k3 = intrinsics.k3;
+  auto g = [&](double r) {
+    const double r2 = r * r;
+    return r * (1.0 + r2 * (k1 + r2 * (k2 + r2 * k3)));
+  };
+  const double r_fold = RadialFoldRadius(k1, k2, k3);
+  auto refuse = [&](double rd) {
     throw std::domain_error(internal::Concat(
         "cannot undistort pixel (", pixel.x(), ", ", pixel.y(), "): radial distortion k1 = ", k1,
-        ", k2 = ", k2, " folds over at normalized radius ", r_fold, " (distorted ", g(r_fold),
-        "), this pixel is at distorted radius ", rd));
+        ", k2 = ", k2, ", k3 = ", k3, " folds over at normalized radius ", r_fold,
+        " (distorted ", g(r_fold), "), this pixel is at distorted radius ", rd));
+  };
+  // The radial inverse of (xd, yd): exact without p1, p2, else Newton's start below.
+  Eigen::Vector2d xy(xd, yd);
+  const double rd = std::hypot(xd, yd);
+  if (rd > 0.0) {
+    if (std::isfinite(r_fold) && !(rd < g(r_fold))) {
+      if (intrinsics.p1 == 0.0 && intrinsics.p2 == 0.0) refuse(rd);
+    } else {
+      // Safeguarded Newton on the bracket [0, min(r_fold, upper)] where g is increasing.
+      double lo = 0.0;
+      double hi = r_fold;
+      if (!std::isfinite(hi)) {
+        hi = std::max(1.0, rd);
+        while (g(hi) < rd) hi *= 2.0;
+      }
+      double r = std::min(rd, 0.5 * (lo + hi));
+      constexpr int kMaxIterations = 200;
+      constexpr double kRadiusTolerance = 1e-15;
+      for (int i = 0; i < kMaxIterations; ++i) {
+        const double f = g(r) - rd;
+        if (f < 0.0) lo = r; else hi = r;
+        const double r2 = r * r;
+        const double slope = 1.0 + r2 * (3.0 * k1 + r2 * (5.0 * k2 + 7.0 * k3 * r2));
+        double next = r - f / slope;
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        const bool done = std::abs(next - r) <= kRadiusTolerance * (1.0 + r);
+        r = next;
+        if (done || hi - lo <= kRadiusTolerance * (1.0 + r)) break;
+      }
+      xy *= r / rd;
+    }
   }
-  // Safeguarded Newton on the bracket [0, min(r_fold, upper)] where g is increasing.
-  double lo = 0.0;
-  double hi = r_fold;
-  if (!std::isfinite(hi)) {
-    hi = std::max(1.0, rd);
-    while (g(hi) < rd) hi *= 2.0;
+  if (intrinsics.p1 == 0.0 && intrinsics.p2 == 0.0) return {xy.x(), xy.y(), 1.0};
+
+  // Tangential terms: Newton on the 2D map (x, y) -> (xd, yd) from the radial solution. Its
+  // Jacobian (PixelFromNormalized's model):
+  //   dxd/dx = d + x^2 d' + 2 p1 y + 6 p2 x    dxd/dy = x y d' + 2 p1 x + 2 p2 y
+  //   dyd/dx = x y d' + 2 p1 x + 2 p2 y         dyd/dy = d + y^2 d' + 6 p1 y + 2 p2 x
+  // with d' = 2 (k1 + 2 k2 r2 + 3 k3 r2^2).
+  const double p1 = intrinsics.p1, p2 = intrinsics.p2;
+  constexpr int kMaxNewton = 100;
+  constexpr double kTolerance = 1e-15;
+  for (int i = 0; i < kMaxNewton; ++i) {
+    const double x = xy.x(), y = xy.y();
+    const double r2 = x * x + y * y;
+    const double d = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double d1 = 2.0 * (k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2));
+    const Eigen::Vector2d f(d * x + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd,
+                            d * y + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd);
+    const double off = x * y * d1 + 2.0 * p1 * x + 2.0 * p2 * y;
+    Eigen::Matrix2d jacobian;
+    jacobian << d + x * x * d1 + 2.0 * p1 * y + 6.0 * p2 * x, off,  //
+        off, d + y * y * d1 + 6.0 * p1 * y + 2.0 * p2 * x;
+    const double det = jacobian.determinant();
+    if (!(det > 0.0) || !(std::sqrt(r2) < r_fold)) break;
+    const Eigen::Vector2d step = jacobian.inverse() * f;
+    xy -= step;
+    if (step.norm() <= kTolerance * (1.0 + xy.norm())) return {xy.x(), xy.y(), 1.0};
   }
-  double r = std::min(rd, 0.5 * (lo + hi));
-  constexpr int kMaxIterations = 200;
-  constexpr double kRadiusTolerance = 1e-15;
-  for (int i = 0; i < kMaxIterations; ++i) {
-    const double f = g(r) - rd;
-    if (f < 0.0) lo = r; else hi = r;
-    const double r2 = r * r;
-    const double slope = 1.0 + r2 * (3.0 * k1 + 5.0 * k2 * r2);
-    double next = r - f / slope;
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    const bool done = std::abs(next - r) <= kRadiusTolerance * (1.0 + r);
-    r = next;
-    if (done || hi - lo <= kRadiusTolerance * (1.0 + r)) break;
-  }
-  return {xd * r / rd, yd * r / rd, 1.0};
+  throw std::domain_error(internal::Concat(
+      "cannot undistort pixel (", pixel.x(), ", ", pixel.y(), "): the lens (k1 = ", k1,
+      ", k2 = ", k2, ", p1 = ", p1, ", p2 = ", p2, ", k3 = ", k3,
+      ") folds over there (its Jacobian determinant reaches 0) or Newton did not converge"));
 }
 
 }  // namespace camproj

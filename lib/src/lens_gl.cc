@@ -50,9 +50,9 @@ Eigen::Vector2d PinholeNormalized(const Intrinsics& k, const Eigen::Vector2d& pi
 
 // The camera's (distorted) pixel of normalized coordinates n.
 Eigen::Vector2d LensPixel(const Intrinsics& k, const Eigen::Vector2d& n) {
-  const double params[7] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+  const std::array<double, kIntrinsicsArraySize> params = IntrinsicsArray(k);
   Eigen::Vector2d pixel;
-  PixelFromNormalized(params, n.x(), n.y(), pixel.data());
+  PixelFromNormalized(params.data(), n.x(), n.y(), pixel.data());
   return pixel;
 }
 
@@ -106,6 +106,10 @@ void RequireLensCoversImage(const Camera& camera) {
   Require(camera.projection == Projection::kPerspective,
           "an orthographic camera has no lens distortion to render");
   const Intrinsics& k = camera.intrinsics;
+  Require(!k.HasBeyondTwoRadial(), "the GL lens renders radial k1, k2 only; this camera also has "
+          "p1 = ", k.p1, ", p2 = ", k.p2, ", k3 = ", k.k3, " (calibrate without --tangential and "
+          "--k3 for a lens GL can render, or warp with OpenCV's cv::remap from the opencv-yaml "
+          "export)");
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
   if (!std::isfinite(r_fold)) return;
   const double rd_fold = DistortedRadius(r_fold, k.k1, k.k2);

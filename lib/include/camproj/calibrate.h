@@ -49,7 +49,8 @@ struct CalibrateOptions {
   bool aspect_free = true;           // fy / fx; false: fy = fx
   bool principal_point_free = true;  // false: the image centre, ((W - 1) / 2, (H - 1) / 2)
   bool skew_free = false;
-  int num_radial = 2;                // 0 (none), 1 (k1) or 2 (k1, k2)
+  int num_radial = 2;                // 0 (none), 1 (k1), 2 (k1, k2) or 3 (k1, k2, k3)
+  bool tangential_free = false;      // p1, p2
   bool compute_uncertainty = true;
   // Refuse views that do not fit the shared camera: after the joint fit, the worst view whose
   // sum of squared residuals, in units of the other views' noise estimate, exceeds the
@@ -68,7 +69,7 @@ struct CalibrateOptions {
   double parameter_tolerance = 1e-10;  // relative step
 
   // Throws std::invalid_argument naming the field unless the image size is positive,
-  // num_radial is 0, 1 or 2, and the iteration count and tolerances are positive.
+  // num_radial is 0 to 3, and the iteration count and tolerances are positive.
   void Check() const;
 };
 
@@ -116,12 +117,14 @@ struct Calibration {
   int num_points = 0;                 // over all views
   int num_parameters = 0;             // 6 per view + the free intrinsics
   double rms_px = 0.0;                // sqrt(sum |r|^2 / num_points), as cv::calibrateCamera's
-  // 1-sigma of each free intrinsic ("fx", "fy", "cx", "cy", "skew", "k1", "k2"), px or unitless,
+  // 1-sigma of each free intrinsic ("fx", "fy", "cx", "cy", "skew", "k1", "k2", "p1", "p2", "k3"),
+  // px or unitless,
   // from the covariance above; empty unless compute_uncertainty.
   std::vector<ParameterSigma> intrinsics_sigma;
-  // The covariance of the intrinsics block [fx, fy / fx, cx, cy, skew, k1, k2] (px, 1, px, px,
+  // The covariance of the intrinsics block [fx, fy / fx, cx, cy, skew, k1, k2, p1, p2, k3] (px, 1,
+  // px, px,
   // px, 1, 1), zero rows and columns for fixed entries; zero unless compute_uncertainty.
-  Eigen::Matrix<double, 7, 7> intrinsics_covariance = Eigen::Matrix<double, 7, 7>::Zero();
+  Eigen::Matrix<double, 10, 10> intrinsics_covariance = Eigen::Matrix<double, 10, 10>::Zero();
   CrossValidation cross_validation;
   Intrinsics start;                   // the closed-form start's intrinsics
   int iterations = 0;

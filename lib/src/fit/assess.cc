@@ -35,7 +35,7 @@ constexpr double kSingularRcond = 1e-12;
 std::vector<std::string> ParameterNames(const Model& model) {
   std::vector<std::string> names = {"rotation_x_deg", "rotation_y_deg", "rotation_z_deg",
                                     "eye_x", "eye_y", "eye_z"};
-  const char* user_slot_names[] = {"fx", "fy", "cx", "cy", "skew", "k1", "k2"};
+  const char* user_slot_names[] = {"fx", "fy", "cx", "cy", "skew", "k1", "k2", "p1", "p2", "k3"};
   for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
     if (model.free[slot]) names.push_back(user_slot_names[slot]);
   }
@@ -45,7 +45,8 @@ std::vector<std::string> ParameterNames(const Model& model) {
 // FitResult::model: "pose" and the free intrinsics.
 std::string ModelName(const Model& model) {
   std::string name = "pose";
-  const char* model_slot_names[] = {"focal", "aspect", "principal-point", "", "skew", "k1", "k2"};
+  const char* model_slot_names[] = {"focal", "aspect", "principal-point", "", "skew",
+                                    "k1",    "k2",     "p1",              "p2", "k3"};
   for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
     if (model.free[slot] && slot != 3) name += std::string("+") + model_slot_names[slot];
   }
@@ -103,7 +104,7 @@ void SetCovariance(const JacobiScaledNormal<ParamMatrix>& scaled_normal,
   std::vector<double> values = {0.0, 0.0, 0.0};
   for (int j = 0; j < 3; ++j) values.push_back(CameraCenterInWorld(camera.cam_from_world)(j));
   const Intrinsics& k = camera.intrinsics;
-  const double slot_values[] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2};
+  const double slot_values[] = {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3};
   for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
     if (model.free[slot]) values.push_back(slot_values[slot]);
   }

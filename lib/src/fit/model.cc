@@ -14,7 +14,7 @@ namespace {
 
 // Names of the fit-intrinsics slots, in reprojection_error.h's layout.
 const std::array<const char*, kFitIntrinsicsSize> kSlotNames = {
-    "focal", "aspect", "cx", "cy", "skew", "k1", "k2"};
+    "focal", "aspect", "cx", "cy", "skew", "k1", "k2", "p1", "p2", "k3"};
 
 // A value as internal::Concat writes it (printf's %.17g in the "C" locale), without a stream:
 // MakeModel describes every fixed slot on every fit, and a stream costs ~5000 instructions.
@@ -32,11 +32,11 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
   if (options.known_intrinsics) {
     const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
                                             PixelOrigin::kCenter);
-    model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2};
-    model.fixed.push_back({"intrinsics", Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx,
-                                                ", cy ", k.cy, ", skew ", k.skew, ", k1 ", k.k1,
-                                                ", k2 ", k.k2),
-                           "given: pose only"});
+    model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3};
+    std::string text = Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx, ", cy ", k.cy, ", skew ",
+                              k.skew, ", k1 ", k.k1, ", k2 ", k.k2);
+    if (k.HasBeyondTwoRadial()) text += Concat(", p1 ", k.p1, ", p2 ", k.p2, ", k3 ", k.k3);
+    model.fixed.push_back({"intrinsics", text, "given: pose only"});
     return model;
   }
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);

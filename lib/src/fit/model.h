@@ -1,5 +1,6 @@
 // The intrinsic model of the perspective fit (private): which slots of the fit-intrinsics block
-// (reprojection_error.h's layout: focal, aspect, cx, cy, skew, k1, k2; kCenter px) are free, the
+// (reprojection_error.h's layout: focal, aspect, cx, cy, skew, k1, k2, p1, p2, k3; kCenter px;
+// the last three are never free in a single-view fit, they hold given values or 0) are free, the
 // value of every slot (the start of a free one, the given or default value of a fixed one) and
 // how the fixed ones are reported. MakeModel builds it from FitOptions and ProjectOntoModel puts a
 // closed-form K on it; every stage after the scene carries one: the start sets its free values,
@@ -43,6 +44,9 @@ struct Model {
     k.skew = value[4];
     k.k1 = value[5];
     k.k2 = value[6];
+    k.p1 = value[7];
+    k.p2 = value[8];
+    k.k3 = value[9];
     return k;
   }
 };

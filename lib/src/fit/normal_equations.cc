@@ -40,7 +40,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     // instructions). A point behind makes infinities or NaNs, never a trap, and is refused below.
     all_in_front &= p.z() > 0.0;
     Eigen::Array2d r;
-    double jk[2 * kFitIntrinsicsSize];  // row-major 2 x 7
+    double jk[2 * kFitIntrinsicsSize];  // row-major 2 x kFitIntrinsicsSize
     double jp[6];                                 // row-major 2 x 3: d residual / d p
     ResidualOfCamPoint(intrinsics.data(), p, pixels[i], r.data(), jk, jp);
     Eigen::Array2d j[kNumGeneral];

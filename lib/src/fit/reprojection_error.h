@@ -15,13 +15,17 @@
 namespace camproj {
 namespace internal {
 
-// Fit intrinsics block layout: [f, aspect, cx, cy, skew, k1, k2] with fx = f, fy = aspect * f
-// (pixels, kCenter). Aspect as a ratio lets "square pixels" be a constant, not a penalty.
-inline constexpr int kFitIntrinsicsSize = 7;
+// Fit intrinsics block layout: [f, aspect, cx, cy, skew, k1, k2, p1, p2, k3] with fx = f,
+// fy = aspect * f (pixels, kCenter). Aspect as a ratio lets "square pixels" be a constant, not a
+// penalty. The single-view fitter frees at most the first 7 (p1, p2, k3 hold given values);
+// Calibrate frees any.
+inline constexpr int kFitIntrinsicsSize = 10;
+static_assert(kFitIntrinsicsSize == kIntrinsicsArraySize);
 
 template <typename T>
 void PixelFromFitIntrinsics(const T* fit, const T& x, const T& y, T* pixel) {
-  const T k[7] = {fit[0], fit[1] * fit[0], fit[2], fit[3], fit[4], fit[5], fit[6]};
+  const T k[kIntrinsicsArraySize] = {fit[0], fit[1] * fit[0], fit[2], fit[3], fit[4],
+                                     fit[5], fit[6],          fit[7], fit[8], fit[9]};
   PixelFromNormalized(k, x, y, pixel);
 }
 
@@ -60,7 +64,7 @@ struct ReprojectionError {
 
 // The residual (predicted - observed pixel) of a point already in the camera frame, which the
 // caller has checked is in front (z > 0), with analytic derivatives: d residual / d intrinsics
-// (2 x 7, row-major, layout above) and d residual / d point_in_cam (2 x 3, row-major), each
+// (2 x kFitIntrinsicsSize, row-major, layout above) and d residual / d point_in_cam (2 x 3, row-major), each
 // only if its pointer is given. The part of the model after the rotation, shared by
 // ProjectPointWithJacobian and the fitter's normal equations (which rotate with a matrix).
 inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_cam,
@@ -70,24 +74,33 @@ inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_
   const double inv_z = 1.0 / p.z();
   const double x = p.x() * inv_z;
   const double y = p.y() * inv_z;
-  const double f = k[0], a = k[1], s = k[4], k1 = k[5], k2 = k[6];
-  const double r2 = x * x + y * y;
-  const double d = 1.0 + r2 * (k1 + r2 * k2);
-  const double xd = d * x;
-  const double yd = d * y;
+  const double f = k[0], a = k[1], s = k[4], k1 = k[5], k2 = k[6], p1 = k[7], p2 = k[8],
+               k3 = k[9];
+  const double xx = x * x, yy = y * y, xy = x * y;
+  const double r2 = xx + yy;
+  const double d = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = d * x + 2.0 * p1 * xy + p2 * (r2 + 2.0 * xx);
+  const double yd = d * y + p1 * (r2 + 2.0 * yy) + 2.0 * p2 * xy;
   residual[0] = f * xd + s * yd + k[2] - observed.x();
   residual[1] = a * f * yd + k[3] - observed.y();
   if (jacobian_k != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> jk(jacobian_k);
-    const double pu = f * x + s * y;  // d u / d d, divided by nothing: u = d (f x + s y) + cx
-    jk << xd, 0.0, 1.0, 0.0, yd, pu * r2, pu * r2 * r2,  //
-        a * yd, f * yd, 0.0, 1.0, 0.0, a * f * y * r2, a * f * y * r2 * r2;
+    Eigen::Map<Eigen::Matrix<double, 2, kFitIntrinsicsSize, Eigen::RowMajor>> jk(jacobian_k);
+    const double pu = f * x + s * y;  // d u / d d: u = d (f x + s y) + (tangential) + cx
+    const double pv = a * f * y;      // d v / d d
+    const double r4 = r2 * r2;
+    // d (xd, yd) / d p1 = (2 x y, r2 + 2 y^2), / d p2 = (r2 + 2 x^2, 2 x y).
+    const double xd_p1 = 2.0 * xy, yd_p1 = r2 + 2.0 * yy, xd_p2 = r2 + 2.0 * xx, yd_p2 = 2.0 * xy;
+    jk << xd, 0.0, 1.0, 0.0, yd, pu * r2, pu * r4, f * xd_p1 + s * yd_p1, f * xd_p2 + s * yd_p2,
+        pu * r4 * r2,  //
+        a * yd, f * yd, 0.0, 1.0, 0.0, pv * r2, pv * r4, a * f * yd_p1, a * f * yd_p2,
+        pv * r4 * r2;
   }
   if (jacobian_p == nullptr) return;
-  // d pixel / d (x, y), then / d p.
-  const double dd = 2.0 * (k1 + 2.0 * k2 * r2);  // d d / d x = dd x, d d / d y = dd y
-  const double dxd_dx = d + x * dd * x, dxd_dy = x * dd * y;
-  const double dyd_dx = y * dd * x, dyd_dy = d + y * dd * y;
+  // d pixel / d (x, y), then / d p. d' = 2 (k1 + 2 k2 r2 + 3 k3 r2^2): d d / d x = d' x.
+  const double dd = 2.0 * (k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2));
+  const double off = xy * dd + 2.0 * p1 * x + 2.0 * p2 * y;
+  const double dxd_dx = d + xx * dd + 2.0 * p1 * y + 6.0 * p2 * x, dxd_dy = off;
+  const double dyd_dx = off, dyd_dy = d + yy * dd + 6.0 * p1 * y + 2.0 * p2 * x;
   Eigen::Matrix2d d_pixel_d_xy;
   d_pixel_d_xy << f * dxd_dx + s * dyd_dx, f * dxd_dy + s * dyd_dy,  //
       a * f * dyd_dx, a * f * dyd_dy;
