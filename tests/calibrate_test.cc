@@ -146,13 +146,19 @@ std::vector<CalibrationView> ChessboardViews(const std::string& camera) {
 }
 
 // OpenCV's sample chessboards (13 + 13 real views): the same optimum as cv::calibrateCamera with
-// the same model (fx, fy, cx, cy, k1, k2; no tangential distortion, no k3), and the same RMS.
+// the same model, and the same RMS, for both of its usual models: fx, fy, cx, cy, k1, k2
+// (CALIB_ZERO_TANGENT_DIST | CALIB_FIX_K3) and its default, k1, k2, p1, p2, k3 free (flags 0).
 TEST(CalibrateTest, ChessboardEqualsCalibrateCamera) {
+  for (const bool full_lens : {false, true})
   for (const std::string camera : {"left", "right"}) {
-    SCOPED_TRACE(camera);
+    SCOPED_TRACE(camera + (full_lens ? ", k1 k2 p1 p2 k3" : ", k1 k2"));
     const std::vector<CalibrationView> views = ChessboardViews(camera);
     CalibrateOptions options = Options();
     options.refuse_inconsistent_views = false;  // calibrateCamera keeps every view
+    if (full_lens) {
+      options.num_radial = 3;
+      options.tangential_free = true;
+    }
     const Calibration ours = Calibrate(views, options);
 
     std::vector<std::vector<cv::Point3f>> object_points;
@@ -168,13 +174,18 @@ TEST(CalibrateTest, ChessboardEqualsCalibrateCamera) {
     std::vector<cv::Mat> rvecs, tvecs;
     const double cv_rms = cv::calibrateCamera(
         object_points, image_points, cv::Size(kImage.width, kImage.height), k, distortion, rvecs,
-        tvecs, cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3,
+        tvecs, full_lens ? 0 : cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3,
         cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 1000, 1e-15));
 
-    const double theirs[] = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2),
-                             k.at<double>(1, 2), distortion.at<double>(0), distortion.at<double>(1)};
-    ASSERT_EQ(ours.intrinsics_sigma.size(), 6u);
-    for (int i = 0; i < 6; ++i) {
+    // Ours in the order fx, fy, cx, cy, k1, k2[, p1, p2, k3]; OpenCV's distortion k1 k2 p1 p2 k3.
+    std::vector<double> theirs = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2),
+                                  k.at<double>(1, 2), distortion.at<double>(0),
+                                  distortion.at<double>(1)};
+    if (full_lens) {
+      for (int i = 2; i < 5; ++i) theirs.push_back(distortion.at<double>(i));
+    }
+    ASSERT_EQ(ours.intrinsics_sigma.size(), theirs.size());
+    for (size_t i = 0; i < theirs.size(); ++i) {
       const ParameterSigma& p = ours.intrinsics_sigma[i];
       EXPECT_LE(std::abs(p.value - theirs[i]),
                 std::max(kSameOptimumRelative * std::abs(theirs[i]), kSameOptimumSigmas * p.sigma))

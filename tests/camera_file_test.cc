@@ -43,7 +43,13 @@ std::string ExpectInputError(const std::string& text) {
 TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
   std::mt19937_64 rng(testing::Seed(8));
   for (int i = 0; i < 200; ++i) {
-    const Camera camera = RandomFileCamera(rng);
+    Camera camera = RandomFileCamera(rng);
+    if (i % 3 == 0) {  // OpenCV's whole lens
+      camera.intrinsics.k2 = testing::Uniform(rng, -0.1, 0.1);
+      camera.intrinsics.p1 = testing::Uniform(rng, -0.01, 0.01);
+      camera.intrinsics.p2 = testing::Uniform(rng, -0.01, 0.01);
+      camera.intrinsics.k3 = testing::Uniform(rng, -0.1, 0.1);
+    }
     CameraFileOptions options;
     options.pixel_origin = i % 2 ? PixelOrigin::kCorner : PixelOrigin::kCenter;
     const Camera back = CameraFromJsonText(CameraToJsonText(camera, options), "test");
@@ -51,6 +57,10 @@ TEST(CameraFileTest, RoundTripsBitForBitInBothPixelOrigins) {
     EXPECT_EQ(back.intrinsics.fx, camera.intrinsics.fx);
     EXPECT_EQ(back.intrinsics.skew, camera.intrinsics.skew);
     EXPECT_EQ(back.intrinsics.k1, camera.intrinsics.k1);
+    EXPECT_EQ(back.intrinsics.k2, camera.intrinsics.k2);
+    EXPECT_EQ(back.intrinsics.p1, camera.intrinsics.p1);
+    EXPECT_EQ(back.intrinsics.p2, camera.intrinsics.p2);
+    EXPECT_EQ(back.intrinsics.k3, camera.intrinsics.k3);
     if (options.pixel_origin == PixelOrigin::kCenter) {
       EXPECT_EQ(back.intrinsics.cx, camera.intrinsics.cx);
       EXPECT_EQ(back.intrinsics.cy, camera.intrinsics.cy);

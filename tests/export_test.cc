@@ -258,7 +258,13 @@ Eigen::Matrix3d EigenMatrix3(const cv::Mat& m) {
 TEST(ExportOpenCvYamlTest, OpenCvReadsItBackAndProjectPointsGivesOurPixels) {
   std::mt19937_64 rng(testing::Seed(3));
   for (int i = 0; i < 200; ++i) {
-    const TestCamera test = MakeTestCamera(rng, false, i % 2 == 0, false);
+    TestCamera test = MakeTestCamera(rng, false, i % 2 == 0, false);
+    if (i % 4 == 0) {  // OpenCV's whole lens: p1, p2, k3 too
+      test.random.intrinsics.p1 = testing::Uniform(rng, -0.002, 0.002);
+      test.random.intrinsics.p2 = testing::Uniform(rng, -0.002, 0.002);
+      test.random.intrinsics.k3 = testing::Uniform(rng, -0.01, 0.01);
+      test.camera.intrinsics = test.random.intrinsics;
+    }
     const Camera& camera = test.camera;
     const std::string text = ExportCamera(camera, ExportFormat::kOpenCvYaml);
     const OpenCvCamera cv_camera = ReadOpenCvYaml(text);
@@ -270,7 +276,9 @@ TEST(ExportOpenCvYamlTest, OpenCvReadsItBackAndProjectPointsGivesOurPixels) {
     ASSERT_EQ(cv_camera.distortion.size(), cv::Size(5, 1)) << text;
     EXPECT_EQ(cv_camera.distortion.at<double>(0), camera.intrinsics.k1);
     EXPECT_EQ(cv_camera.distortion.at<double>(1), camera.intrinsics.k2);
-    EXPECT_EQ(cv::countNonZero(cv_camera.distortion.colRange(2, 5)), 0);
+    EXPECT_EQ(cv_camera.distortion.at<double>(2), camera.intrinsics.p1);
+    EXPECT_EQ(cv_camera.distortion.at<double>(3), camera.intrinsics.p2);
+    EXPECT_EQ(cv_camera.distortion.at<double>(4), camera.intrinsics.k3);
     EXPECT_EQ(EigenMatrix3(cv_camera.rotation), camera.cam_from_world.rotation);
     ASSERT_EQ(cv_camera.tvec.size(), cv::Size(1, 3)) << text;
     ASSERT_EQ(cv_camera.rvec.size(), cv::Size(1, 3)) << text;
@@ -436,6 +444,15 @@ TEST(ExportColmapTest, HandComputedLinesAndSkewRefused) {
   const std::string text = ExportCamera(camera, ExportFormat::kColmap);
   EXPECT_NE(text.find("\n1 PINHOLE 640 480 500 400 320 240\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\n1 1 0 0 0 1 -2 3 1 image\n\n"), std::string::npos) << text;
+  // OPENCV holds k1 k2 p1 p2; FULL_OPENCV adds k3 and the rational k4 k5 k6 (0).
+  camera.intrinsics.k1 = -0.25;
+  camera.intrinsics.p2 = 0.125;
+  EXPECT_NE(ExportCamera(camera, ExportFormat::kColmap).find("\n1 OPENCV 640 480 500 400 320 240 -0.25 0 0 0.125\n"),
+            std::string::npos);
+  camera.intrinsics.k3 = 0.5;
+  EXPECT_NE(ExportCamera(camera, ExportFormat::kColmap)
+                .find("\n1 FULL_OPENCV 640 480 500 400 320 240 -0.25 0 0 0.125 0.5 0 0 0\n"),
+            std::string::npos);
   camera.intrinsics.skew = -0.25;
   try {
     ExportCamera(camera, ExportFormat::kColmap);

@@ -52,7 +52,7 @@ struct NoiseFreeCase {
   bool planar;
   int min_points;
   int max_points;
-  bool distortion;   // the true camera has k1, k2 (and they are fitted)
+  bool distortion;   // the true camera has k1, k2 (fitted unless known; known: p1, p2, k3 too)
   bool skew;         // the true camera has skew (fitted)
   bool centred;      // principal point at the image centre, square pixels (a gluPerspective camera)
   bool known_intrinsics;
@@ -83,6 +83,12 @@ TEST_P(NoiseFreeTest, RecoversTheCameraExactly) {
     if (c.distortion) {
       camera.intrinsics.k1 = testing::Uniform(rng, -0.2, 0.1);
       camera.intrinsics.k2 = testing::Uniform(rng, -0.02, 0.02);
+      if (c.known_intrinsics) {
+        // A pose against a calibration with OpenCV's whole lens: p1, p2, k3 held in the fit.
+        camera.intrinsics.p1 = testing::Uniform(rng, -0.005, 0.005);
+        camera.intrinsics.p2 = testing::Uniform(rng, -0.005, 0.005);
+        camera.intrinsics.k3 = testing::Uniform(rng, -0.01, 0.01);
+      }
     }
     SceneOptions scene_options;
     scene_options.planar = c.planar;

@@ -70,6 +70,11 @@ TEST(IntrinsicsTest, RayFromPixelInvertsProjection) {
       k.k1 = testing::Uniform(rng, -0.3, 0.3);
       k.k2 = testing::Uniform(rng, -0.05, 0.05);
     }
+    if (i % 4 == 3) {  // OpenCV's whole lens: the 2D Newton path
+      k.p1 = testing::Uniform(rng, -0.01, 0.01);
+      k.p2 = testing::Uniform(rng, -0.01, 0.01);
+      k.k3 = testing::Uniform(rng, -0.05, 0.05);
+    }
     // Normalized radius below 0.8 keeps d increasing for these k1, k2.
     const Eigen::Vector3d point(testing::Uniform(rng, -0.5, 0.5), testing::Uniform(rng, -0.5, 0.5),
                                 1.0);
@@ -82,6 +87,55 @@ TEST(IntrinsicsTest, RayFromPixelInvertsProjection) {
                                                       : kExactRelative * pixel.norm())
         << "case " << i;
   }
+}
+
+// cv::projectPoints' model by hand: x = 0.5, y = 0.25, r2 = 0.3125.
+TEST(IntrinsicsTest, HandComputedTangentialAndK3) {
+  Intrinsics k;
+  k.fx = 800;
+  k.fy = 600;
+  k.cx = 320;
+  k.cy = 240;
+  k.k1 = 0.1;
+  k.p1 = 0.01;
+  k.p2 = -0.02;
+  k.k3 = 0.5;
+  const double r2 = 0.3125;
+  const double d = 1.0 + 0.1 * r2 + 0.5 * r2 * r2 * r2;
+  const double xd = d * 0.5 + 2 * 0.01 * 0.5 * 0.25 - 0.02 * (r2 + 2 * 0.25);
+  const double yd = d * 0.25 + 0.01 * (r2 + 2 * 0.0625) + 2 * -0.02 * 0.5 * 0.25;
+  const Eigen::Vector2d pixel = PixelFromCam(k, Eigen::Vector3d(1.0, 0.5, 2.0));
+  EXPECT_NEAR(pixel.x(), 800 * xd + 320, kExactRelative * 1000);
+  EXPECT_NEAR(pixel.y(), 600 * yd + 240, kExactRelative * 1000);
+}
+
+// The fold with k3: g'(r) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 (s = r^2) vanishes at r_fold and is
+// positive below it, for random k1, k2, k3 (grid of 1000 radii below the fold).
+TEST(IntrinsicsTest, FoldRadiusWithK3IsTheFirstZeroOfTheSlope) {
+  std::mt19937_64 rng(testing::Seed(12));
+  int folds = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const double k1 = testing::Uniform(rng, -0.5, 0.5);
+    const double k2 = testing::Uniform(rng, -0.5, 0.5);
+    const double k3 = testing::Uniform(rng, -0.5, 0.5);
+    auto slope = [&](double r) {
+      const double s = r * r;
+      return 1.0 + s * (3.0 * k1 + s * (5.0 * k2 + s * 7.0 * k3));
+    };
+    const double r_fold = RadialFoldRadius(k1, k2, k3);
+    if (k3 > 0.0 && !std::isfinite(r_fold)) {
+      for (int j = 1; j <= 1000; ++j) ASSERT_GT(slope(0.01 * j), 0.0) << k1 << " " << k2 << " " << k3;
+      continue;
+    }
+    ASSERT_TRUE(std::isfinite(r_fold)) << k1 << " " << k2 << " " << k3;  // k3 < 0: h -> -inf
+    ++folds;
+    // |h(r_fold)| at the last bit of s: h' s ulp(s) ~ 1e-15.
+    EXPECT_NEAR(slope(r_fold), 0.0, 1e-12) << k1 << " " << k2 << " " << k3;
+    for (int j = 0; j < 1000; ++j) {
+      ASSERT_GT(slope(r_fold * j / 1000.0), 0.0) << k1 << " " << k2 << " " << k3;
+    }
+  }
+  EXPECT_GT(folds, 500);  // every k3 < 0 folds: about half, plus some with k3 > 0
 }
 
 TEST(IntrinsicsTest, UndistortionRefusesWhereTheRadialMapFolds) {

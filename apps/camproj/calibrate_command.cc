@@ -23,6 +23,8 @@ struct CalibrateArgs {
   std::string poses_path;
   std::vector<std::string> fix;
   bool skew = false;
+  bool tangential = false;
+  bool k3 = false;
   bool keep_all_views = false;
   std::string pixel_origin = "center";
 };
@@ -34,8 +36,8 @@ Command AddCalibrateCommand(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "calibrate",
       "Calibrate one camera or projector from many views of known points (a chessboard moved in\n"
-      "front of it, or a 3D rig): intrinsics shared by every view (fx, fy, cx, cy, k1, k2 —\n"
-      "OpenCV's model without p1, p2, k3), a pose per view, refined jointly (Ceres). Each view is\n"
+      "front of it, or a 3D rig): intrinsics shared by every view (fx, fy, cx, cy, k1, k2 by\n"
+      "default; p1, p2 with --tangential, k3 with --k3), a pose per view, refined jointly (Ceres). Each view is\n"
       "a CSV with X,Y,Z,u,v in its own world frame (a board's frame is fine); a folder stands for\n"
       "its *.csv files. Writes CALIB.json: the intrinsics at the top level (so `camproj fit\n"
       "--intrinsics CALIB.json` fits poses against them) with their sigmas, and each view's full\n"
@@ -53,6 +55,10 @@ Command AddCalibrateCommand(CLI::App& root) {
       ->delimiter(',')
       ->check(CLI::IsMember({"aspect", "principal-point", "k1", "k2"}));
   app->add_flag("--skew", args->skew, "also estimate skew (default 0)");
+  app->add_flag("--tangential", args->tangential,
+                "also estimate OpenCV's tangential distortion p1, p2 (default 0)");
+  app->add_flag("--k3", args->k3, "also estimate the third radial term k3 (default 0); with "
+                "--tangential, cv::calibrateCamera's default model");
   app->add_flag("--keep-all-views", args->keep_all_views,
                 "keep views that do not fit the camera the others share (by default such a view, "
                 "more than 2.5x the others' RMS and beyond their noise, is left out and named)");
@@ -69,6 +75,13 @@ Command AddCalibrateCommand(CLI::App& root) {
               if (entry == "k1") options.num_radial = 0;
             }
             options.skew_free = args->skew;
+            options.tangential_free = args->tangential;
+            if (args->k3) {
+              if (options.num_radial < 2) {
+                throw std::invalid_argument("--k3 needs k1 and k2 free: drop --fix k1/k2");
+              }
+              options.num_radial = 3;
+            }
             options.refuse_inconsistent_views = !args->keep_all_views;
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             const std::vector<std::string> inputs = ExpandInputs(args->view_paths);
@@ -123,7 +136,7 @@ Command AddCalibrateCommand(CLI::App& root) {
               if (cv.rms_px > 3.0 * cv.predicted_rms_px) {
                 out << ": more than 3 times that, so the views do not share one camera as this "
                        "model describes it (a view that does not belong, or a lens that needs more "
-                       "than k1, k2)";
+                       "than this model's terms)";
               }
               out << '\n' << std::setprecision(6);
             } else {

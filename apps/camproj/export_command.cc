@@ -10,6 +10,7 @@
 #include "camproj/depth_precision.h"
 #include "camproj/errors.h"
 #include "camproj/export.h"
+#include "camproj/number_text.h"
 #include "camproj/file_io.h"
 #include "camproj/lens_gl.h"
 #include "camproj/world_origin.h"
@@ -220,15 +221,24 @@ Command AddExportCommand(CLI::App& root) {
             }
             if (pinhole_only && camera.intrinsics.HasDistortion()) {
               // Not only in the export's comment: the matrix is not this camera.
-              char line[512];
+              const Intrinsics& k = camera.intrinsics;
+              char line[768];
               std::snprintf(line, sizeof line,
-                            "camproj: warning: k1 = %.6g, k2 = %.6g: the %s export's projection "
+                            "camproj: warning: k1 = %.6g, k2 = %.6g%s: the %s export's projection "
                             "matrix is the pinhole part only and puts points up to %.3g px (worst "
-                            "image corner) from where the lens images them; to render the lens "
-                            "export glsl (per vertex), stmap or distortion-mesh (post-process "
-                            "warp); opencv-yaml, colmap and json keep k1, k2 (docs/exports.md)\n",
-                            camera.intrinsics.k1, camera.intrinsics.k2, args->to.c_str(),
-                            PinholeErrorAtWorstCornerPx(camera));
+                            "image corner) from where the lens images them; %s; opencv-yaml, "
+                            "colmap and json keep the lens (docs/exports.md)\n",
+                            k.k1, k.k2,
+                            k.HasBeyondTwoRadial()
+                                ? (", p1 = " + ShortestDouble(k.p1) + ", p2 = " +
+                                   ShortestDouble(k.p2) + ", k3 = " + ShortestDouble(k.k3)).c_str()
+                                : "",
+                            args->to.c_str(), PinholeErrorAtWorstCornerPx(camera),
+                            k.HasBeyondTwoRadial()
+                                ? "the GL lens exports (glsl, stmap, distortion-mesh) render k1, "
+                                  "k2 only"
+                                : "to render the lens export glsl (per vertex), stmap or "
+                                  "distortion-mesh (post-process warp)");
               std::cerr << line;
             }
             const bool obj = format == ExportFormat::kDistortionMesh &&

@@ -348,7 +348,8 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     document["gl"]["view_relative_to_origin"] = Matrix4Json(views.gl_eye_from_origin_world);
   }
   if (camera.intrinsics.HasDistortion()) {
-    document["gl"]["note"] = "the projection matrix is the pinhole part: k1, k2 are not in it";
+    document["gl"]["note"] = "the projection matrix is the pinhole part: the lens (" +
+                             DistortionText(k) + ") is not in it";
   }
   if (fit != nullptr) {
     json record;

@@ -70,8 +70,12 @@ std::string DistortionNote(const Camera& camera) {
   auto out = ExactStream();
   out << DistortionText(camera.intrinsics) << " are not in the projection matrix (GL projection is linear): it puts points up to "
       << std::setprecision(3) << PinholeErrorAtWorstCornerPx(camera)
-      << " px (worst image corner) from where the lens images them; to render the lens: export "
-         "glsl (per vertex), distortion-mesh or stmap (post-process warp)";
+      << " px (worst image corner) from where the lens images them; "
+      << (camera.intrinsics.HasBeyondTwoRadial()
+              ? "the GL lens exports (glsl, distortion-mesh, stmap) render k1, k2 only: use "
+                "opencv-yaml or colmap for this lens"
+              : "to render the lens: export glsl (per vertex), distortion-mesh or stmap "
+                "(post-process warp)");
   return out.str();
 }
 
