@@ -1015,15 +1015,22 @@ sys.exit(0 if answered >= 15 and beyond <= bound else 1)
 PY
     ;;
   calibrate_chessboard)
-    # OpenCV's left chessboard views: one calibration without left02 (1.24 px RMS, 5x the others:
-    # refused by name), the intrinsics at the top level of the file (fit --intrinsics takes it: a
+    # OpenCV's left chessboard views: one calibration without left02 (1.22 px RMS, 5x the others:
+    # refused by name), the model the views need (BIC: principal point, k1, k2, p1, p2; not aspect,
+    # not k3, each with its reason), the intrinsics at the top level of the file (fit --intrinsics takes it: a
     # pose-only fit), each view a camera file export takes, the poses table one row per view; one
     # view alone is refused and writes nothing.
     boards="$data/real/opencv_chessboard"
     expect_exit 0 "$bin" calibrate "$boards"/left*.csv --image-size 640x480 -o "$work/left.json" --poses "$work/poses.csv"
-    expect_in out "^calibrated 12 views, 648 points: rms 0.24"
-    expect_in out "^refused view left02: its 54 points are 1.24 px RMS from the camera the other views share"
+    expect_in out "^calibrated 12 views, 648 points: rms 0.234"
+    expect_in out "^refused view left02: its 54 points are 1.22 px RMS from the camera the other views share"
     expect_in out "^  k1 "
+    expect_in out "^  p1 "
+    expect_not_in out "^  fy "
+    expect_in out "^model (BIC with sigma 0.171 px, estimated from the richest model):"
+    expect_in out "^  principal-point freed: BIC -"
+    expect_in out "^  aspect          left out: BIC +6.9 if freed"
+    expect_in out "^  k3              left out: BIC +"
     expect_in out "^cross-validation: the even and the odd views calibrated apart (6 and 6) put the image's pixels [0-9.]* px apart"
     [[ $(wc -l <"$work/poses.csv") -eq 13 ]] || fail "poses.csv has not 12 rows:\n$(cat "$work/poses.csv")"
     expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/left.json" -o "$work/v3.json"
@@ -1044,8 +1051,15 @@ PY
     expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --fix aspect,principal-point,k2 -o "$work/right.json"
     expect_in out "^calibrated 12 views"
     expect_not_in out "^  fy "
-    expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --keep-all-views -o "$work/right.json"
+    expect_exit 0 "$bin" calibrate "$work/right" --image-size 640x480 --keep-all-views \
+      --model principal-point+aspect+k1+k2 -o "$work/right.json"
     expect_in out "^calibrated 13 views, 702 points: rms 0.4"
+    expect_not_in out "^model"
+    expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model k2 -o "$work/bad.json"
+    expect_in err "--model k2: k2 needs k1 too"
+    expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model opencv --fix k3 -o "$work/bad.json"
+    expect_in err "--model opencv frees k3 but --fix holds it"
+    [[ ! -e "$work/bad.json" ]] || fail "a bad --model wrote a file"
     expect_not_in out "^refused view"
     ;;
   *) fail "unknown case" ;;

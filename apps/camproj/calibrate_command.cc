@@ -1,4 +1,5 @@
 // camproj calibrate: one camera from many views (shared intrinsics, a pose per view).
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -22,12 +23,59 @@ struct CalibrateArgs {
   std::string output_path;
   std::string poses_path;
   std::vector<std::string> fix;
-  bool skew = false;
-  bool tangential = false;
-  bool k3 = false;
+  std::string model = "auto";
+  double sigma = 0.0;
   bool keep_all_views = false;
   std::string pixel_origin = "center";
 };
+
+// The model --model and --fix ask for: with auto, every group a candidate but those fixed; else
+// exactly the groups listed (a fixed one among them is a contradiction).
+CalibrateOptions ModelOptions(const std::string& model, const std::vector<std::string>& fix) {
+  CalibrateOptions options;
+  std::vector<std::string> groups;
+  if (model == "auto" || model == "opencv") {
+    // Skew is no candidate of auto: sensors have square grids, and a fitted skew takes up other
+    // model errors (the left chessboards: 0.39 +- 0.12 px at BIC -4.3, docs/calibration.md).
+    groups = {"principal-point", "aspect", "k1", "k2", "tangential", "k3"};
+  } else {
+    std::stringstream list(model);
+    for (std::string group; std::getline(list, group, '+');) groups.push_back(group);
+  }
+  options.select_model = model == "auto";
+  options.aspect_free = options.principal_point_free = options.skew_free = false;
+  options.tangential_free = false;
+  options.num_radial = 0;
+  for (const std::string& group : groups) {
+    const bool fixed = std::find(fix.begin(), fix.end(), group) != fix.end() ||
+                       (group == "k2" || group == "k3") &&
+                           std::find(fix.begin(), fix.end(), "k1") != fix.end() ||
+                       group == "k3" && std::find(fix.begin(), fix.end(), "k2") != fix.end();
+    if (fixed && model != "auto") {
+      throw std::invalid_argument("--model " + model + " frees " + group + " but --fix holds it");
+    }
+    if (fixed) continue;
+    if (group == "principal-point") options.principal_point_free = true;
+    else if (group == "aspect") options.aspect_free = true;
+    else if (group == "skew") options.skew_free = true;
+    else if (group == "tangential") options.tangential_free = true;
+    else if (group == "k1") options.num_radial = std::max(options.num_radial, 1);
+    else if (group == "k2" || group == "k3") {
+      const int terms = group == "k2" ? 2 : 3;
+      if (model != "auto" && model != "opencv" &&
+          std::find(groups.begin(), groups.end(), terms == 2 ? "k1" : "k2") == groups.end()) {
+        throw std::invalid_argument("--model " + model + ": " + group + " needs " +
+                                    (terms == 2 ? "k1" : "k2") + " too");
+      }
+      options.num_radial = std::max(options.num_radial, terms);
+    } else if (group != "focal") {
+      throw std::invalid_argument("--model: unknown group \"" + group + "\"; expected auto, opencv "
+                                  "or groups among principal-point, aspect, skew, k1, k2, "
+                                  "tangential, k3 joined by '+'");
+    }
+  }
+  return options;
+}
 
 }  // namespace
 
@@ -36,8 +84,8 @@ Command AddCalibrateCommand(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "calibrate",
       "Calibrate one camera or projector from many views of known points (a chessboard moved in\n"
-      "front of it, or a 3D rig): intrinsics shared by every view (fx, fy, cx, cy, k1, k2 by\n"
-      "default; p1, p2 with --tangential, k3 with --k3), a pose per view, refined jointly (Ceres). Each view is\n"
+      "front of it, or a 3D rig): intrinsics shared by every view (the model the views need,\n"
+      "chosen by BIC among OpenCV's fx, fy, cx, cy, k1, k2, p1, p2, k3), a pose per view, refined jointly (Ceres). Each view is\n"
       "a CSV with X,Y,Z,u,v in its own world frame (a board's frame is fine); a folder stands for\n"
       "its *.csv files. Writes CALIB.json: the intrinsics at the top level (so `camproj fit\n"
       "--intrinsics CALIB.json` fits poses against them) with their sigmas, and each view's full\n"
@@ -50,15 +98,22 @@ Command AddCalibrateCommand(CLI::App& root) {
   app->add_option("--poses", args->poses_path,
                   "also write a CSV of the views' poses: eye, target, up, R, t per view");
   app->add_option("--fix", args->fix,
-                  "intrinsics to hold: aspect (fy = fx), principal-point (the image centre), k2, "
-                  "k1 (and k2); comma-separated")
+                  "intrinsics --model auto never frees: aspect (fy = fx), principal-point (the "
+                  "image centre), skew, k1 (and k2, k3), k2 (and k3), tangential, k3; "
+                  "comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"aspect", "principal-point", "k1", "k2"}));
-  app->add_flag("--skew", args->skew, "also estimate skew (default 0)");
-  app->add_flag("--tangential", args->tangential,
-                "also estimate OpenCV's tangential distortion p1, p2 (default 0)");
-  app->add_flag("--k3", args->k3, "also estimate the third radial term k3 (default 0); with "
-                "--tangential, cv::calibrateCamera's default model");
+      ->check(CLI::IsMember({"aspect", "principal-point", "skew", "k1", "k2", "tangential", "k3"}));
+  app->add_option("--model", args->model,
+                  "auto (default): free only the groups the views need among those of opencv, "
+                  "by BIC, from the focal length up (docs/calibration.md); opencv: cv::calibrateCamera's default model "
+                  "(principal point, aspect, k1, k2, p1, p2, k3); or the groups to free joined "
+                  "by '+' among principal-point, aspect, skew, k1, k2, tangential (p1, p2), k3, "
+                  "e.g. principal-point+aspect+k1+k2 (calibrateCamera with "
+                  "CALIB_ZERO_TANGENT_DIST | CALIB_FIX_K3)");
+  app->add_option("--sigma", args->sigma,
+                  "pixel noise (px, 1 sigma) for --model auto's criterion; default: estimated "
+                  "from the richest model")
+      ->check(CLI::PositiveNumber);
   app->add_flag("--keep-all-views", args->keep_all_views,
                 "keep views that do not fit the camera the others share (by default such a view, "
                 "more than 2.5x the others' RMS and beyond their noise, is left out and named)");
@@ -66,22 +121,9 @@ Command AddCalibrateCommand(CLI::App& root) {
                   "convention of the input pixels and the written cx, cy")
       ->check(CLI::IsMember({"center", "corner"}));
   return {app, [args]() {
-            CalibrateOptions options;
+            CalibrateOptions options = ModelOptions(args->model, args->fix);
             options.image_size = ParseImageSize(args->image_size, "--image-size");
-            for (const std::string& entry : args->fix) {
-              if (entry == "aspect") options.aspect_free = false;
-              if (entry == "principal-point") options.principal_point_free = false;
-              if (entry == "k2") options.num_radial = std::min(options.num_radial, 1);
-              if (entry == "k1") options.num_radial = 0;
-            }
-            options.skew_free = args->skew;
-            options.tangential_free = args->tangential;
-            if (args->k3) {
-              if (options.num_radial < 2) {
-                throw std::invalid_argument("--k3 needs k1 and k2 free: drop --fix k1/k2");
-              }
-              options.num_radial = 3;
-            }
+            options.pixel_sigma = args->sigma;
             options.refuse_inconsistent_views = !args->keep_all_views;
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             const std::vector<std::string> inputs = ExpandInputs(args->view_paths);
@@ -119,6 +161,16 @@ Command AddCalibrateCommand(CLI::App& root) {
               if (p.name == "cy") value = k.cy;
               out << "  " << std::left << std::setw(5) << p.name << std::right << value << " +- "
                   << p.sigma << (p.unit.empty() ? "" : " " + p.unit) << '\n';
+            }
+            if (!calibration.model_choice.empty()) {
+              out << "model (BIC with sigma " << std::setprecision(3)
+                  << calibration.selection_sigma_px << " px, "
+                  << (calibration.selection_sigma_given ? "given" : "estimated from the richest model")
+                  << "):\n" << std::setprecision(6);
+              for (const CalibrationModelChoice& c : calibration.model_choice) {
+                out << "  " << std::left << std::setw(16) << c.group << std::right << c.reason
+                    << '\n';
+              }
             }
             for (const RefusedView& view : calibration.refused_views) {
               out << "refused view " << view.name << ": its " << view.num_points << " points are "

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -14,6 +15,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "camproj/model_select.h"
 #include "fit/closed_form.h"
 #include "fit/common.h"
 #include "fit/reprojection_error.h"
@@ -30,6 +32,10 @@ void CalibrateOptions::Check() const {
   }
   if (max_iterations <= 0) {
     throw std::invalid_argument("CalibrateOptions.max_iterations must be positive");
+  }
+  if (!(pixel_sigma >= 0.0) || !std::isfinite(pixel_sigma)) {
+    throw std::invalid_argument("CalibrateOptions.pixel_sigma must be >= 0 (0: estimated), got " +
+                                std::to_string(pixel_sigma));
   }
   if (!(function_tolerance > 0.0) || !(gradient_tolerance > 0.0) ||
       !(parameter_tolerance > 0.0)) {
@@ -667,8 +673,157 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
 
 }  // namespace
 
+namespace {
+
+// The ladder's groups in their order (SelectCalibrationModel): whether `o` frees the group, how
+// to free it, and the group it needs first.
+struct LadderGroup {
+  const char* name;
+  const char* needs;  // nullptr or the group that must be free first
+  bool (*is_free)(const CalibrateOptions& o);
+  void (*free)(CalibrateOptions* o);
+};
+
+const LadderGroup kLadder[] = {
+    {"principal-point", nullptr, [](const CalibrateOptions& o) { return o.principal_point_free; },
+     [](CalibrateOptions* o) { o->principal_point_free = true; }},
+    {"aspect", nullptr, [](const CalibrateOptions& o) { return o.aspect_free; },
+     [](CalibrateOptions* o) { o->aspect_free = true; }},
+    {"skew", nullptr, [](const CalibrateOptions& o) { return o.skew_free; },
+     [](CalibrateOptions* o) { o->skew_free = true; }},
+    {"k1", nullptr, [](const CalibrateOptions& o) { return o.num_radial >= 1; },
+     [](CalibrateOptions* o) { o->num_radial = std::max(o->num_radial, 1); }},
+    {"k2", "k1", [](const CalibrateOptions& o) { return o.num_radial >= 2; },
+     [](CalibrateOptions* o) { o->num_radial = std::max(o->num_radial, 2); }},
+    {"tangential", nullptr, [](const CalibrateOptions& o) { return o.tangential_free; },
+     [](CalibrateOptions* o) { o->tangential_free = true; }},
+    {"k3", "k2", [](const CalibrateOptions& o) { return o.num_radial >= 3; },
+     [](CalibrateOptions* o) { o->num_radial = std::max(o->num_radial, 3); }},
+};
+
+bool IsFreeIn(const char* group_name, const CalibrateOptions& options) {
+  for (const LadderGroup& group : kLadder) {
+    if (std::string(group.name) == group_name) return group.is_free(options);
+  }
+  return false;
+}
+
+// "+1.234" / "-1.234".
+std::string Signed(double value) {
+  std::ostringstream text;
+  text.precision(1);
+  text << std::fixed << std::showpos << value;
+  return text.str();
+}
+
+}  // namespace
+
+CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& views,
+                                        const CalibrateOptions& options,
+                                        std::vector<CalibrationModelChoice>* choice,
+                                        double* sigma_px) {
+  options.Check();
+  CalibrateOptions quiet = options;
+  quiet.select_model = false;
+  quiet.compute_uncertainty = false;
+  quiet.cross_validate = false;
+  // The richest model the options allow: the views it keeps, and the noise they show.
+  const Calibration richest = Calibrate(views, quiet);
+  std::vector<CalibrationView> kept;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const std::string name = ViewName(views[i], i);
+    const bool refused = std::any_of(richest.refused_views.begin(), richest.refused_views.end(),
+                                     [&](const RefusedView& r) { return r.name == name; });
+    if (!refused) kept.push_back(views[i]);
+  }
+  auto sum_squares = [](const Calibration& c) { return c.rms_px * c.rms_px * c.num_points; };
+  const double sigma =
+      options.pixel_sigma > 0.0
+          ? options.pixel_sigma
+          : std::max(kMinNoisePx, std::sqrt(sum_squares(richest) /
+                                            (2.0 * richest.num_points - richest.num_parameters)));
+  const double log_2n = std::log(2.0 * richest.num_points);
+  auto bic = [&](const Calibration& c) {
+    return sum_squares(c) / (sigma * sigma) + c.num_parameters * log_2n;
+  };
+
+  // From the focal length alone, one group per round.
+  quiet.refuse_inconsistent_views = false;
+  CalibrateOptions current = quiet;
+  current.principal_point_free = current.aspect_free = current.skew_free = false;
+  current.tangential_free = false;
+  current.num_radial = 0;
+  Calibration current_fit = Calibrate(kept, current);
+  std::map<std::string, std::string> reasons;
+  while (true) {
+    const LadderGroup* best = nullptr;
+    Calibration best_fit;
+    CalibrateOptions best_options;
+    for (const LadderGroup& group : kLadder) {
+      if (!group.is_free(options) || group.is_free(current)) continue;
+      if (group.needs != nullptr && !IsFreeIn(group.needs, current)) {
+        reasons[group.name] = std::string("left out: needs ") + group.needs + " first";
+        continue;
+      }
+      CalibrateOptions trial = current;
+      group.free(&trial);
+      try {
+        Calibration fit = Calibrate(kept, trial);
+        const double change = bic(fit) - bic(current_fit);
+        const int added = fit.num_parameters - current_fit.num_parameters;
+        reasons[group.name] =
+            "left out: BIC " + Signed(change) + " if freed (J / sigma^2 falls by " +
+            Signed((sum_squares(current_fit) - sum_squares(fit)) / (sigma * sigma)).substr(1) +
+            " for " + std::to_string(added) + " more parameter" + (added == 1 ? "" : "s") +
+            " at ln 2N = " + Signed(log_2n).substr(1) + " each)";
+        if (change < 0.0 && (best == nullptr || bic(fit) < bic(best_fit))) {
+          best = &group;
+          best_fit = std::move(fit);
+          best_options = trial;
+        }
+      } catch (const SceneError& e) {
+        reasons[group.name] = std::string("left out: not determined (") + e.what() + ")";
+      }
+    }
+    if (best == nullptr) break;
+    reasons[best->name] = "freed: BIC " + Signed(bic(best_fit) - bic(current_fit));
+    current = best_options;
+    current_fit = std::move(best_fit);
+  }
+
+  choice->clear();
+  for (const LadderGroup& group : kLadder) {
+    CalibrationModelChoice entry;
+    entry.group = group.name;
+    entry.free = group.is_free(current);
+    entry.reason = group.is_free(options) ? reasons[group.name]
+                                          : "not a candidate (held by the options)";
+    choice->push_back(entry);
+  }
+  *sigma_px = sigma;
+  CalibrateOptions chosen = options;
+  chosen.select_model = false;
+  chosen.principal_point_free = current.principal_point_free;
+  chosen.aspect_free = current.aspect_free;
+  chosen.skew_free = current.skew_free;
+  chosen.tangential_free = current.tangential_free;
+  chosen.num_radial = current.num_radial;
+  return chosen;
+}
+
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
   options.Check();
+  if (options.select_model) {
+    std::vector<CalibrationModelChoice> choice;
+    double sigma = 0.0;
+    const CalibrateOptions chosen = SelectCalibrationModel(views, options, &choice, &sigma);
+    Calibration result = Calibrate(views, chosen);
+    result.model_choice = std::move(choice);
+    result.selection_sigma_px = sigma;
+    result.selection_sigma_given = options.pixel_sigma > 0.0;
+    return result;
+  }
+
   if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
   for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
 

@@ -28,6 +28,16 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   nlohmann::ordered_json sigma = nlohmann::ordered_json::object();
   for (const ParameterSigma& p : calibration.intrinsics_sigma) sigma[p.name] = p.sigma;
   file["sigma"] = sigma;
+  if (!calibration.model_choice.empty()) {
+    nlohmann::ordered_json model = nlohmann::ordered_json::object();
+    for (const CalibrationModelChoice& c : calibration.model_choice) {
+      model[c.group] = {{"free", c.free}, {"reason", c.reason}};
+    }
+    file["model"] = {{"selection", "BIC from the focal length up (docs/calibration.md)"},
+                     {"sigma_px", calibration.selection_sigma_px},
+                     {"sigma_given", calibration.selection_sigma_given},
+                     {"groups", model}};
+  }
   file["rms_px"] = calibration.rms_px;
   file["num_points"] = calibration.num_points;
   file["num_parameters"] = calibration.num_parameters;

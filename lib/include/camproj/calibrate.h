@@ -61,6 +61,12 @@ struct CalibrateOptions {
   // Also calibrate the even and the odd views apart and compare them (Calibration::
   // cross_validation); needs compute_uncertainty and >= 4 views.
   bool cross_validate = true;
+  // Choose the model the views need (SelectCalibrationModel below): the free flags above then say
+  // what the ladder may free (a group whose flag is off is never freed), not what is free.
+  bool select_model = false;
+  // Pixel noise for the selection's criterion (px, 1 sigma); 0: estimated from the richest
+  // model the flags allow, sqrt(J / (2N - p)), floored at kMinNoisePx.
+  double pixel_sigma = 0.0;
   int max_iterations = 200;
   // Stops at a relative cost change below function_tolerance (1e-12: a parameter ~2e-5 sigma from
   // the optimum at 500 degrees of freedom) or a relative step below parameter_tolerance.
@@ -71,6 +77,15 @@ struct CalibrateOptions {
   // Throws std::invalid_argument naming the field unless the image size is positive,
   // num_radial is 0 to 3, and the iteration count and tolerances are positive.
   void Check() const;
+};
+
+// One rung of the model ladder across views: a group of intrinsics, whether it was freed, why.
+struct CalibrationModelChoice {
+  std::string group;   // "principal-point", "aspect", "skew", "k1", "k2", "tangential", "k3"
+  bool free = false;
+  // "freed: BIC -412.3", "left out: BIC +6.2 (J falls by 0.7 sigma^2, p ln 2N = 6.9)",
+  // "not a candidate", "left out: needs k1 first", "left out: not determined (...)".
+  std::string reason;
 };
 
 struct CalibratedView {
@@ -126,6 +141,11 @@ struct Calibration {
   // px, 1, 1), zero rows and columns for fixed entries; zero unless compute_uncertainty.
   Eigen::Matrix<double, 10, 10> intrinsics_covariance = Eigen::Matrix<double, 10, 10>::Zero();
   CrossValidation cross_validation;
+  // With CalibrateOptions::select_model: every group of the ladder in its order, freed or not
+  // and why; the noise the criterion used and whether it was given.
+  std::vector<CalibrationModelChoice> model_choice;
+  double selection_sigma_px = 0.0;
+  bool selection_sigma_given = false;
   Intrinsics start;                   // the closed-form start's intrinsics
   int iterations = 0;
   std::string termination;            // Ceres' words
@@ -137,6 +157,21 @@ struct Calibration {
 // determine the free intrinsics (fewer equations than unknowns, or no closed-form start: say
 // which intrinsics to fix), kNumerical when the refinement fails.
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options);
+
+// The model ladder across views (CalibrateOptions::select_model; docs/calibration.md). From the
+// focal length alone (square pixels, the principal point at the image centre, no skew, no lens)
+// it frees one group at a time among principal point, aspect, skew, k1, k2 (after k1), p1 + p2
+// ("tangential") and k3 (after k2) — those the options allow — each round the one that lowers
+//   BIC = J / sigma^2 + p ln(2N)
+// most (J the sum of squared residuals over every view, p = 6 per view + the free intrinsics, N
+// the points), until none lowers it: the single-view ladder's criterion (model_select.h). The
+// views are those the richest allowed model keeps (its refused views are left out of the ladder;
+// the final calibration refuses again). Returns the options of the chosen model (select_model
+// off) and fills `choice` with every group's reason and `sigma_px` with the noise used.
+CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& views,
+                                        const CalibrateOptions& options,
+                                        std::vector<CalibrationModelChoice>* choice,
+                                        double* sigma_px);
 
 }  // namespace camproj
 
