@@ -569,6 +569,10 @@ struct JointProblem {
     solver_options.gradient_tolerance = options.gradient_tolerance;
     solver_options.parameter_tolerance = options.parameter_tolerance;
     solver_options.num_threads = 1;
+    // The closed-form start is near the optimum: LM's first steps need little damping. Ceres'
+    // default radius 1e4 damped them for an iteration or two more (callgrind, bench --calibrate
+    // at 5 views: 11 % fewer instructions at 1e6, the same optimum; 1e8 and 1e12 no better).
+    solver_options.initial_trust_region_radius = 1e6;
     solver_options.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
