@@ -26,6 +26,7 @@ struct CalibrateArgs {
   std::string model = "auto";
   double sigma = 0.0;
   bool keep_all_views = false;
+  bool keep_all_points = false;
   std::string pixel_origin = "center";
 };
 
@@ -117,6 +118,9 @@ Command AddCalibrateCommand(CLI::App& root) {
   app->add_flag("--keep-all-views", args->keep_all_views,
                 "keep views that do not fit the camera the others share (by default such a view, "
                 "more than 2.5x the others' RMS and beyond their noise, is left out and named)");
+  app->add_flag("--keep-all-points", args->keep_all_points,
+                "keep single points that do not fit (by default a point beyond the level-0.001 "
+                "bound of the residuals' robust spread is left out and named)");
   app->add_option("--pixel-origin", args->pixel_origin,
                   "convention of the input pixels and the written cx, cy")
       ->check(CLI::IsMember({"center", "corner"}));
@@ -125,6 +129,7 @@ Command AddCalibrateCommand(CLI::App& root) {
             options.image_size = ParseImageSize(args->image_size, "--image-size");
             options.pixel_sigma = args->sigma;
             options.refuse_inconsistent_views = !args->keep_all_views;
+            options.remove_outliers = !args->keep_all_points;
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             const std::vector<std::string> inputs = ExpandInputs(args->view_paths);
             RequireOutputIsNotAnInput(args->output_path, inputs);
@@ -133,7 +138,8 @@ Command AddCalibrateCommand(CLI::App& root) {
             std::vector<CalibrationView> views;
             for (const std::string& path : inputs) {
               const Correspondences file = ReadCorrespondencesFile(path);
-              CalibrationView view{std::filesystem::path(path).stem().string(), file.points_in_world, {}};
+              CalibrationView view{std::filesystem::path(path).stem().string(),
+                                   file.points_in_world, {}, file.ids};
               for (const auto& pixel : file.pixels) {
                 view.pixels.push_back(ConvertPixelOrigin(pixel, origin, PixelOrigin::kCenter));
               }
@@ -171,6 +177,13 @@ Command AddCalibrateCommand(CLI::App& root) {
                 out << "  " << std::left << std::setw(16) << c.group << std::right << c.reason
                     << '\n';
               }
+            }
+            for (const OutlierPoint& point : calibration.outliers) {
+              out << "left out point " << point.id << " of " << point.view << ": "
+                  << std::setprecision(3) << point.residual_px
+                  << " px from the calibrated camera (bound " << point.bound_px
+                  << " px); --keep-all-points keeps it\n"
+                  << std::setprecision(6);
             }
             for (const RefusedView& view : calibration.refused_views) {
               out << "refused view " << view.name << ": its " << view.num_points << " points are "

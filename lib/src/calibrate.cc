@@ -164,6 +164,10 @@ void CheckView(const CalibrationView& view, size_t index) {
     throw std::invalid_argument(name + " has " + std::to_string(view.points_in_world.size()) +
                                 " points but " + std::to_string(view.pixels.size()) + " pixels");
   }
+  if (!view.ids.empty() && view.ids.size() != view.pixels.size()) {
+    throw std::invalid_argument(name + " has " + std::to_string(view.ids.size()) + " ids for " +
+                                std::to_string(view.pixels.size()) + " points");
+  }
   if (view.points_in_world.size() < 4) {
     throw std::invalid_argument(name + " has " + std::to_string(view.points_in_world.size()) +
                                 " points; a view needs at least 4");
@@ -588,7 +592,9 @@ struct JointProblem {
 // Each view's camera, RMS and depth range at the joint optimum; returns the sum of squares over
 // every view.
 double AssembleViews(const std::vector<CalibrationView>& views, const JointProblem& joint,
-                     const CalibrateOptions& options, Calibration* result) {
+                     const CalibrateOptions& options, Calibration* result,
+                     std::vector<std::vector<double>>* residual_norms) {
+  residual_norms->assign(views.size(), {});
   double sum_squares = 0.0;
   for (size_t i = 0; i < views.size(); ++i) {
     const std::array<double, kPoseSize>& pose = joint.poses[i];
@@ -613,6 +619,7 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
       internal::ResidualOfCamPoint(joint.k.data(), point_in_cam, views[i].pixels[j], residual,
                                    nullptr, nullptr);
       view_sum += residual[0] * residual[0] + residual[1] * residual[1];
+      (*residual_norms)[i].push_back(std::hypot(residual[0], residual[1]));
       min_depth = std::min(min_depth, point_in_cam.z());
       max_depth = std::max(max_depth, point_in_cam.z());
     }
@@ -623,6 +630,65 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
     result->views.push_back(view);
   }
   return sum_squares;
+}
+
+// A view may lose at most this share of its points as outliers; beyond it the view as a whole
+// does not fit (wrong correspondences, another camera) and is the view refusal's question.
+constexpr double kMaxOutlierShare = 0.3;
+// Familywise level of the outlier bound over all points.
+constexpr double kOutlierLevel = 0.001;
+
+// Each view's outlier bound (CalibrateOptions::remove_outliers): |r| of a 2D Gaussian residual is
+// Rayleigh(sigma), with median sigma sqrt(2 ln 2) and P(|r| > b) = exp(-b^2 / (2 sigma^2));
+// sigma from the view's own median (real views differ in noise: OpenCV's left chessboards 0.15 to
+// 0.47 px RMS, and one sigma for all would cut the noisy views' ordinary points), b at level
+// kOutlierLevel over all N points.
+std::vector<double> OutlierBounds(const std::vector<std::vector<double>>& residual_norms) {
+  size_t total = 0;
+  for (const auto& norms : residual_norms) total += norms.size();
+  const double quantile = std::sqrt(2.0 * std::log(static_cast<double>(total) / kOutlierLevel));
+  std::vector<double> bounds;
+  for (const auto& norms : residual_norms) {
+    const double sigma =
+        std::max(kMinNoisePx, internal::Median(norms) / std::sqrt(2.0 * std::log(2.0)));
+    bounds.push_back(sigma * quantile);
+  }
+  return bounds;
+}
+
+// The views without the points beyond `bound`, or std::nullopt when there are none; the points
+// left out into *outliers.
+std::optional<std::vector<CalibrationView>> WithoutOutliers(
+    const std::vector<CalibrationView>& views,
+    const std::vector<std::vector<double>>& residual_norms, const std::vector<double>& bounds,
+    std::vector<OutlierPoint>* outliers) {
+  std::vector<CalibrationView> cleaned;
+  bool any = false;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const std::vector<double>& norms = residual_norms[i];
+    const double bound = bounds[i];
+    const auto beyond = std::count_if(norms.begin(), norms.end(), [&](double r) { return r > bound; });
+    const size_t kept_points = norms.size() - static_cast<size_t>(beyond);
+    if (beyond == 0 || beyond > kMaxOutlierShare * norms.size() || kept_points < 4) {
+      cleaned.push_back(views[i]);
+      continue;
+    }
+    any = true;
+    CalibrationView view{views[i].name, {}, {}, {}};
+    for (size_t j = 0; j < norms.size(); ++j) {
+      const std::string id = views[i].ids.empty() ? std::to_string(j + 1) : views[i].ids[j];
+      if (norms[j] > bound) {
+        outliers->push_back({ViewName(views[i], i), id, norms[j], bound});
+        continue;
+      }
+      view.points_in_world.push_back(views[i].points_in_world[j]);
+      view.pixels.push_back(views[i].pixels[j]);
+      view.ids.push_back(id);
+    }
+    cleaned.push_back(std::move(view));
+  }
+  if (!any) return std::nullopt;
+  return cleaned;
 }
 
 // The intrinsics' covariance (scaled by s^2) and the sigmas of the free ones into *result.
@@ -738,7 +804,20 @@ CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& view
     const std::string name = ViewName(views[i], i);
     const bool refused = std::any_of(richest.refused_views.begin(), richest.refused_views.end(),
                                      [&](const RefusedView& r) { return r.name == name; });
-    if (!refused) kept.push_back(views[i]);
+    if (refused) continue;
+    // Without the points the richest model left out.
+    CalibrationView view{views[i].name, {}, {}, {}};
+    for (size_t j = 0; j < views[i].pixels.size(); ++j) {
+      const std::string id = views[i].ids.empty() ? std::to_string(j + 1) : views[i].ids[j];
+      const bool outlier = std::any_of(
+          richest.outliers.begin(), richest.outliers.end(),
+          [&](const OutlierPoint& o) { return o.view == name && o.id == id; });
+      if (outlier) continue;
+      view.points_in_world.push_back(views[i].points_in_world[j]);
+      view.pixels.push_back(views[i].pixels[j]);
+      view.ids.push_back(id);
+    }
+    kept.push_back(std::move(view));
   }
   auto sum_squares = [](const Calibration& c) { return c.rms_px * c.rms_px * c.num_points; };
   const double sigma =
@@ -753,6 +832,7 @@ CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& view
 
   // From the focal length alone, one group per round.
   quiet.refuse_inconsistent_views = false;
+  quiet.remove_outliers = false;
   CalibrateOptions current = quiet;
   current.principal_point_free = current.aspect_free = current.skew_free = false;
   current.tangential_free = false;
@@ -862,11 +942,29 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   result.num_parameters = num_parameters;
   result.iterations = static_cast<int>(summary.iterations.size()) - 1;
   result.termination = summary.message;
-  const double sum_squares = AssembleViews(views, joint, options, &result);
+  std::vector<std::vector<double>> residual_norms;
+  const double sum_squares = AssembleViews(views, joint, options, &result, &residual_norms);
   result.rms_px = std::sqrt(sum_squares / num_points);
 
+  // Views first: a view that does not fit bends the joint fit, and points of good views would
+  // be left out for it. A view whose misfit is a few points — its median |r| within
+  // kViewRmsFactor of the other views' (pooled), though its RMS is not — is kept for the point
+  // stage instead.
   if (options.refuse_inconsistent_views && views.size() >= 4) {
-    if (auto refused = WorstInconsistentView(result, sum_squares, num_parameters)) {
+    auto refused = WorstInconsistentView(result, sum_squares, num_parameters);
+    if (refused && options.remove_outliers) {
+      std::vector<double> others;
+      for (size_t i = 0; i < views.size(); ++i) {
+        if (i != refused->first) {
+          others.insert(others.end(), residual_norms[i].begin(), residual_norms[i].end());
+        }
+      }
+      if (internal::Median(residual_norms[refused->first]) <=
+          kViewRmsFactor * internal::Median(others)) {
+        refused.reset();
+      }
+    }
+    if (refused) {
       std::vector<CalibrationView> kept;
       for (size_t i = 0; i < views.size(); ++i) {
         if (i != refused->first) kept.push_back(views[i]);
@@ -878,6 +976,20 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
       } catch (const SceneError&) {
         // The others alone cannot determine the camera: keep every view (its RMS shows it).
       }
+    }
+  }
+  if (options.remove_outliers) {
+    std::vector<OutlierPoint> outliers;
+    if (auto cleaned =
+            WithoutOutliers(views, residual_norms, OutlierBounds(residual_norms), &outliers)) {
+      // One round: the points beyond the bounds of the fit that had them all. Bounds taken
+      // again without them would be tighter and peel further (measured on the chessboards:
+      // 4 rounds, every point at a board's edge column).
+      CalibrateOptions rest_options = options;
+      rest_options.remove_outliers = false;
+      Calibration rest = Calibrate(*cleaned, rest_options);
+      rest.outliers.insert(rest.outliers.begin(), outliers.begin(), outliers.end());
+      return rest;
     }
   }
   if (options.compute_uncertainty) AddUncertainty(joint, sum_squares, options, &result);

@@ -66,6 +66,12 @@ std::string CalibrationToJsonText(const Calibration& calibration,
                        {"chi_square", view.statistic}, {"bound", view.bound}});
   }
   file["refused_views"] = refused;
+  nlohmann::ordered_json outliers = nlohmann::ordered_json::array();
+  for (const OutlierPoint& point : calibration.outliers) {
+    outliers.push_back({{"view", point.view}, {"id", point.id},
+                        {"residual_px", point.residual_px}, {"bound_px", point.bound_px}});
+  }
+  file["outliers"] = outliers;
   return file.dump(2) + "\n";
 }
 

@@ -40,6 +40,8 @@ struct CalibrationView {
   std::string name;  // for messages and the result, e.g. the file's name
   std::vector<Eigen::Vector3d> points_in_world;
   std::vector<Eigen::Vector2d> pixels;
+  // Optional: a name per point for messages (the file's ids); empty: "1", "2", ... in order.
+  std::vector<std::string> ids;
 };
 
 // Which intrinsics the views share and refine. The default is cv::calibrateCamera's model
@@ -58,6 +60,13 @@ struct CalibrateOptions {
   // 2.5 times the others' is left out and the rest calibrated again, until none is or 3 views
   // remain. Needs >= 4 views.
   bool refuse_inconsistent_views = true;
+  // Leave out single points that do not fit (a mis-detected corner, a mis-click): after the joint
+  // fit, every point whose residual |r| exceeds sigma sqrt(2 ln(N / 0.001)) — the level-0.001
+  // bound over all N points of a Rayleigh |r| with sigma = median |r| / sqrt(2 ln 2), robust to
+  // the outliers themselves — is left out and the rest calibrated again, until none is. A view
+  // with more than 30 % of its points beyond the bound keeps them: that is a view that does not
+  // fit (refuse_inconsistent_views), not a few bad points.
+  bool remove_outliers = true;
   // Also calibrate the even and the odd views apart and compare them (Calibration::
   // cross_validation); needs compute_uncertainty and >= 4 views.
   bool cross_validate = true;
@@ -114,6 +123,15 @@ struct CrossValidation {
   double predicted_rms_px = 0.0;  // sqrt(mean over the grid of trace(Cov_A + Cov_B) there)
 };
 
+// A point left out because it does not fit the calibrated camera (CalibrateOptions::
+// remove_outliers).
+struct OutlierPoint {
+  std::string view;
+  std::string id;            // CalibrationView::ids, or its 1-based number in the view
+  double residual_px = 0.0;  // |r| in the calibration that left it out
+  double bound_px = 0.0;     // the bound it exceeded
+};
+
 // A view left out because it does not fit the camera the other views share.
 struct RefusedView {
   std::string name;
@@ -129,6 +147,7 @@ struct Calibration {
   Intrinsics intrinsics;  // kCenter; entries not free hold their fixed values
   std::vector<CalibratedView> views;  // in the order given, without the refused ones
   std::vector<RefusedView> refused_views;  // in the order they were refused
+  std::vector<OutlierPoint> outliers;       // points left out, in the order they were
   int num_points = 0;                 // over all views
   int num_parameters = 0;             // 6 per view + the free intrinsics
   double rms_px = 0.0;                // sqrt(sum |r|^2 / num_points), as cv::calibrateCamera's
