@@ -1233,6 +1233,36 @@ PY
     expect_exit 0 "$bin" calibrate "$work/left.csv" "$work/zoomed03.csv" --image-size 640x480 --keep-all-views -o "$work/kept.json"
     expect_in out "^calibrated 14 views, 756 points"
     ;;
+  calibrate_many_views)
+    # A 504-view calibration (the 12 left views that fit, 42 times under other names, from one
+    # view-column file) writes a 1.4 MB file: the moving-camera recipe's second step (fit
+    # --intrinsics) and --view read it; only a file over 16 MiB is refused.
+    boards="$data/real/opencv_chessboard"
+    py - "$work/many.csv" "$boards"/left0[13-9].csv "$boards"/left1*.csv <<'PY'
+import os, sys
+with open(sys.argv[1], "w") as out:
+    out.write("view,X,Y,Z,u,v\n")
+    for copy in range(42):
+        for path in sys.argv[2:]:
+            name = os.path.splitext(os.path.basename(path))[0]
+            for line in open(path).read().split("\n")[1:]:
+                if line.strip():
+                    out.write("%s_%d,%s\n" % (name, copy, line))
+PY
+    expect_exit 0 "$bin" calibrate "$work/many.csv" --image-size 640x480 -o "$work/calib.json"
+    expect_in out "^calibrated 504 views, 27216 points: rms 0.241514 px"
+    [[ $(wc -c <"$work/calib.json") -gt 1048576 ]] || fail "the calibration file is not over 1 MiB"
+    expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/calib.json"
+    expect_in out "model: pose, 6 free parameters"
+    expect_exit 0 "$bin" export "$work/calib.json" --view left14_41 --to json -o "$work/last.json"
+    expect_exit 0 "$bin" project "$work/last.json" "$boards/left14.csv"
+    [[ $(wc -l <"$work/out") -eq 55 ]] || fail "left14_41's camera projected not 54 points"
+    { printf '{"image_size": [640, 480]'; head -c 16800000 /dev/zero | tr '\0' ' '; printf '}'; } >"$work/big.json"
+    expect_exit 2 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/big.json"
+    expect_in err "big.json: larger than 16777216 bytes"
+    expect_exit 2 "$bin" export "$work/big.json" --view left03_0
+    expect_in err "big.json: larger than 16777216 bytes"
+    ;;
   *) fail "unknown case" ;;
 esac
 echo "ok [$case]"

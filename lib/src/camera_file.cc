@@ -17,6 +17,9 @@ using json = nlohmann::json;
 // Deepest nesting of arrays and objects a camera file may have: the files camproj writes nest 5
 // deep (document > fit > selection > candidates > candidate).
 constexpr int kMaxJsonDepth = 32;
+// A calibration file takes about 2.9 KB per view: 16 MiB holds ~5800 views (a 500-frame sequence
+// is 1.4 MB) and still refuses a wrong file before parsing it.
+constexpr size_t kMaxCalibrationFileBytes = size_t{16} << 20;
 
 namespace {
 
@@ -326,8 +329,7 @@ Camera CalibrationViewFromJsonText(const std::string& text, const std::string& s
 }
 
 Camera ReadCalibrationView(const std::string& path, const std::string& view) {
-  // About 3 KB per view: 256 MB holds any real calibration and refuses a wrong file early.
-  return CalibrationViewFromJsonText(ReadWholeFile(path, size_t{1} << 28), path, view);
+  return CalibrationViewFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path, view);
 }
 
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source) {
@@ -335,7 +337,8 @@ Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& so
 }
 
 Intrinsics ReadIntrinsicsFile(const std::string& path) {
-  return IntrinsicsFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
+  // Also a calibration file's intrinsics (`camproj fit --intrinsics CALIB.json`).
+  return IntrinsicsFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path);
 }
 
 std::vector<int> OutlierIndicesFromJsonText(const std::string& text, const std::string& source) {

@@ -86,7 +86,9 @@ Camera CalibrationViewFromJsonText(const std::string& text, const std::string& s
 Camera ReadCalibrationView(const std::string& path, const std::string& view);
 
 // The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
-// skew, k1, k2]} and optionally "pixel_origin": returned in kCenter. Throws InputError.
+// skew, k1, k2]} and optionally "pixel_origin" (a calibration file too): returned in kCenter.
+// Throws InputError. ReadIntrinsicsFile and ReadCalibrationView refuse a file over 16 MiB (a
+// calibration of ~5800 views), ReadCameraFile one over 1 MiB.
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source);
 Intrinsics ReadIntrinsicsFile(const std::string& path);
 
