@@ -271,17 +271,24 @@ class CsvParser {
 
   // The index in views_ of the current row's view, added at its first row.
   size_t ViewOfRow() {
-    std::string_view name;
-    if (view_column_) {
-      name = fields_[*view_column_];
-      if (name.empty()) FailField(*view_column_, "empty view name");
+    if (!view_column_) {
+      if (views_.empty()) AddView("");
+      return 0;
     }
-    const auto [it, inserted] = view_index_.emplace(std::string(name), views_.size());
-    if (inserted) {
-      views_.push_back({std::string(name), {}});
-      line_of_id_.emplace_back();
-    }
-    return it->second;
+    const std::string_view name = fields_[*view_column_];
+    if (name.empty()) FailField(*view_column_, "empty view name");
+    // Rows usually come view by view: the previous row's view without a lookup.
+    if (!views_.empty() && name == views_[last_view_].name) return last_view_;
+    const auto it = view_index_.find(std::string(name));
+    last_view_ = it != view_index_.end() ? it->second : AddView(name);
+    return last_view_;
+  }
+
+  size_t AddView(std::string_view name) {
+    view_index_.emplace(std::string(name), views_.size());
+    views_.push_back({std::string(name), {}});
+    line_of_id_.emplace_back();
+    return views_.size() - 1;
   }
 
   double Number(size_t index) const {
@@ -317,6 +324,7 @@ class CsvParser {
   // One view without a view column (named ""); else one per name, in order of first appearance.
   std::vector<CorrespondencesView> views_;
   std::unordered_map<std::string, size_t> view_index_;
+  size_t last_view_ = 0;
   std::vector<std::unordered_map<std::string, int>> line_of_id_;  // per view: id -> its line
   size_t num_rows_ = 0;
 };
