@@ -1,8 +1,9 @@
 // libFuzzer target for the camera-file reader (camproj/camera_file.h).
 //
-// The contract under test: CameraFromJsonText either returns a camera that passes
-// Camera::Check or throws camproj::InputError. Anything else -- another exception type (it
-// escapes and aborts), a crash, a leak, undefined behaviour, a hang -- is a finding. Besides, an
+// The contract under test: CameraFromJsonText (and CalibrationViewFromJsonText, for a view named
+// "a") either returns a camera that passes Camera::Check or throws camproj::InputError. Anything
+// else -- another exception type (it escapes and aborts), a crash, a leak, undefined behaviour, a
+// hang -- is a finding. Besides, an
 // accepted camera written back with CameraToJsonText must read back bit for bit (the writer
 // promises full precision). A violated check prints what differs and aborts, so libFuzzer saves
 // the input.
@@ -59,6 +60,15 @@ bool Same(const camproj::Camera& a, const camproj::Camera& b) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  // A calibration file's view (the dictionary's "views", "name", "camera"): the same contract.
+  try {
+    const camproj::Camera view = camproj::CalibrationViewFromJsonText(text, "fuzz.json", "a");
+    view.Check();
+  } catch (const camproj::InputError& e) {
+    Expect(std::strlen(e.what()) > 0, "InputError with an empty message");
+  } catch (const std::invalid_argument& e) {
+    Fail(std::string("the reader returned a view's camera that fails Check: ") + e.what());
+  }
   camproj::Camera camera;
   try {
     camera = camproj::CameraFromJsonText(text, "fuzz.json");

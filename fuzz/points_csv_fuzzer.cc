@@ -8,6 +8,9 @@
 //     same result, or InputError with the same message ("share every rule and message");
 //   * tight limits (short lines, few rows) may only turn a success into an InputError;
 //   * an accepted file written back with CorrespondencesToCsvText reads back bit for bit.
+//   * the reader by view (ReadCorrespondencesViewsFile) agrees with its text form, each view
+//     meets the postconditions and its rows are the plain reader's rows of its lines (when both
+//     accept the input); one view named "" is exactly the plain reader's result.
 // A violated check prints what differs and aborts, so libFuzzer saves the input.
 //
 // Build and run: scripts/fuzz.sh.
@@ -23,6 +26,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_set>
+#include <vector>
 
 #include "camproj/errors.h"
 #include "camproj/points_file.h"
@@ -101,6 +105,83 @@ void CheckPostconditions(const camproj::Correspondences& c) {
   }
 }
 
+// The outcome of one parse by view.
+struct ViewsOutcome {
+  std::optional<std::vector<camproj::CorrespondencesView>> value;
+  std::string error;
+};
+
+template <typename Parse>
+ViewsOutcome RunViews(Parse parse) {
+  ViewsOutcome outcome;
+  try {
+    outcome.value = parse();
+  } catch (const camproj::InputError& e) {
+    outcome.error = e.what();
+    Expect(!outcome.error.empty(), "InputError with an empty message");
+  }
+  return outcome;
+}
+
+bool Same(const ViewsOutcome& a, const ViewsOutcome& b) {
+  if (a.value.has_value() != b.value.has_value()) return false;
+  if (!a.value) return a.error == b.error;
+  if (a.value->size() != b.value->size()) return false;
+  for (size_t v = 0; v < a.value->size(); ++v) {
+    if ((*a.value)[v].name != (*b.value)[v].name ||
+        !Same((*a.value)[v].correspondences, (*b.value)[v].correspondences, true)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The reader by view against the plain reader on the same text (both having accepted it).
+void CheckViews(const std::vector<camproj::CorrespondencesView>& views,
+                const std::optional<camproj::Correspondences>& plain) {
+  Expect(!views.empty(), "success without views");
+  std::unordered_set<std::string> names;
+  size_t rows = 0;
+  for (const camproj::CorrespondencesView& view : views) {
+    CheckPostconditions(view.correspondences);
+    Expect(names.insert(view.name).second, "a repeated view: " + view.name);
+    Expect(!view.name.empty() || views.size() == 1, "an unnamed view among others");
+    rows += view.correspondences.pixels.size();
+  }
+  if (!plain) return;
+  Expect(rows == plain->pixels.size(), "the views' rows are not the plain reader's rows");
+  if (views.size() == 1 && views[0].name.empty()) {
+    Expect(Same(views[0].correspondences, *plain, /*compare_line_numbers=*/true),
+           "one unnamed view differs from the plain reader's result");
+    return;
+  }
+  for (const camproj::CorrespondencesView& view : views) {
+    const camproj::Correspondences& c = view.correspondences;
+    for (size_t i = 0; i < c.pixels.size(); ++i) {
+      // The plain reader's rows are in line order: find this row's line there.
+      size_t lo = 0, hi = plain->line_numbers.size();
+      while (lo < hi) {
+        const size_t mid = (lo + hi) / 2;
+        if (plain->line_numbers[mid] < c.line_numbers[i]) {
+          lo = mid + 1;
+        } else {
+          hi = mid;
+        }
+      }
+      Expect(lo < plain->line_numbers.size() && plain->line_numbers[lo] == c.line_numbers[i],
+             "a view's row is on a line the plain reader did not read");
+      for (int k = 0; k < 3; ++k) {
+        Expect(SameBits(c.points_in_world[i][k], plain->points_in_world[lo][k]),
+               "a view's point differs from the plain reader's");
+      }
+      for (int k = 0; k < 2; ++k) {
+        Expect(SameBits(c.pixels[i][k], plain->pixels[lo][k]),
+               "a view's pixel differs from the plain reader's");
+      }
+    }
+  }
+}
+
 // A read-only view of `text` as a file, without touching the disk.
 class MemoryFile {
  public:
@@ -142,6 +223,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       Run([&] { return camproj::ReadCorrespondencesFile(source, defaults); });
   Expect(Same(text_outcome, stream_outcome), "text reader: " + Describe(text_outcome) +
                                                  "; streamed reader: " + Describe(stream_outcome));
+
+  const ViewsOutcome views_text =
+      RunViews([&] { return camproj::CorrespondencesViewsFromCsvText(text, source, defaults); });
+  const ViewsOutcome views_stream =
+      RunViews([&] { return camproj::ReadCorrespondencesViewsFile(source, defaults); });
+  Expect(Same(views_text, views_stream), "the text and the streamed readers by view differ");
+  if (views_text.value) CheckViews(*views_text.value, text_outcome.value);
 
   // Tight limits, chosen from the input so the fuzzer can reach both sides of each bound.
   camproj::CorrespondencesLimits tight;

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "camproj/calibration_file.h"
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "seeds.h"
@@ -153,6 +154,62 @@ TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {
             std::string::npos);
   EXPECT_NE(ExpectInputError(good_prefix + R"("cam_from_world": {"R": [[1,0,0],[0,1,0],[0,0,-1]], "t": [0,0,0]},
             "frustum": {"near": 1, "far": 2}})").find("left-handed"), std::string::npos);
+}
+
+// The message of the InputError that selecting `view` in `text` as "calib.json" throws.
+std::string ExpectViewError(const std::string& text, const std::string& view) {
+  try {
+    CalibrationViewFromJsonText(text, "calib.json", view);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError for view " << view;
+  return "";
+}
+
+// A calibration file's view is selected by name, bit for bit the camera that was written; a
+// calibration file is not taken for one camera, a camera file not for a calibration.
+TEST(CameraFileTest, CalibrationViewsAreSelectedByName) {
+  std::mt19937_64 rng(testing::Seed(31));
+  Calibration calibration;
+  calibration.image_size = {640, 480};
+  for (const char* name : {"left01", "left03"}) {
+    CalibratedView view;
+    view.name = name;
+    view.camera = RandomFileCamera(rng);
+    view.camera.image_size = calibration.image_size;
+    view.num_points = 54;
+    calibration.views.push_back(view);
+  }
+  calibration.intrinsics = calibration.views[0].camera.intrinsics;
+  calibration.refused_views.push_back({"left02", 54, 1.24, 0.25, 200.0, 40.0});
+  const std::string text = CalibrationToJsonText(calibration);
+  for (const CalibratedView& view : calibration.views) {
+    const Camera back = CalibrationViewFromJsonText(text, "calib.json", view.name);
+    EXPECT_EQ(back.cam_from_world.rotation, view.camera.cam_from_world.rotation);
+    EXPECT_EQ(back.cam_from_world.translation, view.camera.cam_from_world.translation);
+    EXPECT_EQ(back.intrinsics.fx, view.camera.intrinsics.fx);
+    EXPECT_EQ(back.intrinsics.cx, view.camera.intrinsics.cx);
+    EXPECT_EQ(back.intrinsics.k1, view.camera.intrinsics.k1);
+    EXPECT_EQ(back.z_near, view.camera.z_near);
+    EXPECT_EQ(back.z_far, view.camera.z_far);
+  }
+  EXPECT_EQ(ExpectViewError(text, "left02"),
+            "calib.json: view left02 was refused by the calibration (refused_views): it has no "
+            "camera");
+  EXPECT_EQ(ExpectViewError(text, "left9"),
+            "calib.json: no view named left9; the views are left01, left03");
+  EXPECT_EQ(ExpectInputError(text),
+            "cam.json: a calibration file of 2 views, not one camera: select a view by its name "
+            "(camproj export and project: --view NAME)");
+  EXPECT_EQ(ExpectViewError(CameraToJsonText(calibration.views[0].camera), "left01"),
+            "calib.json: not a calibration file (no views array): a view is selected only in the "
+            "file camproj calibrate writes");
+  EXPECT_EQ(ExpectViewError(R"({"views": [{"name": "a", "camera": {"image_size": [640, 480]}}]})",
+                            "a"),
+            "calib.json, view a: intrinsics: missing");
+  EXPECT_EQ(ExpectViewError(R"({"views": [{"name": "a"}]})", "a"),
+            "calib.json, view a: camera: missing");
 }
 
 // world_origin (docs/camera-file.md) is optional: absent stays absent, present round-trips bit

@@ -19,6 +19,51 @@ expect_exit() {
 expect_in() { grep -q -- "$2" "$work/$1" || fail "$1 lacks '$2':\n$(cat "$work/$1")"; }
 expect_not_in() { ! grep -q -- "$2" "$work/$1" || fail "$1 has '$2':\n$(cat "$work/$1")"; }
 py() { /usr/bin/python3 "$@"; }
+# same_calibration A B: two calibration files with the same keys, names and strings, and numbers
+# equal to 1e-12 relative: the intrinsics and poses come out bit for bit, but the covariance's
+# (sigma, predicted_rms_px) last bits vary with where the inputs sit in memory (1-4 ulp measured,
+# from the same points read from one file or from two).
+same_calibration() {
+  py - "$1" "$2" <<'PY'
+import json, sys
+def same(a, b, path):
+    assert type(a) == type(b), path
+    if isinstance(a, dict):
+        assert list(a) == list(b), path
+        for k in a: same(a[k], b[k], path + "." + k)
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)): same(x, y, "%s[%d]" % (path, i))
+    elif isinstance(a, float):
+        assert abs(a - b) <= 1e-12 * max(abs(a), abs(b)), (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+same(a, b, "")
+for name in ("intrinsics", "views"):
+    assert a[name] == b[name], name + " not bit for bit"
+PY
+}
+# views_csv OUT FILE...: the single-view CSVs (X,Y,Z,u,v) as one CSV with a view column (each
+# view named by its file's stem) and an id column numbering each view's rows, so that the ids
+# repeat across views; the rows interleaved (row 1 of every view, then row 2, ...), so that a
+# view's rows are not adjacent.
+views_csv() {
+  py - "$@" <<'PY'
+import os, sys
+views = []
+for path in sys.argv[2:]:
+    lines = [l.strip() for l in open(path) if l.strip() and not l.startswith("#")]
+    assert lines[0] == "X,Y,Z,u,v", (path, lines[0])
+    views.append((os.path.splitext(os.path.basename(path))[0], lines[1:]))
+with open(sys.argv[1], "w") as out:
+    out.write("view,id,X,Y,Z,u,v\n")
+    for k in range(max(len(rows) for _, rows in views)):
+        for name, rows in views:
+            if k < len(rows):
+                out.write("%s,%d,%s\n" % (name, k + 1, rows[k]))
+PY
+}
 
 case $case in
   fit_projector)
@@ -1064,6 +1109,202 @@ PY
     expect_in err "--model opencv frees k3 but --fix holds it"
     [[ ! -e "$work/bad.json" ]] || fail "a bad --model wrote a file"
     expect_not_in out "^refused view"
+    ;;
+  calibrate_view_column)
+    # The left chessboard views in one CSV with a view column (rows interleaved, ids repeated
+    # across views) calibrate exactly as the 13 files do: the same calibration (the covariance's
+    # last bits aside, see same_calibration), poses byte for byte, the same summary; so do some
+    # views in files and the rest in a view-column file.
+    boards="$data/real/opencv_chessboard"
+    expect_exit 0 "$bin" calibrate "$boards"/left*.csv --image-size 640x480 -o "$work/files.json" --poses "$work/files_poses.csv"
+    grep -v '^wrote ' "$work/out" >"$work/files.out"
+    views_csv "$work/all.csv" "$boards"/left*.csv
+    [[ $(grep -c '^left03,1,' "$work/all.csv") -eq 1 && $(grep -c ',1,0.0,0.0,0.0,' "$work/all.csv") -eq 13 ]] \
+      || fail "all.csv does not repeat id 1 once per view"
+    expect_exit 0 "$bin" calibrate "$work/all.csv" --image-size 640x480 -o "$work/all.json" --poses "$work/all_poses.csv"
+    expect_in out "^calibrated 12 views, 644 points: rms 0.189844 px"
+    expect_in out "^refused view left02: its 54 points are 1.22 px RMS"
+    expect_in out "^views (rms px): left01 0.195 left03 0.173 left04 "
+    expect_in out "^wrote $work/all.json and $work/all_poses.csv"
+    same_calibration "$work/files.json" "$work/all.json" || fail "the view column's calibration differs from the files':\n$(diff "$work/files.json" "$work/all.json" | head)"
+    cmp -s "$work/files_poses.csv" "$work/all_poses.csv" || fail "the view column's poses differ"
+    grep -v '^wrote ' "$work/out" | cmp -s - "$work/files.out" || fail "the summaries differ"
+    # Mixed: left01-left07 in a view-column file, the others as files.
+    views_csv "$work/first.csv" "$boards"/left0[1-7].csv
+    expect_exit 0 "$bin" calibrate "$work/first.csv" "$boards"/left0[89].csv "$boards"/left1*.csv --image-size 640x480 -o "$work/mixed.json"
+    same_calibration "$work/files.json" "$work/mixed.json" || fail "files and a view-column file together differ:\n$(diff "$work/files.json" "$work/mixed.json" | head)"
+    # Bad input: exit 2, the file, line and field (or both sources of a name), no output file.
+    awk 'NR == 30 { print; sub(/^left0[0-9],[0-9]+,/, "left03,2,") } { print }' "$work/all.csv" >"$work/dup.csv"
+    expect_exit 2 "$bin" calibrate "$work/dup.csv" --image-size 640x480 -o "$work/dup.json"
+    expect_in err "dup.csv: line 31, column 2 (id): duplicate id \"2\" in view \"left03\" (also on line 17)"
+    [[ ! -e "$work/dup.json" ]] || fail "bad input wrote a calibration file"
+    sed '20s/^left[0-9]*,/,/' "$work/all.csv" >"$work/unnamed.csv"
+    expect_exit 2 "$bin" calibrate "$work/unnamed.csv" --image-size 640x480 -o "$work/unnamed.json"
+    expect_in err "unnamed.csv: line 20, column 1 (view): empty view name"
+    [[ ! -e "$work/unnamed.json" ]] || fail "bad input wrote a calibration file"
+    expect_exit 2 "$bin" calibrate "$work/first.csv" "$boards/left05.csv" --image-size 640x480 -o "$work/twice.json"
+    expect_in err "left05.csv: view name left05 is also the name of the view from $work/first.csv, line 6; every view needs its own name"
+    [[ ! -e "$work/twice.json" ]] || fail "bad input wrote a calibration file"
+    # A file without a view column but with repeated ids is still refused.
+    printf 'id,X,Y,Z,u,v\na,0,0,0,1,1\nb,1,0,0,2,1\na,0,1,0,1,2\nc,1,1,0,2,2\n' >"$work/ids.csv"
+    expect_exit 2 "$bin" calibrate "$work/ids.csv" --image-size 640x480 -o "$work/ids.json"
+    expect_in err "ids.csv: line 4, column 1 (id): duplicate id \"a\" (also on line 2)"
+    ;;
+  calibrate_views_load_in_export_and_project)
+    # A view of the calibration, selected by name (--view) or taken out as docs/calibration.md
+    # says, is a camera file for export and project: projected through it, left05's corners land
+    # on their pixels with the calibration's own RMS of that view (0.151 px).
+    boards="$data/real/opencv_chessboard"
+    views_csv "$work/all.csv" "$boards"/left*.csv
+    expect_exit 0 "$bin" calibrate "$work/all.csv" --image-size 640x480 -o "$work/calib.json"
+    expect_exit 0 "$bin" export "$work/calib.json" --view left05 --to gl
+    expect_in out "^projection "
+    expect_exit 0 "$bin" export "$work/calib.json" --view left05 --to json -o "$work/left05.json"
+    py -c "import json, sys; json.dump(json.load(open(sys.argv[1]))['views'][3]['camera'], open(sys.argv[2], 'w'))" \
+      "$work/calib.json" "$work/extracted.json"
+    for camera in "--view left05 $work/calib.json" "$work/left05.json" "$work/extracted.json"; do
+      expect_exit 0 "$bin" project $camera "$boards/left05.csv"
+      py - "$work/out" "$boards/left05.csv" "$work/calib.json" <<'PY' || fail "left05 projected through $camera is off its pixels"
+import csv, json, math, sys
+projected = list(csv.DictReader(open(sys.argv[1])))
+observed = list(csv.DictReader(open(sys.argv[2])))
+assert len(projected) == len(observed) == 54, len(projected)
+d = [math.hypot(float(p["u"]) - float(o["u"]), float(p["v"]) - float(o["v"])) for p, o in zip(projected, observed)]
+rms = math.sqrt(sum(x * x for x in d) / len(d))
+# The calibration's own RMS of the view (no corner of left05 is left out as an outlier; the
+# camera file's 17 digits reproduce it to ~1e-12 px).
+view = [v for v in json.load(open(sys.argv[3]))["views"] if v["name"] == "left05"][0]
+assert view["num_points"] == 54 and abs(rms - view["rms_px"]) < 1e-9, (rms, view["rms_px"])
+PY
+    done
+    expect_exit 0 "$bin" project "$work/calib.json" --view left05 "$boards/left05.csv"
+    cp "$work/out" "$work/by_name.out"
+    expect_exit 0 "$bin" project "$work/extracted.json" "$boards/left05.csv"
+    cmp -s "$work/out" "$work/by_name.out" || fail "--view and the extracted camera project differently"
+    # A calibration file is not one camera; a refused view or an unknown name is named.
+    expect_exit 2 "$bin" export "$work/calib.json" --to gl
+    expect_in err "calib.json: a calibration file of 12 views, not one camera: select a view by its name"
+    expect_exit 2 "$bin" project "$work/calib.json" --view left02 "$boards/left02.csv"
+    expect_in err "calib.json: view left02 was refused by the calibration (refused_views): it has no camera"
+    expect_exit 2 "$bin" export "$work/calib.json" --view left10 --to gl
+    expect_in err "calib.json: no view named left10; the views are left01, left03, left04, left05, left06, left07, left08, left09, left11, left12, ... (12 in all)"
+    expect_exit 2 "$bin" export "$work/left05.json" --view left05 --to gl
+    expect_in err "left05.json: not a calibration file (no views array)"
+    ;;
+  calibrate_mixed_planar_and_3d)
+    # One synthetic camera (synth's default: 1920x1080, fovy 40 deg, fx = fy = 1483.638 px, the
+    # principal point at the centre, no distortion) seen in 4 planar views and 4 views of a point
+    # cloud, 30 points each, 0.3 px noise. With fx, fy, cx, cy, k1, k2 free, every intrinsic is
+    # within 3 sigma of the truth and the cloud views pin the focal length (sigma 0.83 px); the
+    # planar views alone leave it to 28.9 px. The automatic model (fx only: the rest left out by
+    # BIC) is within 3 sigma too. --keep-all-points: the outlier stage would leave out plane3's 8th
+    # point (1.28 px, at its bound: a chance of ~1 % per set at these noise levels), and this case
+    # is about the model, not that stage.
+    for seed in 1 2 3 4; do
+      expect_exit 0 "$bin" synth --seed $seed --object plane --points 30 --noise 0.3 -o "$work/plane$seed.csv" --truth "$work/truth_plane$seed.json"
+      expect_exit 0 "$bin" synth --seed $((seed + 10)) --object cloud --points 30 --noise 0.3 -o "$work/cloud$seed.csv" --truth "$work/truth_cloud$seed.json"
+    done
+    model=principal-point+aspect+k1+k2
+    expect_exit 0 "$bin" calibrate "$work"/plane[1-4].csv "$work"/cloud[1-4].csv --image-size 1920x1080 --model $model --keep-all-points -o "$work/mixed.json"
+    expect_in out "^calibrated 8 views, 240 points: rms 0.38"
+    expect_not_in out "^refused view"
+    expect_in out "^views (rms px): plane1 0.377 plane2 0.366 plane3 0.421 plane4 0.34 cloud1 0.392 cloud2 0.405 cloud3 0.402 cloud4 0.346"
+    expect_exit 0 "$bin" calibrate "$work"/plane[1-4].csv --image-size 1920x1080 --model $model -o "$work/planes.json"
+    expect_exit 0 "$bin" calibrate "$work"/plane[1-4].csv "$work"/cloud[1-4].csv --image-size 1920x1080 -o "$work/auto.json"
+    expect_in out "^calibrated 8 views, 240 points"
+    py - "$work" <<'PY' || fail "the mixed calibration is off the truth"
+import json, sys
+work = sys.argv[1]
+truths = [json.load(open("%s/truth_%s%d.json" % (work, kind, s)))["intrinsics"] for kind in ("plane", "cloud") for s in range(1, 5)]
+assert all(t == truths[0] for t in truths), "synth's cameras differ"
+truth = truths[0]
+mixed = json.load(open(work + "/mixed.json"))
+for name in ("fx", "fy", "cx", "cy", "k1", "k2"):
+    error = mixed["intrinsics"][name] - truth[name]
+    assert abs(error) < 3 * mixed["sigma"][name], (name, mixed["intrinsics"][name], truth[name], mixed["sigma"][name])
+assert 0.7 < mixed["sigma"]["fx"] < 1.0, mixed["sigma"]["fx"]
+planes = json.load(open(work + "/planes.json"))
+assert planes["sigma"]["fx"] > 20, planes["sigma"]["fx"]
+auto = json.load(open(work + "/auto.json"))
+assert list(auto["sigma"]) == ["fx"], auto["sigma"]
+for name, value in auto["intrinsics"].items():
+    bound = 3 * auto["sigma"]["fx"] if name in ("fx", "fy") else 1e-9
+    assert abs(value - truth.get(name, 0.0)) < bound, (name, value, truth.get(name))
+PY
+    ;;
+  calibrate_view_with_too_few_points)
+    # A view of 3 points is refused by its file (and line, in a view-column file) before any
+    # calibration: exit 2, nothing written, an existing calibration file left as it was.
+    boards="$data/real/opencv_chessboard"
+    head -4 "$boards/left05.csv" >"$work/few.csv"
+    expect_exit 2 "$bin" calibrate "$boards"/left0[1-4].csv "$work/few.csv" --image-size 640x480 -o "$work/calib.json"
+    expect_in err "^camproj: error: $work/few.csv: view few has 3 points; a view needs at least 4$"
+    [[ ! -e "$work/calib.json" ]] || fail "a refused calibration wrote its file"
+    views_csv "$work/all.csv" "$boards"/left0[1-4].csv "$work/few.csv"
+    echo kept >"$work/calib.json"
+    expect_exit 2 "$bin" calibrate "$work/all.csv" --image-size 640x480 -o "$work/calib.json" --poses "$work/poses.csv"
+    expect_in err "^camproj: error: $work/all.csv, line 6: view few has 3 points; a view needs at least 4$"
+    [[ $(cat "$work/calib.json") == kept && ! -e "$work/poses.csv" ]] || fail "a refused calibration changed the output files"
+    head -2 "$boards/left05.csv" >"$work/one.csv"
+    expect_exit 2 "$bin" calibrate "$boards"/left0[1-4].csv "$work/one.csv" --image-size 640x480 -o "$work/calib.json"
+    expect_in err "one.csv: view one has 1 point; a view needs at least 4"
+    ;;
+  calibrate_other_camera_refused)
+    # left03 seen by another camera (its pixels scaled by 1.3 about the image centre: a 30 %
+    # longer focal length) among the left views of a view-column file: refused by name in the
+    # summary and the file (as is left02, 5x the others' RMS), exit 0, and the rest calibrated
+    # exactly as without it.
+    boards="$data/real/opencv_chessboard"
+    awk -F, 'BEGIN { OFS = "," } NR == 1 { print; next } { $4 = 319.5 + 1.3 * ($4 - 319.5); $5 = 239.5 + 1.3 * ($5 - 239.5); print }' \
+      "$boards/left03.csv" >"$work/zoomed03.csv"
+    views_csv "$work/left.csv" "$boards"/left*.csv
+    expect_exit 0 "$bin" calibrate "$work/left.csv" "$work/zoomed03.csv" --image-size 640x480 -o "$work/with.json"
+    expect_in out "^refused view zoomed03: its 54 points are 1.47 px RMS from the camera the other views share (0.471 px): another camera"
+    expect_in out "^refused view left02: its 54 points are 1.22 px RMS"
+    expect_in out "^calibrated 12 views, 644 points: rms 0.189844 px"
+    expect_not_in out "^views (rms px):.*zoomed03"
+    expect_in out "^wrote $work/with.json"
+    expect_exit 0 "$bin" calibrate "$work/left.csv" --image-size 640x480 -o "$work/without.json"
+    py - "$work/with.json" "$work/without.json" <<'PY' || fail "the refused view changed the calibration"
+import json, sys
+with_, without = (json.load(open(p)) for p in sys.argv[1:])
+assert [v["name"] for v in with_["refused_views"]] == ["zoomed03", "left02"], with_["refused_views"]
+assert with_["intrinsics"] == without["intrinsics"], (with_["intrinsics"], without["intrinsics"])
+assert [v["name"] for v in with_["views"]] == [v["name"] for v in without["views"]]
+PY
+    # Kept on request, it is the worst view by far.
+    expect_exit 0 "$bin" calibrate "$work/left.csv" "$work/zoomed03.csv" --image-size 640x480 --keep-all-views --keep-all-points -o "$work/kept.json"
+    expect_in out "^calibrated 14 views, 756 points"
+    ;;
+  calibrate_many_views)
+    # A 504-view calibration (the 12 left views that fit, 42 times under other names, from one
+    # view-column file) writes a 1.4 MB file: the moving-camera recipe's second step (fit
+    # --intrinsics) and --view read it; only a file over 16 MiB is refused.
+    boards="$data/real/opencv_chessboard"
+    py - "$work/many.csv" "$boards"/left0[13-9].csv "$boards"/left1*.csv <<'PY'
+import os, sys
+with open(sys.argv[1], "w") as out:
+    out.write("view,X,Y,Z,u,v\n")
+    for copy in range(42):
+        for path in sys.argv[2:]:
+            name = os.path.splitext(os.path.basename(path))[0]
+            for line in open(path).read().split("\n")[1:]:
+                if line.strip():
+                    out.write("%s_%d,%s\n" % (name, copy, line))
+PY
+    expect_exit 0 "$bin" calibrate "$work/many.csv" --image-size 640x480 -o "$work/calib.json"
+    expect_in out "^calibrated 504 views, 27048 points: rms 0.189592 px"
+    [[ $(wc -c <"$work/calib.json") -gt 1048576 ]] || fail "the calibration file is not over 1 MiB"
+    expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/calib.json"
+    expect_in out "model: pose, 6 free parameters"
+    expect_exit 0 "$bin" export "$work/calib.json" --view left14_41 --to json -o "$work/last.json"
+    expect_exit 0 "$bin" project "$work/last.json" "$boards/left14.csv"
+    [[ $(wc -l <"$work/out") -eq 55 ]] || fail "left14_41's camera projected not 54 points"
+    { printf '{"image_size": [640, 480]'; head -c 16800000 /dev/zero | tr '\0' ' '; printf '}'; } >"$work/big.json"
+    expect_exit 2 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/big.json"
+    expect_in err "big.json: larger than 16777216 bytes"
+    expect_exit 2 "$bin" export "$work/big.json" --view left03_0
+    expect_in err "big.json: larger than 16777216 bytes"
     ;;
   *) fail "unknown case" ;;
 esac

@@ -359,5 +359,109 @@ TEST(PointsFileTest, UnreadablePathsNameThePath) {
       {"empty.csv: empty file"});
 }
 
+// The message of the InputError that parsing `text` by view as "all.csv" throws.
+std::string ViewsParseError(const std::string& text) {
+  try {
+    CorrespondencesViewsFromCsvText(text, "all.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError for:\n" << text;
+  return "";
+}
+
+TEST(PointsFileTest, ViewColumnGroupsRowsByFirstAppearanceAndIdsRepeatAcrossViews) {
+  const std::string text =
+      "view,id,X,Y,Z,u,v\n"
+      "b,p1,1,2,3,4,5\n"
+      "a,p1,6,7,8,9,10\n"
+      "# a comment\n"
+      "b,p2,11,12,13,14,15\n"
+      "a,p2,16,17,18,19,20\n"
+      "c,p1,21,22,23,24,25\n";
+  const std::vector<CorrespondencesView> views = CorrespondencesViewsFromCsvText(text, "t");
+  ASSERT_EQ(views.size(), 3u);
+  EXPECT_EQ(views[0].name, "b");
+  EXPECT_EQ(views[1].name, "a");
+  EXPECT_EQ(views[2].name, "c");
+  EXPECT_EQ(views[0].correspondences.ids, (std::vector<std::string>{"p1", "p2"}));
+  EXPECT_EQ(views[0].correspondences.line_numbers, (std::vector<int>{2, 5}));
+  EXPECT_EQ(views[0].correspondences.points_in_world[1], Eigen::Vector3d(11, 12, 13));
+  EXPECT_EQ(views[0].correspondences.pixels[1], Eigen::Vector2d(14, 15));
+  EXPECT_EQ(views[1].correspondences.ids, (std::vector<std::string>{"p1", "p2"}));
+  EXPECT_EQ(views[1].correspondences.line_numbers, (std::vector<int>{3, 6}));
+  EXPECT_EQ(views[1].correspondences.points_in_world[0], Eigen::Vector3d(6, 7, 8));
+  EXPECT_EQ(views[2].correspondences.pixels, (std::vector<Eigen::Vector2d>{{24, 25}}));
+  // The plain reader ignores the view column, so its ids must be unique in the whole file.
+  EXPECT_NE(ParseError(text).find("pts.csv: line 3, column 2 (id): duplicate id \"p1\" (also on "
+                                  "line 2)"),
+            std::string::npos);
+}
+
+TEST(PointsFileTest, ViewsWithoutAnIdColumnNumberTheirOwnRows) {
+  const std::vector<CorrespondencesView> views = CorrespondencesViewsFromCsvText(
+      "X,Y,Z,u,v,view\n1,2,3,4,5,a\n1,2,3,4,5,b\n1,2,3,4,5,a\n", "t");
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[0].correspondences.ids, (std::vector<std::string>{"1", "2"}));
+  EXPECT_EQ(views[1].correspondences.ids, (std::vector<std::string>{"1"}));
+}
+
+TEST(PointsFileTest, FileWithoutViewColumnIsOneUnnamedView) {
+  const std::string text = "id,X,Y,Z,u,v\nq,1,2,3,4,5\nr,6,7,8,9,10\n";
+  const std::vector<CorrespondencesView> views = CorrespondencesViewsFromCsvText(text, "t");
+  const Correspondences plain = CorrespondencesFromCsvText(text, "t");
+  ASSERT_EQ(views.size(), 1u);
+  EXPECT_EQ(views[0].name, "");
+  EXPECT_EQ(views[0].correspondences.ids, plain.ids);
+  EXPECT_EQ(views[0].correspondences.points_in_world, plain.points_in_world);
+  EXPECT_EQ(views[0].correspondences.pixels, plain.pixels);
+  EXPECT_EQ(views[0].correspondences.line_numbers, plain.line_numbers);
+}
+
+TEST(PointsFileTest, ViewErrorsNameTheSourceLineAndColumn) {
+  EXPECT_EQ(ViewsParseError("view,id,X,Y,Z,u,v\na,1,1,2,3,4,5\nb,1,1,2,3,4,5\na,1,1,2,3,4,5\n"),
+            "all.csv: line 4, column 2 (id): duplicate id \"1\" in view \"a\" (also on line 2)");
+  EXPECT_EQ(ViewsParseError("view,X,Y,Z,u,v\na,1,2,3,4,5\n ,1,2,3,4,5\n"),
+            "all.csv: line 3, column 1 (view): empty view name");
+  EXPECT_EQ(ViewsParseError("view,X,Y,Z,u,v\na,1,2,x,4,5\n"),
+            "all.csv: line 2, column 4 (Z): expected a number, got \"x\"");
+  EXPECT_EQ(ViewsParseError("view,X,Y,Z,u,v\n"),
+            "all.csv: the header (line 1) is followed by no data rows");
+  CorrespondencesLimits limits;
+  limits.max_points = 2;  // all views together
+  try {
+    CorrespondencesViewsFromCsvText("view,X,Y,Z,u,v\na,1,2,3,4,5\nb,1,2,3,4,5\nc,1,2,3,4,5\n",
+                                    "all.csv", limits);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "all.csv: line 4: more than 2 data rows");
+  }
+}
+
+TEST(PointsFileTest, StreamedViewsMatchText) {
+  const TempDir dir("views");
+  std::string text = "view,id,X,Y,Z,u,v\r\n";
+  for (int i = 0; i < 3000; ++i) {
+    text += "v" + std::to_string(i % 7) + "," + std::to_string(i / 7) + "," + std::to_string(i) +
+            ".5,1,2,3," + std::to_string(i % 640) + "\r\n";
+  }
+  const std::string path = dir.Write("all.csv", text);
+  const std::vector<CorrespondencesView> from_file = ReadCorrespondencesViewsFile(path);
+  const std::vector<CorrespondencesView> from_text = CorrespondencesViewsFromCsvText(text, path);
+  ASSERT_EQ(from_file.size(), 7u);
+  ASSERT_EQ(from_text.size(), 7u);
+  for (size_t v = 0; v < 7; ++v) {
+    EXPECT_EQ(from_file[v].name, "v" + std::to_string(v));
+    EXPECT_EQ(from_file[v].name, from_text[v].name);
+    EXPECT_EQ(from_file[v].correspondences.points_in_world,
+              from_text[v].correspondences.points_in_world);
+    EXPECT_EQ(from_file[v].correspondences.pixels, from_text[v].correspondences.pixels);
+    EXPECT_EQ(from_file[v].correspondences.ids, from_text[v].correspondences.ids);
+    EXPECT_EQ(from_file[v].correspondences.line_numbers, from_text[v].correspondences.line_numbers);
+  }
+  EXPECT_EQ(from_file[6].correspondences.pixels.size(), 428u);  // 3000 = 7 * 428 + 4
+  EXPECT_EQ(from_file[0].correspondences.pixels.size(), 429u);
+}
+
 }  // namespace
 }  // namespace camproj

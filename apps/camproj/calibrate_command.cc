@@ -3,11 +3,13 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
 #include "camproj/calibrate.h"
 #include "camproj/calibration_file.h"
+#include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
@@ -78,6 +80,45 @@ CalibrateOptions ModelOptions(const std::string& model, const std::vector<std::s
   return options;
 }
 
+// Calibrate's own minimum (calibrate.h), checked here first so that the message can name the
+// file and lines the view came from.
+constexpr size_t kMinPointsPerView = 4;
+
+// Each file's views: one per distinct value of its `view` column, or the whole file (named by its
+// stem) without one. Pixels converted to kCenter. Throws InputError naming the file (and line) of
+// a view with too few points, and both sources of a name given twice.
+std::vector<CalibrationView> ReadViews(const std::vector<std::string>& paths, PixelOrigin origin) {
+  std::vector<CalibrationView> views;
+  std::map<std::string, std::string> source_of_name;
+  for (const std::string& path : paths) {
+    for (CorrespondencesView& file_view : ReadCorrespondencesViewsFile(path)) {
+      const Correspondences& c = file_view.correspondences;
+      const bool from_column = !file_view.name.empty();
+      const std::string name =
+          from_column ? file_view.name : std::filesystem::path(path).stem().string();
+      const std::string source =
+          from_column ? path + ", line " + std::to_string(c.line_numbers.front()) : path;
+      if (c.pixels.size() < kMinPointsPerView) {
+        throw InputError(source + ": view " + name + " has " + std::to_string(c.pixels.size()) +
+                         " point" + (c.pixels.size() == 1 ? "" : "s") + "; a view needs at least " +
+                         std::to_string(kMinPointsPerView));
+      }
+      const auto [it, inserted] = source_of_name.emplace(name, source);
+      if (!inserted) {
+        throw InputError(source + ": view name " + name + " is also the name of the view from " +
+                         it->second + "; every view needs its own name");
+      }
+      CalibrationView view{name, c.points_in_world, {}, c.ids};
+      view.pixels.reserve(c.pixels.size());
+      for (const auto& pixel : c.pixels) {
+        view.pixels.push_back(ConvertPixelOrigin(pixel, origin, PixelOrigin::kCenter));
+      }
+      views.push_back(std::move(view));
+    }
+  }
+  return views;
+}
+
 }  // namespace
 
 Command AddCalibrateCommand(CLI::App& root) {
@@ -86,14 +127,22 @@ Command AddCalibrateCommand(CLI::App& root) {
       "calibrate",
       "Calibrate one camera or projector from many views of known points (a chessboard moved in\n"
       "front of it, or a 3D rig): intrinsics shared by every view (the model the views need,\n"
-      "chosen by BIC among OpenCV's fx, fy, cx, cy, k1, k2, p1, p2, k3), a pose per view, refined jointly (Ceres). Each view is\n"
-      "a CSV with X,Y,Z,u,v in its own world frame (a board's frame is fine); a folder stands for\n"
-      "its *.csv files. Writes CALIB.json: the intrinsics at the top level (so `camproj fit\n"
-      "--intrinsics CALIB.json` fits poses against them) with their sigmas, and each view's full\n"
-      "camera under views[i].camera.\n\n"
+      "chosen by BIC among OpenCV's fx, fy, cx, cy, k1, k2, p1, p2, k3), a pose per view, refined\n"
+      "jointly (Ceres). Each view is a CSV with X,Y,Z,u,v in its own world frame (a board's frame\n"
+      "is fine), named by its file name; a folder stands for its *.csv files. A CSV with a `view`\n"
+      "column holds several views: its rows are grouped by that column's value, which names the\n"
+      "view (ids may repeat across views, not within one). View names must be unique over all\n"
+      "inputs. Writes CALIB.json: the intrinsics at the top level (so `camproj fit --intrinsics\n"
+      "CALIB.json` fits poses against them) with their sigmas, and each view's full camera under\n"
+      "views[i].camera (export and project take one by name: --view NAME).\n\n"
       "Example:\n"
-      "  camproj calibrate data/real/opencv_chessboard/left*.csv --image-size 640x480 -o left.json");
-  app->add_option("VIEWS", args->view_paths, "view CSV files, or folders of them")->required();
+      "  camproj calibrate data/real/opencv_chessboard/left*.csv --image-size 640x480 \\\n"
+      "      -o left.json\n"
+      "  camproj calibrate views.csv --image-size 640x480 -o calib.json  # view,X,Y,Z,u,v");
+  app->add_option("VIEWS", args->view_paths,
+                  "view CSV files (one view each, or several by a `view` column), or folders "
+                  "of them")
+      ->required();
   app->add_option("--image-size", args->image_size, "WxH in pixels")->required();
   app->add_option("-o,--output", args->output_path, "calibration file to write")->required();
   app->add_option("--poses", args->poses_path,
@@ -135,16 +184,7 @@ Command AddCalibrateCommand(CLI::App& root) {
             RequireOutputIsNotAnInput(args->output_path, inputs);
             if (!args->poses_path.empty()) RequireOutputIsNotAnInput(args->poses_path, inputs);
 
-            std::vector<CalibrationView> views;
-            for (const std::string& path : inputs) {
-              const Correspondences file = ReadCorrespondencesFile(path);
-              CalibrationView view{std::filesystem::path(path).stem().string(),
-                                   file.points_in_world, {}, file.ids};
-              for (const auto& pixel : file.pixels) {
-                view.pixels.push_back(ConvertPixelOrigin(pixel, origin, PixelOrigin::kCenter));
-              }
-              views.push_back(std::move(view));
-            }
+            const std::vector<CalibrationView> views = ReadViews(inputs, origin);
             const Calibration calibration = Calibrate(views, options);
             CameraFileOptions file_options;
             file_options.pixel_origin = origin;

@@ -22,6 +22,7 @@ namespace {
 
 struct ExportArgs {
   std::string camera_path;
+  std::string view;  // a calibration file's view, by name
   std::string to = "gl";
   std::string depth = "no";
   bool reversed_z = false;
@@ -68,8 +69,11 @@ Command AddExportCommand(CLI::App& root) {
       "Examples:\n"
       "  camproj export camera.json --to gl --depth zo --reversed-z\n"
       "  camproj export camera.json --to stmap -o lens.tif > render_target.txt\n"
-      "  camproj export camera.json --to opencv-yaml > camera.yaml");
+      "  camproj export camera.json --to opencv-yaml > camera.yaml\n"
+      "  camproj export calib.json --view left03 --to gl   # one view of a calibration");
   app->add_option("CAMERA", args->camera_path, "camera file (docs/camera-file.md)")->required();
+  app->add_option("--view", args->view,
+                  "CAMERA is a calibration file (camproj calibrate): export this view's camera");
   app->add_option("--to", args->to, "format")
       ->check(CLI::IsMember({"gl", "glm", "opencv-yaml", "colmap", "three", "json", "glsl",
                              "distortion-mesh", "stmap", "undistort-stmap"}));
@@ -98,7 +102,8 @@ Command AddExportCommand(CLI::App& root) {
                 "gl, glm, glsl, three: no depth-precision notes on stderr (warnings still "
                 "printed)");
   return {app, [args]() {
-            Camera camera = ReadCameraFile(args->camera_path);
+            Camera camera = args->view.empty() ? ReadCameraFile(args->camera_path)
+                                               : ReadCalibrationView(args->camera_path, args->view);
             if (args->z_near > 0.0) camera.z_near = args->z_near;
             if (args->z_far > 0.0) camera.z_far = args->z_far;
             if (args->infinite_far) {

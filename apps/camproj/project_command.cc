@@ -14,6 +14,7 @@ namespace {
 
 struct ProjectArgs {
   std::string camera_path;
+  std::string view;  // a calibration file's view, by name
   std::string points_path;
   std::string pixel_origin = "center";
 };
@@ -29,13 +30,19 @@ Command AddProjectCommand(CLI::App& root) {
       "printed escaped, as \\x1b). POINTS.csv needs\n"
       "X,Y,Z; u,v columns are ignored.\n\n"
       "Example:\n"
-      "  camproj project camera.json points.csv");
+      "  camproj project camera.json points.csv\n"
+      "  camproj project calib.json --view left03 left03.csv   # one view of a calibration");
   app->add_option("CAMERA", args->camera_path, "camera file")->required();
+  app->add_option("--view", args->view,
+                  "CAMERA is a calibration file (camproj calibrate): project through this view's "
+                  "camera");
   app->add_option("POINTS", args->points_path, "CSV with X,Y,Z")->required();
   app->add_option("--pixel-origin", args->pixel_origin, "convention of the printed pixels")
       ->check(CLI::IsMember({"center", "corner"}));
   return {app, [args]() {
-            const Camera camera = ReadCameraFile(args->camera_path);
+            const Camera camera = args->view.empty()
+                                      ? ReadCameraFile(args->camera_path)
+                                      : ReadCalibrationView(args->camera_path, args->view);
             CorrespondencesLimits limits;
             limits.require_pixels = false;
             const Correspondences points = ReadCorrespondencesFile(args->points_path, limits);

@@ -1,5 +1,6 @@
 #include "camproj/camera_file.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -16,6 +17,9 @@ using json = nlohmann::json;
 // Deepest nesting of arrays and objects a camera file may have: the files camproj writes nest 5
 // deep (document > fit > selection > candidates > candidate).
 constexpr int kMaxJsonDepth = 32;
+// A calibration file takes about 2.9 KB per view: 16 MiB holds ~5800 views (a 500-frame sequence
+// is 1.4 MB) and still refuses a wrong file before parsing it.
+constexpr size_t kMaxCalibrationFileBytes = size_t{16} << 20;
 
 namespace {
 
@@ -176,9 +180,10 @@ void CameraFileOptions::Check() const {
                     "target distance must be finite and positive, got ", target_distance);
 }
 
-Camera CameraFromJsonText(const std::string& text, const std::string& source) {
-  const json document = ParseJson(text, source);
-  const Reader reader(source);
+namespace {
+
+// A camera file's document, or a calibration file's views[i].camera.
+Camera CameraFromDocument(const json& document, const Reader& reader) {
   Camera camera;
   const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
   if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
@@ -258,12 +263,82 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   return camera;
 }
 
+// A name from a file, for a message: cut short like any quoted file text.
+std::string ShortName(const std::string& name) {
+  constexpr size_t kMaxBytes = 60;
+  return name.size() > kMaxBytes ? name.substr(0, kMaxBytes) + "..." : name;
+}
+
+// The `name` strings of a calibration file's views (or refused_views) array.
+std::vector<std::string> ViewNames(const json& document, const char* key) {
+  std::vector<std::string> names;
+  if (!document.contains(key) || !document.at(key).is_array()) return names;
+  for (const json& view : document.at(key)) {
+    if (view.is_object() && view.contains("name") && view.at("name").is_string()) {
+      names.push_back(view.at("name").get<std::string>());
+    }
+  }
+  return names;
+}
+
+bool IsCalibrationFile(const json& document) {
+  return document.is_object() && document.contains("views") && document.at("views").is_array() &&
+         !document.contains("look_at") && !document.contains("cam_from_world");
+}
+
+}  // namespace
+
+Camera CameraFromJsonText(const std::string& text, const std::string& source) {
+  const json document = ParseJson(text, source);
+  if (IsCalibrationFile(document)) {
+    throw InputError(source + ": a calibration file of " +
+                     std::to_string(document.at("views").size()) +
+                     " views, not one camera: select a view by its name (camproj export and "
+                     "project: --view NAME)");
+  }
+  return CameraFromDocument(document, Reader(source));
+}
+
+Camera CalibrationViewFromJsonText(const std::string& text, const std::string& source,
+                                   const std::string& view) {
+  const json document = ParseJson(text, source);
+  if (!IsCalibrationFile(document)) {
+    throw InputError(source + ": not a calibration file (no views array): a view is selected "
+                              "only in the file camproj calibrate writes");
+  }
+  for (const json& entry : document.at("views")) {
+    if (entry.is_object() && entry.contains("name") && entry.at("name") == view) {
+      const Reader reader(source + ", view " + ShortName(view));
+      return CameraFromDocument(reader.Member(entry, "", "camera"), reader);
+    }
+  }
+  const std::vector<std::string> refused = ViewNames(document, "refused_views");
+  if (std::find(refused.begin(), refused.end(), view) != refused.end()) {
+    throw InputError(source + ": view " + ShortName(view) +
+                     " was refused by the calibration (refused_views): it has no camera");
+  }
+  const std::vector<std::string> names = ViewNames(document, "views");
+  constexpr size_t kMaxListed = 10;
+  std::string listed;
+  for (size_t i = 0; i < names.size() && i < kMaxListed; ++i) {
+    listed += (i == 0 ? "" : ", ") + ShortName(names[i]);
+  }
+  if (names.size() > kMaxListed) listed += ", ... (" + std::to_string(names.size()) + " in all)";
+  throw InputError(source + ": no view named " + ShortName(view) + "; the views are " +
+                   (listed.empty() ? "none" : listed));
+}
+
+Camera ReadCalibrationView(const std::string& path, const std::string& view) {
+  return CalibrationViewFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path, view);
+}
+
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source) {
   return ReadIntrinsics(ParseJson(text, source), Reader(source));
 }
 
 Intrinsics ReadIntrinsicsFile(const std::string& path) {
-  return IntrinsicsFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
+  // Also a calibration file's intrinsics (`camproj fit --intrinsics CALIB.json`).
+  return IntrinsicsFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path);
 }
 
 std::vector<int> OutlierIndicesFromJsonText(const std::string& text, const std::string& source) {

@@ -26,6 +26,7 @@ namespace {
 
 constexpr std::array<const char*, 5> kRequiredColumns = {"X", "Y", "Z", "u", "v"};
 constexpr std::string_view kIdColumn = "id";
+constexpr std::string_view kViewColumn = "view";
 constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
 // File text quoted in a message is cut to this many bytes: a message is read, not a dump.
 constexpr size_t kMaxQuotedBytes = 60;
@@ -82,8 +83,10 @@ bool ParsesAsNumber(std::string_view field) {
 // Fed one line at a time, so that text and streamed files share every rule and message.
 class CsvParser {
  public:
-  CsvParser(std::string source, const CorrespondencesLimits& limits)
-      : source_(std::move(source)), limits_(limits) {}
+  // by_view: a `view` column groups the rows (FinishViews); without it the column is ignored
+  // like any extra column.
+  CsvParser(std::string source, const CorrespondencesLimits& limits, bool by_view = false)
+      : source_(std::move(source)), limits_(limits), by_view_(by_view) {}
 
   // The line number the next AddLine call will be given.
   int64_t next_line() const { return line_ + 1; }
@@ -119,26 +122,39 @@ class CsvParser {
   }
 
   Correspondences Finish() {
+    Complete();
+    return std::move(views_.front().correspondences);
+  }
+
+  std::vector<CorrespondencesView> FinishViews() {
+    Complete();
+    return std::move(views_);
+  }
+
+ private:
+  // The checks at the end of the text, and the vectors' slack given back.
+  void Complete() {
     if (header_line_ == 0) {
       throw InputError(
           source_ + ": " +
           (saw_text_ ? "no header: the file has only comments and blank lines" : "empty file") +
           "; expected a header line naming the columns X,Y,Z,u,v");
     }
-    if (result_.pixels.empty()) {
+    if (num_rows_ == 0) {
       throw InputError(source_ + ": the header (line " + std::to_string(header_line_) +
                        ") is followed by no data rows");
     }
     // The rows were appended one by one (capacity up to twice the size); the fit holds them
     // throughout, so give the slack back.
-    result_.points_in_world.shrink_to_fit();
-    result_.pixels.shrink_to_fit();
-    result_.ids.shrink_to_fit();
-    result_.line_numbers.shrink_to_fit();
-    return std::move(result_);
+    for (CorrespondencesView& view : views_) {
+      Correspondences& c = view.correspondences;
+      c.points_in_world.shrink_to_fit();
+      c.pixels.shrink_to_fit();
+      c.ids.shrink_to_fit();
+      c.line_numbers.shrink_to_fit();
+    }
   }
 
- private:
   std::string ColumnLabel(size_t index) const {
     std::string label = "column " + std::to_string(index + 1);
     if (index < names_.size() && !names_[index].empty()) label += " (" + names_[index] + ")";
@@ -185,6 +201,8 @@ class CsvParser {
     }
     const auto id = index_of_name.find(kIdColumn);
     if (id != index_of_name.end()) id_column_ = id->second;
+    const auto view = index_of_name.find(kViewColumn);
+    if (by_view_ && view != index_of_name.end()) view_column_ = view->second;
   }
 
   // Names the likely cause of a header that lacks the required columns.
@@ -222,28 +240,55 @@ class CsvParser {
                           "; column " + std::to_string(names_.size() + 1) +
                           " is not in the header");
     }
-    if (result_.pixels.size() >= limits_.max_points) {
+    if (num_rows_ >= limits_.max_points) {
       FailLine(line_, "more than " + std::to_string(limits_.max_points) + " data rows");
     }
     std::array<double, 5> values{};
     for (size_t c = 0; c < (has_pixels_ ? values.size() : 3); ++c) values[c] = Number(column_[c]);
+    const size_t view = ViewOfRow();
+    Correspondences& result = views_[view].correspondences;
     std::string id;
     if (id_column_) {
       const std::string_view text = fields_[*id_column_];
       if (text.empty()) FailField(*id_column_, "empty id");
-      const auto [it, inserted] = line_of_id_.emplace(std::string(text), static_cast<int>(line_));
+      const auto [it, inserted] =
+          line_of_id_[view].emplace(std::string(text), static_cast<int>(line_));
       if (!inserted) {
-        FailField(*id_column_, "duplicate id " + Quoted(text) + " (also on line " +
-                                   std::to_string(it->second) + ")");
+        FailField(*id_column_, "duplicate id " + Quoted(text) +
+                                   (view_column_ ? " in view " + Quoted(views_[view].name) : "") +
+                                   " (also on line " + std::to_string(it->second) + ")");
       }
       id = text;
     } else {
-      id = std::to_string(result_.pixels.size() + 1);
+      id = std::to_string(result.pixels.size() + 1);
     }
-    result_.points_in_world.emplace_back(values[0], values[1], values[2]);
-    result_.pixels.emplace_back(values[3], values[4]);
-    result_.ids.push_back(std::move(id));
-    result_.line_numbers.push_back(static_cast<int>(line_));
+    result.points_in_world.emplace_back(values[0], values[1], values[2]);
+    result.pixels.emplace_back(values[3], values[4]);
+    result.ids.push_back(std::move(id));
+    result.line_numbers.push_back(static_cast<int>(line_));
+    ++num_rows_;
+  }
+
+  // The index in views_ of the current row's view, added at its first row.
+  size_t ViewOfRow() {
+    if (!view_column_) {
+      if (views_.empty()) AddView("");
+      return 0;
+    }
+    const std::string_view name = fields_[*view_column_];
+    if (name.empty()) FailField(*view_column_, "empty view name");
+    // Rows usually come view by view: the previous row's view without a lookup.
+    if (!views_.empty() && name == views_[last_view_].name) return last_view_;
+    const auto it = view_index_.find(std::string(name));
+    last_view_ = it != view_index_.end() ? it->second : AddView(name);
+    return last_view_;
+  }
+
+  size_t AddView(std::string_view name) {
+    view_index_.emplace(std::string(name), views_.size());
+    views_.push_back({std::string(name), {}});
+    line_of_id_.emplace_back();
+    return views_.size() - 1;
   }
 
   double Number(size_t index) const {
@@ -272,10 +317,16 @@ class CsvParser {
   std::vector<std::string> names_;
   std::array<size_t, 5> column_{};  // index of X, Y, Z, u, v in a row
   bool has_pixels_ = true;
+  bool by_view_ = false;
   std::optional<size_t> id_column_;
-  std::unordered_map<std::string, int> line_of_id_;
+  std::optional<size_t> view_column_;  // only when by_view_
   std::vector<std::string_view> fields_;  // reused: one allocation for all rows
-  Correspondences result_;
+  // One view without a view column (named ""); else one per name, in order of first appearance.
+  std::vector<CorrespondencesView> views_;
+  std::unordered_map<std::string, size_t> view_index_;
+  size_t last_view_ = 0;
+  std::vector<std::unordered_map<std::string, int>> line_of_id_;  // per view: id -> its line
+  size_t num_rows_ = 0;
 };
 
 std::string IdProblem(const std::string& id) {
@@ -294,10 +345,9 @@ void CorrespondencesLimits::Check() const {
   internal::Require(max_points > 0, "max_points must be positive, got ", max_points);
 }
 
-Correspondences CorrespondencesFromCsvText(const std::string& text, const std::string& source,
-                                           const CorrespondencesLimits& limits) {
-  limits.Check();
-  CsvParser parser(source, limits);
+namespace {
+
+void ParseText(const std::string& text, CsvParser& parser) {
   const std::string_view all(text);
   size_t begin = 0;
   while (begin < all.size()) {
@@ -306,14 +356,10 @@ Correspondences CorrespondencesFromCsvText(const std::string& text, const std::s
     parser.AddLine(all.substr(begin, end - begin));
     begin = end + 1;
   }
-  return parser.Finish();
 }
 
-Correspondences ReadCorrespondencesFile(const std::string& path,
-                                        const CorrespondencesLimits& limits) {
-  limits.Check();
+void ParseFile(const std::string& path, const CorrespondencesLimits& limits, CsvParser& parser) {
   InputFile in(path);
-  CsvParser parser(path, limits);
   // `pending` holds the start of a line that runs past the buffer; a line may end in '\r' that
   // AddLine drops, so one byte more than the limit is still a candidate.
   std::string pending;
@@ -341,7 +387,40 @@ Correspondences ReadCorrespondencesFile(const std::string& path,
     }
   }
   if (!pending.empty()) parser.AddLine(pending);
+}
+
+}  // namespace
+
+Correspondences CorrespondencesFromCsvText(const std::string& text, const std::string& source,
+                                           const CorrespondencesLimits& limits) {
+  limits.Check();
+  CsvParser parser(source, limits);
+  ParseText(text, parser);
   return parser.Finish();
+}
+
+Correspondences ReadCorrespondencesFile(const std::string& path,
+                                        const CorrespondencesLimits& limits) {
+  limits.Check();
+  CsvParser parser(path, limits);
+  ParseFile(path, limits, parser);
+  return parser.Finish();
+}
+
+std::vector<CorrespondencesView> CorrespondencesViewsFromCsvText(
+    const std::string& text, const std::string& source, const CorrespondencesLimits& limits) {
+  limits.Check();
+  CsvParser parser(source, limits, /*by_view=*/true);
+  ParseText(text, parser);
+  return parser.FinishViews();
+}
+
+std::vector<CorrespondencesView> ReadCorrespondencesViewsFile(
+    const std::string& path, const CorrespondencesLimits& limits) {
+  limits.Check();
+  CsvParser parser(path, limits, /*by_view=*/true);
+  ParseFile(path, limits, parser);
+  return parser.FinishViews();
 }
 
 std::string CorrespondencesToCsvText(const Correspondences& correspondences) {

@@ -73,8 +73,22 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source);
 // ReadWholeFile + CameraFromJsonText.
 Camera ReadCameraFile(const std::string& path);
 
+// The camera of one view of a calibration file (calibration_file.h, docs/calibration.md): the
+// `camera` of the entry of `views` whose `name` is `view`, read as CameraFromJsonText reads a
+// camera file, with messages naming "SOURCE, view NAME: KEY: ...". Throws InputError naming the
+// source when the text is not a calibration file (a `views` array and no pose at the top level),
+// when that view was refused (`refused_views`), or when no view has that name (the message lists
+// the first ten names). CameraFromJsonText refuses a calibration file, pointing here.
+Camera CalibrationViewFromJsonText(const std::string& text, const std::string& source,
+                                   const std::string& view);
+
+// ReadWholeFile + CalibrationViewFromJsonText.
+Camera ReadCalibrationView(const std::string& path, const std::string& view);
+
 // The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
-// skew, k1, k2]} and optionally "pixel_origin": returned in kCenter. Throws InputError.
+// skew, k1, k2]} and optionally "pixel_origin" (a calibration file too): returned in kCenter.
+// Throws InputError. ReadIntrinsicsFile and ReadCalibrationView refuse a file over 16 MiB (a
+// calibration of ~5800 views), ReadCameraFile one over 1 MiB.
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source);
 Intrinsics ReadIntrinsicsFile(const std::string& path);
 

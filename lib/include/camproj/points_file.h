@@ -6,11 +6,19 @@
 //
 // The first line that is neither blank nor a comment is the header. It names the columns X, Y, Z
 // (the point in the world frame, user units) and u, v (the pixel, see conventions.h), in any order
-// and case-sensitively; an optional `id` column names each point in reports; other columns are
-// ignored. Every following line that is neither blank nor a comment is a data row with exactly as
-// many fields as the header. Fields are split at every comma (there is no quoting) and spaces or
-// tabs around a field are dropped. Lines end in LF or CRLF; a UTF-8 byte-order mark before the
-// header is skipped. Rows whose fields are all empty (spreadsheets write ",,,,") count as blank.
+// and case-sensitively; an optional `id` column names each point in reports; other columns
+// (also `view`, except for the reader by view below) are ignored. Every following line that is
+// neither blank nor a comment is a data row with exactly as many fields as the header. Fields are
+// split at every comma (there is no quoting) and spaces or tabs around a field are dropped. Lines
+// end in LF or CRLF; a UTF-8 byte-order mark before the header is skipped. Rows whose fields are
+// all empty (spreadsheets write ",,,,") count as blank.
+//
+// Several views in one file (ReadCorrespondencesViewsFile, for `camproj calibrate`): a column
+// named `view` groups the rows into views by its text; each view has its own world frame, so the
+// same id may appear once in every view:
+//   view,id,X,Y,Z,u,v
+//   left01,1,0,0,0,244.41,94.14
+//   left03,1,0,0,0,153.88,65.27
 //
 // The reader takes pixels as they are written: which pixel origin they follow is for the caller
 // to state (docs/conventions.md, "pixel"); nothing here converts them.
@@ -61,6 +69,29 @@ Correspondences CorrespondencesFromCsvText(const std::string& text, const std::s
 // file cannot be opened or read.
 Correspondences ReadCorrespondencesFile(const std::string& path,
                                         const CorrespondencesLimits& limits = {});
+
+// The rows of one view of a file read by view.
+struct CorrespondencesView {
+  std::string name;  // the `view` column's text; "" for a file without that column
+  // The view's rows in file order (line_numbers are the file's). Without an id column the ids
+  // number the view's rows ("1", "2", ...), as if the view were a file of its own.
+  Correspondences correspondences;
+};
+
+// Parses correspondences text as CorrespondencesFromCsvText does, but grouped into views by a
+// column named `view`: one entry per distinct view name, in order of first appearance (a view's
+// rows need not be adjacent). Ids must be unique within a view only. A file without a `view`
+// column is one view named "", exactly what CorrespondencesFromCsvText returns. Throws InputError
+// as CorrespondencesFromCsvText does, and also on an empty view field; a repeated id names its
+// view: "all.csv: line 9, column 2 (id): duplicate id \"3\" in view \"left03\" (also on line 5)".
+// limits.max_points bounds the rows of all views together.
+std::vector<CorrespondencesView> CorrespondencesViewsFromCsvText(
+    const std::string& text, const std::string& source, const CorrespondencesLimits& limits = {});
+
+// Reads the file at `path` as CorrespondencesViewsFromCsvText reads text, streaming it as
+// ReadCorrespondencesFile does.
+std::vector<CorrespondencesView> ReadCorrespondencesViewsFile(
+    const std::string& path, const CorrespondencesLimits& limits = {});
 
 // The file text: header "X,Y,Z,u,v", plus ",id" when `ids` is non-empty and differs from the
 // default numbering "1", "2", ...; one row per point; doubles in the shortest form that reads back
