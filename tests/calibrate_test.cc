@@ -118,13 +118,18 @@ bool CoversTheTruth(const Calibration& c) {
 TEST(CalibrateTest, SigmasCoverTheTruth) {
   constexpr int kSeeds = 200;
   int failures = 0;
-  double fx_squared_z = 0.0;
+  double fx_squared_z = 0.0, center_squared_z = 0.0;
+  const Eigen::Vector2d center(0.5 * (kImage.width - 1), 0.5 * (kImage.height - 1));
+  const Eigen::Vector3d center_ray = CamRayFromPixel(TrueIntrinsics(), center);
   for (int s = 0; s < kSeeds; ++s) {
     const std::vector<CalibrationView> views = Views(Seed(100 + s), 6, true, 0.5);
     CalibrateOptions options = Options();
     options.cross_validate = false;
     const Calibration c = Calibrate(views, options);
     failures += CoversTheTruth(c) ? 0 : 1;
+    // The projection sigma: where the estimate puts the true ray through the image centre.
+    center_squared_z += (PixelFromCam(c.intrinsics, center_ray) - center).squaredNorm() /
+                        std::pow(c.projection_sigma_center_px, 2);
     for (const ParameterSigma& p : c.intrinsics_sigma) {
       if (p.name == "fx") fx_squared_z += std::pow((p.value - TrueIntrinsics().fx) / p.sigma, 2);
     }
@@ -133,6 +138,12 @@ TEST(CalibrateTest, SigmasCoverTheTruth) {
   // a standard deviation of sqrt(2 / 200) = 0.1 over the seeds; 4 of them either side.
   std::printf("mean z^2 of fx: %.3f\n", fx_squared_z / kSeeds);
   EXPECT_NEAR(fx_squared_z / kSeeds, 1.0, 0.4);
+  // The same for the projection sigma at the image centre: E |e|^2 = trace(J C J^T) = sigma^2, so
+  // the mean of |e|^2 / sigma^2 is 1; |e|^2 / sigma^2 is a weighted sum of two chi-square(1)
+  // with weights adding to 1, variance 1-2, so its mean over 200 seeds has a standard deviation
+  // of at most 0.1: 4 of them either side.
+  std::printf("mean |e|^2 / sigma^2 at the image centre: %.3f\n", center_squared_z / kSeeds);
+  EXPECT_NEAR(center_squared_z / kSeeds, 1.0, 0.4);
   ExpectRate("calibrations with fx, cx or k1 beyond 3 sigma of the truth", failures, kSeeds,
              1.0 - std::pow(0.9973, 3));
 }

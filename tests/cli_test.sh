@@ -1074,6 +1074,7 @@ PY
     expect_in out "^  k1 "
     expect_in out "^  p1 "
     expect_not_in out "^  fy "
+    expect_in out "^projection sigma: 0.697 px at the image centre, 2.85 px at the worst image corner"
     expect_in out "^model (BIC with sigma 0.138 px, estimated from the richest model):"
     expect_in out "^  principal-point freed: BIC -"
     expect_in out "^  aspect          left out: BIC +6.6 if freed"
@@ -1082,6 +1083,15 @@ PY
     [[ $(wc -l <"$work/poses.csv") -eq 13 ]] || fail "poses.csv has not 12 rows:\n$(cat "$work/poses.csv")"
     expect_exit 0 "$bin" fit "$boards/left03.csv" --image-size 640x480 --intrinsics "$work/left.json" -o "$work/v3.json"
     expect_in out "model: pose, 6 free parameters"
+    # The issue's name for it: a folder of frames, poses only, against the calibration.
+    mkdir "$work/frames" && cp "$boards/left03.csv" "$boards/left05.csv" "$work/frames/"
+    expect_exit 0 "$bin" fit "$work/frames" --image-size 640x480 --shared-intrinsics "$work/left.json" -o "$work/poses"
+    [[ -f "$work/poses/left03.json" && -f "$work/poses/left05.json" ]] || fail "fit FOLDER --shared-intrinsics wrote no camera per view: $(ls "$work/poses")"
+    py - "$work/poses/left05.json" "$work/left.json" <<'PY' || fail "a pose-only fit changed the shared intrinsics"
+import json, sys
+fitted, calibration = (json.load(open(p))["intrinsics"] for p in sys.argv[1:])
+assert all(fitted[k] == calibration[k] for k in calibration), (fitted, calibration)
+PY
     py - "$work/left.json" "$work/view3.json" <<'PY' || fail "views[2].camera is not a camera file"
 import json, sys
 calibration = json.load(open(sys.argv[1]))

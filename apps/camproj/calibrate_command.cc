@@ -208,6 +208,10 @@ Command AddCalibrateCommand(CLI::App& root) {
               out << "  " << std::left << std::setw(5) << p.name << std::right << value << " +- "
                   << p.sigma << (p.unit.empty() ? "" : " " + p.unit) << '\n';
             }
+            out << "projection sigma: " << std::setprecision(3)
+                << calibration.projection_sigma_center_px << " px at the image centre, "
+                << calibration.projection_sigma_corner_px << " px at the worst image corner\n"
+                << std::setprecision(6);
             if (!calibration.model_choice.empty()) {
               out << "model (BIC with sigma " << std::setprecision(3)
                   << calibration.selection_sigma_px << " px, "

@@ -366,8 +366,9 @@ Command AddFitCommand(CLI::App& root) {
   app->add_option("--skew", args->fit.skew, "fix the skew (px)");
   app->add_option("--k1", args->fit.k1, "fix k1");
   app->add_option("--k2", args->fit.k2, "fix k2");
-  app->add_option("--intrinsics", args->intrinsics_path,
-                  "known intrinsics (a camera file or {\"intrinsics\": {...}}): fit the pose only");
+  app->add_option("--intrinsics,--shared-intrinsics", args->intrinsics_path,
+                  "known intrinsics (a camera file, a calibration from `camproj calibrate`, or "
+                  "{\"intrinsics\": {...}}): fit the pose only");
   app->add_option("--pixel-origin", args->fit.pixel_origin,
                   "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
                   "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));

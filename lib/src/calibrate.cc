@@ -741,6 +741,28 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
     add("p2", k[kP2], c(kP2, kP2), "");
   }
   if (options.num_radial >= 3) add("k3", k[kK3], c(kK3, kK3), "");
+
+  // The covariance in the image: the pixel of the ray through each place, moved by the
+  // intrinsics' uncertainty.
+  auto projection_sigma = [&](const Eigen::Vector2d& pixel) {
+    const Eigen::Vector3d ray = CamRayFromPixel(result->intrinsics, pixel);
+    double residual[2];
+    Eigen::Matrix<double, 2, kFitIntrinsicsSize, Eigen::RowMajor> jacobian;
+    internal::ResidualOfCamPoint(k, ray, pixel, residual, jacobian.data(), nullptr);
+    return std::sqrt(std::max(0.0, (jacobian * c * jacobian.transpose()).trace()));
+  };
+  const double w = options.image_size.width, h = options.image_size.height;
+  result->projection_sigma_center_px = projection_sigma({0.5 * (w - 1.0), 0.5 * (h - 1.0)});
+  for (const Eigen::Vector2d corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
+                                       Eigen::Vector2d(-0.5, h - 0.5),
+                                       Eigen::Vector2d(w - 0.5, h - 0.5)}) {
+    try {
+      result->projection_sigma_corner_px =
+          std::max(result->projection_sigma_corner_px, projection_sigma(corner));
+    } catch (const std::domain_error&) {
+      // Beyond the lens's fold: no ray there.
+    }
+  }
 }
 
 }  // namespace

@@ -39,6 +39,8 @@ std::string CalibrationToJsonText(const Calibration& calibration,
                      {"groups", model}};
   }
   file["rms_px"] = calibration.rms_px;
+  file["projection_sigma_px"] = {{"center", calibration.projection_sigma_center_px},
+                                 {"worst_corner", calibration.projection_sigma_corner_px}};
   file["num_points"] = calibration.num_points;
   file["num_parameters"] = calibration.num_parameters;
   const CrossValidation& cv = calibration.cross_validation;

@@ -159,6 +159,12 @@ struct Calibration {
   // px, px,
   // px, 1, 1), zero rows and columns for fixed entries; zero unless compute_uncertainty.
   Eigen::Matrix<double, 10, 10> intrinsics_covariance = Eigen::Matrix<double, 10, 10>::Zero();
+  // What the covariance means in the image: the 1-sigma of the pixel a fixed ray lands on,
+  // sqrt(trace(J C J^T)) with J = d pixel / d intrinsics, at the image centre and the worst of
+  // its 4 outer corners (kCenter (-0.5, -0.5) ... (W - 0.5, H - 0.5); a corner beyond the lens's
+  // fold is skipped). px; 0 unless compute_uncertainty.
+  double projection_sigma_center_px = 0.0;
+  double projection_sigma_corner_px = 0.0;
   CrossValidation cross_validation;
   // With CalibrateOptions::select_model: every group of the ladder in its order, freed or not
   // and why; the noise the criterion used and whether it was given.
