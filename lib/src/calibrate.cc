@@ -658,6 +658,21 @@ std::vector<double> OutlierBounds(const std::vector<std::vector<double>>& residu
   return bounds;
 }
 
+// The view with the points keep(index, id) accepts, each with its id (CalibrationView::ids, or its
+// 1-based number in the view when it has none), so that ids stay the file's through removals.
+template <typename Keep>
+CalibrationView ViewKeeping(const CalibrationView& view, Keep keep) {
+  CalibrationView kept{view.name, {}, {}, {}};
+  for (size_t j = 0; j < view.pixels.size(); ++j) {
+    const std::string id = view.ids.empty() ? std::to_string(j + 1) : view.ids[j];
+    if (!keep(j, id)) continue;
+    kept.points_in_world.push_back(view.points_in_world[j]);
+    kept.pixels.push_back(view.pixels[j]);
+    kept.ids.push_back(id);
+  }
+  return kept;
+}
+
 // The views without the points beyond `bound`, or std::nullopt when there are none; the points
 // left out into *outliers.
 std::optional<std::vector<CalibrationView>> WithoutOutliers(
@@ -676,18 +691,11 @@ std::optional<std::vector<CalibrationView>> WithoutOutliers(
       continue;
     }
     any = true;
-    CalibrationView view{views[i].name, {}, {}, {}};
-    for (size_t j = 0; j < norms.size(); ++j) {
-      const std::string id = views[i].ids.empty() ? std::to_string(j + 1) : views[i].ids[j];
-      if (norms[j] > bound) {
-        outliers->push_back({ViewName(views[i], i), id, norms[j], bound});
-        continue;
-      }
-      view.points_in_world.push_back(views[i].points_in_world[j]);
-      view.pixels.push_back(views[i].pixels[j]);
-      view.ids.push_back(id);
-    }
-    cleaned.push_back(std::move(view));
+    cleaned.push_back(ViewKeeping(views[i], [&](size_t j, const std::string& id) {
+      if (norms[j] <= bound) return true;
+      outliers->push_back({ViewName(views[i], i), id, norms[j], bound});
+      return false;
+    }));
   }
   if (!any) return std::nullopt;
   return cleaned;
@@ -830,18 +838,10 @@ CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& view
                                      [&](const RefusedView& r) { return r.name == name; });
     if (refused) continue;
     // Without the points the richest model left out.
-    CalibrationView view{views[i].name, {}, {}, {}};
-    for (size_t j = 0; j < views[i].pixels.size(); ++j) {
-      const std::string id = views[i].ids.empty() ? std::to_string(j + 1) : views[i].ids[j];
-      const bool outlier = std::any_of(
-          richest.outliers.begin(), richest.outliers.end(),
-          [&](const OutlierPoint& o) { return o.view == name && o.id == id; });
-      if (outlier) continue;
-      view.points_in_world.push_back(views[i].points_in_world[j]);
-      view.pixels.push_back(views[i].pixels[j]);
-      view.ids.push_back(id);
-    }
-    kept.push_back(std::move(view));
+    kept.push_back(ViewKeeping(views[i], [&](size_t, const std::string& id) {
+      return std::none_of(richest.outliers.begin(), richest.outliers.end(),
+                          [&](const OutlierPoint& o) { return o.view == name && o.id == id; });
+    }));
   }
   auto sum_squares = [](const Calibration& c) { return c.rms_px * c.rms_px * c.num_points; };
   const double sigma =
