@@ -431,3 +431,37 @@ TEST(CalibrateTest, SinglePointsThatDoNotFitAreLeftOutByName) {
 
 }  // namespace
 }  // namespace camproj
+
+namespace camproj {
+namespace {
+
+// A view that cannot give a pose (its points on one line: one row of the board) is left out by
+// name with the reason, and the rest calibrated exactly as without it; alone it is refused.
+TEST(CalibrateTest, ViewsWithoutAPoseAreRefusedByName) {
+  const std::vector<CalibrationView> good = Views(Seed(60), 6, true, 0.3);
+  CalibrationView row = Views(Seed(61), 1, true, 0.3)[0];
+  row.name = "row";
+  row.points_in_world.resize(9);
+  row.pixels.resize(9);
+  std::vector<CalibrationView> views = good;
+  views.insert(views.begin() + 2, row);
+  CalibrateOptions options = Options();
+  options.cross_validate = false;
+  const Calibration c = Calibrate(views, options);
+  ASSERT_EQ(c.refused_views.size(), 1u);
+  EXPECT_EQ(c.refused_views[0].name, "row");
+  EXPECT_NE(c.refused_views[0].reason.find("its points lie on a line"), std::string::npos);
+  EXPECT_EQ(c.views.size(), 6u);
+  const Calibration alone = Calibrate(good, options);
+  EXPECT_EQ(c.intrinsics.fx, alone.intrinsics.fx);  // the same computation on the same views
+  try {
+    Calibrate({row}, options);
+    ADD_FAILURE() << "a line alone was calibrated";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("row: its points lie on a line"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace camproj

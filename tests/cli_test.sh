@@ -1101,6 +1101,11 @@ json.dump(calibration["views"][1]["camera"], open(sys.argv[2], "w"))
 PY
     expect_exit 0 "$bin" export "$work/view3.json" --to json
     expect_exit 0 "$bin" project "$work/view3.json" "$boards/left03.csv"
+    # A view of one board row (its points on a line) has no pose: refused by name, the rest used.
+    awk -F, 'NR <= 10' "$boards/left03.csv" >"$work/line03.csv"
+    expect_exit 0 "$bin" calibrate "$boards"/left0[4-9].csv "$work/line03.csv" --image-size 640x480 -o "$work/line.json"
+    expect_in out "^refused view line03 (9 points): its points lie on a line: no pose"
+    expect_in out "^calibrated 6 views"
     expect_exit 3 "$bin" calibrate "$boards/left01.csv" --image-size 640x480 -o "$work/one.json"
     expect_in err "1 planar view determines at most 2 of the camera matrix's 4 free entries"
     [[ ! -e "$work/one.json" ]] || fail "a refused calibration wrote its file"

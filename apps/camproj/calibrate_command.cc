@@ -230,6 +230,11 @@ Command AddCalibrateCommand(CLI::App& root) {
                   << std::setprecision(6);
             }
             for (const RefusedView& view : calibration.refused_views) {
+              if (!view.reason.empty()) {
+                out << "refused view " << view.name << " (" << view.num_points
+                    << " points): " << view.reason << "; calibrated without it\n";
+                continue;
+              }
               out << "refused view " << view.name << ": its " << view.num_points << " points are "
                   << std::setprecision(3) << view.rms_px << " px RMS from the camera the other views share ("
                   << view.others_rms_px << " px): another camera, a blurred image or wrong "

@@ -518,8 +518,60 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
   }
 }
 
-// The joint problem: a pose block per view (started from its homography if planar, else by
-// SQPnP, with the start's K) and one block of the free intrinsics shared by all views.
+// Whether the points lie on a line (their second extent below kPlanarShare of the first): no
+// pose is determined from them.
+bool Collinear(const std::vector<Eigen::Vector3d>& points) {
+  const Eigen::Vector3d centroid = internal::Centroid(points);
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
+  const Eigen::Vector3d extent =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return !(extent(1) > kPlanarShare * extent(2));
+}
+
+// With views that cannot be used (why_not[i] set): the others calibrated, those named in
+// refused_views with the reason; std::nullopt when every view can be used. Throws SceneError
+// kDegenerate, naming the first, when none can.
+std::optional<Calibration> CalibrateWithout(const std::vector<CalibrationView>& views,
+                                            const std::vector<std::optional<std::string>>& why_not,
+                                            const CalibrateOptions& options) {
+  std::vector<RefusedView> refused;
+  std::vector<CalibrationView> rest;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (!why_not[i]) {
+      rest.push_back(views[i]);
+      continue;
+    }
+    RefusedView view;
+    view.name = ViewName(views[i], i);
+    view.reason = *why_not[i];
+    view.num_points = static_cast<int>(views[i].pixels.size());
+    refused.push_back(view);
+  }
+  if (refused.empty()) return std::nullopt;
+  if (rest.empty()) {
+    throw SceneError(SceneError::Reason::kDegenerate, refused.front().name + ": " + refused.front().reason);
+  }
+  Calibration calibration = Calibrate(rest, options);
+  calibration.refused_views.insert(calibration.refused_views.begin(), refused.begin(), refused.end());
+  return calibration;
+}
+
+// A view's start pose with the start's K: from its homography if planar, else (or where that
+// fails) by SQPnP; the reason when there is none.
+std::optional<std::string> ViewStart(const CalibrationView& view,
+                                     const std::optional<PlanarView>& plane,
+                                     const Intrinsics& start, internal::StartCamera* camera) {
+  if (auto from_homography = plane ? HomographyPose(*plane, start) : std::nullopt) {
+    *camera = *from_homography;
+    return std::nullopt;
+  }
+  if (internal::PnpStart(view.points_in_world, view.pixels, start, camera)) return std::nullopt;
+  return std::string("no pose from its points with the start's intrinsics (SQPnP failed): check "
+                     "its correspondences");
+}
+
+// The joint problem: a pose block per view (ViewStart) and one block of the free intrinsics shared by all views.
 struct JointProblem {
   std::vector<Eigen::Matrix3d> reference_rotations;  // each view's start
   std::vector<std::array<double, kPoseSize>> poses;  // [w, C], see ViewCost
@@ -529,7 +581,7 @@ struct JointProblem {
   ceres::Problem problem;
 
   JointProblem(const std::vector<CalibrationView>& views,
-               const std::vector<std::optional<PlanarView>>& planes, const Intrinsics& start,
+               const std::vector<internal::StartCamera>& starts, const Intrinsics& start,
                const std::vector<int>& fixed)
       : reference_rotations(views.size()), poses(views.size()), k(FitLayout(start)) {
     for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
@@ -539,14 +591,7 @@ struct JointProblem {
       }
     }
     for (size_t i = 0; i < views.size(); ++i) {
-      internal::StartCamera camera;
-      if (auto from_homography = planes[i] ? HomographyPose(*planes[i], start) : std::nullopt) {
-        camera = *from_homography;
-      } else if (!internal::PnpStart(views[i].points_in_world, views[i].pixels, start, &camera)) {
-        throw SceneError(SceneError::Reason::kDegenerate,
-                         ViewName(views[i], i) + ": no pose from its points with the start's "
-                         "intrinsics (SQPnP failed); check the view's correspondences");
-      }
+      const internal::StartCamera& camera = starts[i];
       reference_rotations[i] = camera.rotation;
       poses[i] = {0.0, 0.0, 0.0, camera.center.x(), camera.center.y(), camera.center.z()};
       problem.AddResidualBlock(new ViewCost(views[i], reference_rotations[i], k, free_slots),
@@ -934,6 +979,16 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
 
   if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
   for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
+  // A view whose points lie on a line has no pose: left out by name before it enters the
+  // closed-form start (its homography is degenerate), the rest calibrated.
+  std::vector<std::optional<std::string>> collinear(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (Collinear(views[i].points_in_world)) {
+      collinear[i] = "its points lie on a line: no pose (a view needs points spanning a plane or "
+                     "a volume)";
+    }
+  }
+  if (auto rest = CalibrateWithout(views, collinear, options)) return *rest;
 
   const std::vector<int> fixed = FixedIntrinsicEntries(options);
   const int free_intrinsics = kFitIntrinsicsSize - static_cast<int>(fixed.size());
@@ -955,7 +1010,14 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
                      "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
                      "add views at other angles, or fix the principal point and the aspect");
   }
-  JointProblem joint(views, planes, *start, fixed);
+  // Views without a start pose are left out by name and the rest calibrated.
+  std::vector<internal::StartCamera> starts(views.size());
+  std::vector<std::optional<std::string>> unstarted(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    unstarted[i] = ViewStart(views[i], planes[i], *start, &starts[i]);
+  }
+  if (auto rest = CalibrateWithout(views, unstarted, options)) return *rest;
+  JointProblem joint(views, starts, *start, fixed);
   const ceres::Solver::Summary summary = joint.Solve(options);
 
   Calibration result;

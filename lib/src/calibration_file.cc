@@ -63,6 +63,11 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   file["views"] = views;
   nlohmann::ordered_json refused = nlohmann::ordered_json::array();
   for (const RefusedView& view : calibration.refused_views) {
+    if (!view.reason.empty()) {
+      refused.push_back({{"name", view.name}, {"num_points", view.num_points},
+                         {"reason", view.reason}});
+      continue;
+    }
     refused.push_back({{"name", view.name}, {"num_points", view.num_points},
                        {"rms_px", view.rms_px}, {"others_rms_px", view.others_rms_px},
                        {"chi_square", view.statistic}, {"bound", view.bound}});

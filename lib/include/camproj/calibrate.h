@@ -133,6 +133,8 @@ struct OutlierPoint {
 };
 
 // A view left out because it does not fit the camera the other views share.
+// A view left out: it does not fit the camera the other views share (the numbers below), or it
+// cannot be started (`reason` says why; the numbers are 0).
 struct RefusedView {
   std::string name;
   int num_points = 0;
@@ -140,6 +142,7 @@ struct RefusedView {
   double others_rms_px = 0.0;  // the other views' RMS in that calibration
   double statistic = 0.0;      // its sum of squares / the other views' noise variance
   double bound = 0.0;          // the chi-square bound it exceeded
+  std::string reason;          // empty for a view that does not fit; else why it has no start
 };
 
 struct Calibration {
