@@ -193,20 +193,41 @@ struct PlanarView {
   Eigen::Matrix3d homography;        // NormalizedHomography(coordinates, pixels)
 };
 
-// The view read in its best-fitting plane, if its points are planar (see kPlanarShare).
-std::optional<PlanarView> PlanarViewOf(const CalibrationView& view) {
-  const std::vector<Eigen::Vector3d>& points = view.points_in_world;
-  const Eigen::Vector3d centroid = internal::Centroid(points);
+// How points spread: their centroid, and the extents (RMS distance from the centroid, ascending)
+// along the principal axes (the columns of `axes`, in the same order).
+struct Spread {
+  Eigen::Vector3d centroid;
+  Eigen::Vector3d extent;
+  Eigen::Matrix3d axes;
+};
+
+Spread SpreadOf(const std::vector<Eigen::Vector3d>& points) {
+  Spread spread;
+  spread.centroid = internal::Centroid(points);
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
+  for (const auto& p : points) scatter += (p - spread.centroid) * (p - spread.centroid).transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
-  // Eigenvalues ascending: extents are their square roots.
-  const Eigen::Vector3d extent = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  spread.extent = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  spread.axes = eigen.eigenvectors();
+  return spread;
+}
+
+// Whether the points lie on a line (their second extent below kPlanarShare of the first): no
+// pose is determined from them.
+bool Collinear(const Spread& spread) {
+  return !(spread.extent(1) > kPlanarShare * spread.extent(2));
+}
+
+// The view read in its best-fitting plane, if its points are planar (see kPlanarShare).
+std::optional<PlanarView> PlanarViewOf(const CalibrationView& view, const Spread& spread) {
+  const std::vector<Eigen::Vector3d>& points = view.points_in_world;
+  const Eigen::Vector3d& extent = spread.extent;
   if (!(extent(2) > 0.0) || extent(0) > kPlanarShare * extent(2)) return std::nullopt;
+  const Eigen::Vector3d& centroid = spread.centroid;
   PlanarView plane;
   plane.centroid = centroid;
-  plane.plane_from_world.row(0) = eigen.eigenvectors().col(2).transpose();
-  plane.plane_from_world.row(1) = eigen.eigenvectors().col(1).transpose();
+  plane.plane_from_world.row(0) = spread.axes.col(2).transpose();
+  plane.plane_from_world.row(1) = spread.axes.col(1).transpose();
   plane.plane_from_world.row(2) =
       plane.plane_from_world.row(0).cross(plane.plane_from_world.row(1));
   plane.coordinates.reserve(points.size());
@@ -518,15 +539,21 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
   }
 }
 
-// Whether the points lie on a line (their second extent below kPlanarShare of the first): no
-// pose is determined from them.
-bool Collinear(const std::vector<Eigen::Vector3d>& points) {
-  const Eigen::Vector3d centroid = internal::Centroid(points);
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
-  const Eigen::Vector3d extent =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues().cwiseMax(0.0).cwiseSqrt();
-  return !(extent(1) > kPlanarShare * extent(2));
+// The views but the refused ones (by index) calibrated, their records first in refused_views.
+Calibration CalibrateRest(const std::vector<CalibrationView>& views,
+                          const std::vector<std::pair<size_t, RefusedView>>& refused,
+                          const CalibrateOptions& options) {
+  std::vector<CalibrationView> rest;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const bool left_out = std::any_of(refused.begin(), refused.end(),
+                                      [&](const auto& r) { return r.first == i; });
+    if (!left_out) rest.push_back(views[i]);
+  }
+  Calibration calibration = Calibrate(rest, options);
+  for (auto r = refused.rbegin(); r != refused.rend(); ++r) {
+    calibration.refused_views.insert(calibration.refused_views.begin(), r->second);
+  }
+  return calibration;
 }
 
 // With views that cannot be used (why_not[i] set): the others calibrated, those named in
@@ -535,26 +562,21 @@ bool Collinear(const std::vector<Eigen::Vector3d>& points) {
 std::optional<Calibration> CalibrateWithout(const std::vector<CalibrationView>& views,
                                             const std::vector<std::optional<std::string>>& why_not,
                                             const CalibrateOptions& options) {
-  std::vector<RefusedView> refused;
-  std::vector<CalibrationView> rest;
+  std::vector<std::pair<size_t, RefusedView>> refused;
   for (size_t i = 0; i < views.size(); ++i) {
-    if (!why_not[i]) {
-      rest.push_back(views[i]);
-      continue;
-    }
+    if (!why_not[i]) continue;
     RefusedView view;
     view.name = ViewName(views[i], i);
     view.reason = *why_not[i];
     view.num_points = static_cast<int>(views[i].pixels.size());
-    refused.push_back(view);
+    refused.emplace_back(i, view);
   }
   if (refused.empty()) return std::nullopt;
-  if (rest.empty()) {
-    throw SceneError(SceneError::Reason::kDegenerate, refused.front().name + ": " + refused.front().reason);
+  if (refused.size() == views.size()) {
+    const RefusedView& first = refused.front().second;
+    throw SceneError(SceneError::Reason::kDegenerate, first.name + ": " + first.reason);
   }
-  Calibration calibration = Calibrate(rest, options);
-  calibration.refused_views.insert(calibration.refused_views.begin(), refused.begin(), refused.end());
-  return calibration;
+  return CalibrateRest(views, refused, options);
 }
 
 // A view's start pose with the start's K: from its homography if planar, else (or where that
@@ -744,6 +766,53 @@ std::optional<std::vector<CalibrationView>> WithoutOutliers(
   }
   if (!any) return std::nullopt;
   return cleaned;
+}
+
+// The view stage: the view that does not fit the camera the others share
+// (WorstInconsistentView) refused and the rest calibrated; std::nullopt when there is none, or
+// when the rest alone cannot determine the camera (every view kept: its RMS shows it). With the
+// point stage on, a view whose misfit is a few points — its median |r| within kViewRmsFactor of
+// the other views' (pooled), though its RMS is not — is kept for that stage instead.
+std::optional<Calibration> WithoutWorstView(const std::vector<CalibrationView>& views,
+                                            const Calibration& result, double sum_squares,
+                                            const std::vector<std::vector<double>>& residual_norms,
+                                            const CalibrateOptions& options) {
+  const auto refused = WorstInconsistentView(result, sum_squares, result.num_parameters);
+  if (!refused) return std::nullopt;
+  if (options.remove_outliers) {
+    std::vector<double> others;
+    for (size_t i = 0; i < views.size(); ++i) {
+      if (i != refused->first) {
+        others.insert(others.end(), residual_norms[i].begin(), residual_norms[i].end());
+      }
+    }
+    if (internal::Median(residual_norms[refused->first]) <=
+        kViewRmsFactor * internal::Median(others)) {
+      return std::nullopt;
+    }
+  }
+  try {
+    return CalibrateRest(views, {*refused}, options);
+  } catch (const SceneError&) {
+    return std::nullopt;
+  }
+}
+
+// The point stage: the points beyond their view's bound left out and the rest calibrated, once
+// (bounds taken again without them would be tighter and peel further: measured on the
+// chessboards, 4 rounds, every point at a board's edge column); std::nullopt when there are none.
+std::optional<Calibration> WithoutOutlierPoints(
+    const std::vector<CalibrationView>& views,
+    const std::vector<std::vector<double>>& residual_norms, const CalibrateOptions& options) {
+  std::vector<OutlierPoint> outliers;
+  const auto cleaned =
+      WithoutOutliers(views, residual_norms, OutlierBounds(residual_norms), &outliers);
+  if (!cleaned) return std::nullopt;
+  CalibrateOptions rest_options = options;
+  rest_options.remove_outliers = false;
+  Calibration rest = Calibrate(*cleaned, rest_options);
+  rest.outliers.insert(rest.outliers.begin(), outliers.begin(), outliers.end());
+  return rest;
 }
 
 // The intrinsics' covariance (scaled by s^2) and the sigmas of the free ones into *result.
@@ -981,9 +1050,11 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
   // A view whose points lie on a line has no pose: left out by name before it enters the
   // closed-form start (its homography is degenerate), the rest calibrated.
+  std::vector<Spread> spreads;
   std::vector<std::optional<std::string>> collinear(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
-    if (Collinear(views[i].points_in_world)) {
+    spreads.push_back(SpreadOf(views[i].points_in_world));
+    if (Collinear(spreads[i])) {
       collinear[i] = "its points lie on a line: no pose (a view needs points spanning a plane or "
                      "a volume)";
     }
@@ -997,8 +1068,8 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   const int num_parameters = 6 * static_cast<int>(views.size()) + free_intrinsics;
   std::vector<std::optional<PlanarView>> planes;
   int planar_views = 0;
-  for (const auto& view : views) {
-    planes.push_back(PlanarViewOf(view));
+  for (size_t i = 0; i < views.size(); ++i) {
+    planes.push_back(PlanarViewOf(views[i], spreads[i]));
     planar_views += planes.back() ? 1 : 0;
   }
   CheckDetermined(views, num_points, num_parameters, free_intrinsics, planar_views, options);
@@ -1033,50 +1104,14 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   result.rms_px = std::sqrt(sum_squares / num_points);
 
   // Views first: a view that does not fit bends the joint fit, and points of good views would
-  // be left out for it. A view whose misfit is a few points — its median |r| within
-  // kViewRmsFactor of the other views' (pooled), though its RMS is not — is kept for the point
-  // stage instead.
+  // be left out for it.
   if (options.refuse_inconsistent_views && views.size() >= 4) {
-    auto refused = WorstInconsistentView(result, sum_squares, num_parameters);
-    if (refused && options.remove_outliers) {
-      std::vector<double> others;
-      for (size_t i = 0; i < views.size(); ++i) {
-        if (i != refused->first) {
-          others.insert(others.end(), residual_norms[i].begin(), residual_norms[i].end());
-        }
-      }
-      if (internal::Median(residual_norms[refused->first]) <=
-          kViewRmsFactor * internal::Median(others)) {
-        refused.reset();
-      }
-    }
-    if (refused) {
-      std::vector<CalibrationView> kept;
-      for (size_t i = 0; i < views.size(); ++i) {
-        if (i != refused->first) kept.push_back(views[i]);
-      }
-      try {
-        Calibration rest = Calibrate(kept, options);
-        rest.refused_views.insert(rest.refused_views.begin(), refused->second);
-        return rest;
-      } catch (const SceneError&) {
-        // The others alone cannot determine the camera: keep every view (its RMS shows it).
-      }
+    if (auto rest = WithoutWorstView(views, result, sum_squares, residual_norms, options)) {
+      return *rest;
     }
   }
   if (options.remove_outliers) {
-    std::vector<OutlierPoint> outliers;
-    if (auto cleaned =
-            WithoutOutliers(views, residual_norms, OutlierBounds(residual_norms), &outliers)) {
-      // One round: the points beyond the bounds of the fit that had them all. Bounds taken
-      // again without them would be tighter and peel further (measured on the chessboards:
-      // 4 rounds, every point at a board's edge column).
-      CalibrateOptions rest_options = options;
-      rest_options.remove_outliers = false;
-      Calibration rest = Calibrate(*cleaned, rest_options);
-      rest.outliers.insert(rest.outliers.begin(), outliers.begin(), outliers.end());
-      return rest;
-    }
+    if (auto rest = WithoutOutlierPoints(views, residual_norms, options)) return *rest;
   }
   if (options.compute_uncertainty) AddUncertainty(joint, sum_squares, options, &result);
   if (options.cross_validate) result.cross_validation = CrossValidate(views, options);
