@@ -237,7 +237,7 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
 // The refusals of the determination check: a camera the points do not pin down to the bound
 // (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
 void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
-                          const std::string& left_out) {
+                          const std::string& left_out, PixelOrigin pixel_origin) {
   if (check.passed) return;
   const std::string add_points =
       "points where the image has none (toward that pixel) and spread in depth, or fix the "
@@ -260,6 +260,18 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the points do not determine the camera well enough: it is " +
                          check.summary + " (--max-uncertainty). " + advice);
+  }
+  if (check.rival_shift_px <= check.bound_px) {
+    const Eigen::Vector2d at =
+        ConvertPixelOrigin(check.averaged_worst_pixel, PixelOrigin::kCenter, pixel_origin);
+    throw SceneError(
+        SceneError::Reason::kAmbiguous,
+        "the points cannot tell which model is right well enough: " + model + " and the models "
+        "that fit them nearly as well (" + check.averaged_rival + " most), averaged with weights "
+        "from their BIC, put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma) near "
+        "pixel (" + std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
+        std::to_string(static_cast<long>(std::lround(at.y()))) + ") (bound " + Px(check.bound_px) +
+        ", --max-uncertainty). " + advice);
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
                    "the points cannot tell " + model + " from " + check.rival +
@@ -379,7 +391,7 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   const DeterminationCheck determination =
       internal::CheckDetermination(gated.selection, kept_points, options);
   RefuseIfUndetermined(determination, gated.selection.fit.model,
-                       LeftOutText(gated.residuals_px, left_out, names));
+                       LeftOutText(gated.residuals_px, left_out, names), options.fit.pixel_origin);
 
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);

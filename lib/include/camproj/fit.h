@@ -242,6 +242,15 @@ struct DeterminationCheck {
   // The rival predicts each kept point from the others better than the returned model
   // (leave-one-out, at up to 12 points): its shift counts even within its own 3 sigma.
   bool rival_predicts_better = false;
+  // The camera averaged over the models fitted (the returned one and every unmirrored rival,
+  // each weighted by exp(-(its BIC - the returned model's) / 2), as posterior model
+  // probabilities: Raftery 1995): its largest 1-sigma spread sqrt(sum_m w_m (sigma_m^2 +
+  // |u_m - u_mean|^2)) over the rivals' test points, and where. Above the bound the points cannot
+  // tell which model is right well enough (kAmbiguous); a model that puts a test point behind
+  // it makes this infinite. The returned model alone: its own sigma there.
+  double averaged_sigma_px = 0.0;
+  Eigen::Vector2d averaged_worst_pixel = Eigen::Vector2d::Zero();  // kCenter
+  std::string averaged_rival;  // the rival that adds most to the spread there ("": none)
   std::string summary;        // one line in words
 };
 

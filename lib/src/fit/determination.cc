@@ -37,6 +37,10 @@ constexpr double kRivalSigmas = 3.0;
 // same widening for the uncertainty bound as well costs 16 answers more and removes none.
 constexpr double kRivalBoxThickness = 0.25;
 
+// The model-averaged camera (DeterminationCheck::averaged_sigma_px) counts the unmirrored rivals
+// up to this far above the returned model's BIC: weight exp(-13.8 / 2) = 1e-3 of its.
+constexpr double kAveragedCriterion = 13.8;
+
 // A point whose leverage is within this of 1 in some direction is one the others cannot predict
 // there (their fit moves with it): its leave-one-out error counts as at this leverage, so that
 // PRESS stays finite and one such point does not decide it alone.
@@ -532,31 +536,42 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.worst_pixel = *PixelFromWorld(camera, test[i]);
     }
   }
-  // The rivals that fit about as well, each with its uncertainty at the kept points (a mirrored
-  // reading sees them with z negated); one with a kept point behind it is no reading of them.
+  // The rivals that fit about as well (the rival check's) or are unmirrored within
+  // kAveragedCriterion (the model average's), each with its uncertainty at the kept points (a
+  // mirrored reading sees them with z negated); one with a kept point behind it is no reading of
+  // them.
   struct Counted {
     const Rival* rival;
     Camera camera;
     PixelUncertainty uncertainty;
+    bool about_as_well;  // within kEqualFitCriterion: the rival check's
+    double weight;       // in the model average, relative to the returned model's 1 (0: not in it)
   };
-  std::vector<Counted> counted;
-  counted.reserve(selection.rivals.size());  // moved in once, never copied
+  std::vector<Counted> fitted;
+  fitted.reserve(selection.rivals.size());  // moved in once, never copied
   for (const Rival& rival : selection.rivals) {
     const double excess = rival.criterion - selection.criterion;
-    if (!(rival.mirrored_world || rival.same_model ? excess <= kEqualFitCriterion
-                                                   : std::abs(excess) <= kEqualFitCriterion)) {
-      continue;
-    }
+    const bool about_as_well = rival.mirrored_world || rival.same_model
+                                   ? excess <= kEqualFitCriterion
+                                   : std::abs(excess) <= kEqualFitCriterion;
+    const bool averaged = !rival.mirrored_world && excess >= -kEqualFitCriterion &&
+                          excess <= kAveragedCriterion;
+    if (!about_as_well && !averaged) continue;
     // A mirrored reading sees every point, test points included, with z negated: in the unit
     // world about the centroid, whose mirror image is the mirrored points' centroid.
     const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
     const Camera rival_camera = InUnitWorld(rival.camera, flip.asDiagonal() * origin, unit);
     try {
-      counted.push_back({&rival, rival_camera,
-                         PixelUncertainty(rival_camera, rival.options, points, sigma,
-                                          rival.mirrored_world)});
+      fitted.push_back({&rival, rival_camera,
+                        PixelUncertainty(rival_camera, rival.options, points, sigma,
+                                         rival.mirrored_world),
+                        about_as_well, averaged ? std::exp(-0.5 * excess) : 0.0});
     } catch (const std::invalid_argument&) {
     }
+  }
+  std::vector<const Counted*> counted;
+  for (const Counted& c : fitted) {
+    if (c.about_as_well) counted.push_back(&c);
   }
   // At a handful of points, the unmirrored rival that predicts each kept point from the others
   // better than the chosen model and every other such rival (PRESS) is as good a reading of the
@@ -569,21 +584,29 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       observed[i] = *PixelFromWorld(camera, points[i]) - selection.fit.residuals_px[i];
     }
     double best = PredictionSumOfSquares(uncertainty, camera, points, observed);
-    for (const Counted& c : counted) {
-      if (c.rival->mirrored_world) continue;
-      const double press = PredictionSumOfSquares(c.uncertainty, c.camera, points, observed);
+    for (const Counted* c : counted) {
+      if (c->rival->mirrored_world) continue;
+      const double press = PredictionSumOfSquares(c->uncertainty, c->camera, points, observed);
       if (press < best) {
         best = press;
-        predicts_better = &c;
+        predicts_better = c;
       }
     }
   }
-  std::optional<TestPoints> rival_test;  // computed for the first unmirrored rival
-  for (const Counted& c : counted) {
-    const Rival& rival = *c.rival;
-    if (!rival_test && !rival.mirrored_world) {
+  // The unmirrored rivals are judged over the box widened to kRivalBoxThickness, each rival's
+  // sigmas there computed once for the rival check and the model average.
+  std::optional<TestPoints> rival_test;
+  std::vector<std::vector<double>> sigmas_there(fitted.size());
+  for (size_t m = 0; m < fitted.size(); ++m) {
+    if (fitted[m].rival->mirrored_world) continue;
+    if (!rival_test) {
       rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
     }
+    sigmas_there[m] = SigmasAt(fitted[m].uncertainty, *rival_test);
+  }
+  for (const Counted* counted_rival : counted) {
+    const Counted& c = *counted_rival;
+    const Rival& rival = *c.rival;
     const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
     // The mirrored reading is judged over the points' own box: off a plane (or a nearly flat
     // scene) the two readings always part, and no data on it can tell them apart.
@@ -598,7 +621,9 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     // with a free intrinsic is undetermined, and a plane would always be refused. Measured on
     // the click benchmark with the model's vertices: docs/model-selection.md.) And except for
     // the rival that predicts the points better (above).
-    const std::vector<double> rival_sigmas = SigmasAt(c.uncertainty, their_test);
+    const std::vector<double> rival_sigmas =
+        rival.mirrored_world ? SigmasAt(c.uncertainty, their_test)
+                             : sigmas_there[static_cast<size_t>(&c - fitted.data())];
     const bool exempt = &c != predicts_better;
     double shift = 0.0;
     for (size_t i = 0; i < our_test.points.size(); ++i) {
@@ -619,7 +644,64 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.rival_predicts_better = !exempt;
     }
   }
-  check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px;
+  // The model average: at each of the rivals' test points, the mixture of the returned camera
+  // (weight 1) and every rival in it (Counted::weight), each with its own sigma there. Coplanar
+  // points: over their own test points (in their plane, and the object points), as a plane
+  // determines no model with a free intrinsic off itself, and most planar scenes are mapped on
+  // the plane (measured: docs/model-selection.md).
+  double total_weight = 1.0;
+  for (const Counted& c : fitted) total_weight += c.weight;
+  if (total_weight > 1.0) {
+    const bool on_the_plane = selection.fit.planar;
+    const TestPoints& average_test = on_the_plane ? test_points : *rival_test;
+    const std::vector<double> own_sigmas =
+        on_the_plane ? sigmas : SigmasAt(uncertainty, average_test);
+    if (on_the_plane) {
+      for (size_t m = 0; m < fitted.size(); ++m) {
+        if (fitted[m].weight > 0.0) sigmas_there[m] = SigmasAt(fitted[m].uncertainty, test_points);
+      }
+    }
+    std::vector<Eigen::Vector2d> pixels(fitted.size());
+    for (size_t i = 0; i < average_test.points.size(); ++i) {
+      const Eigen::Vector3d& x = average_test.points[i];
+      const std::optional<Eigen::Vector2d> own_pixel = PixelFromWorld(camera, x);
+      if (!own_pixel) continue;  // not a test point (every one is in the image)
+      const Eigen::Vector2d ours = *own_pixel;
+      Eigen::Vector2d mean = ours / total_weight;
+      const Counted* behind = nullptr;
+      for (size_t m = 0; m < fitted.size() && !behind; ++m) {
+        if (fitted[m].weight == 0.0) continue;
+        const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(fitted[m].camera, x);
+        if (!theirs) behind = &fitted[m];
+        else pixels[m] = *theirs;
+        if (theirs) mean += fitted[m].weight / total_weight * *theirs;
+      }
+      double variance = std::numeric_limits<double>::infinity();
+      const Counted* most = behind;
+      if (!behind) {
+        variance = (own_sigmas[i] * own_sigmas[i] + (ours - mean).squaredNorm()) / total_weight;
+        double largest = 0.0;
+        for (size_t m = 0; m < fitted.size(); ++m) {
+          if (fitted[m].weight == 0.0) continue;
+          const double term = fitted[m].weight / total_weight *
+                              (sigmas_there[m][i] * sigmas_there[m][i] +
+                               (pixels[m] - mean).squaredNorm());
+          variance += term;
+          if (term > largest) {
+            largest = term;
+            most = &fitted[m];
+          }
+        }
+      }
+      if (!(std::sqrt(variance) <= check.averaged_sigma_px)) {
+        check.averaged_sigma_px = std::sqrt(variance);
+        check.averaged_worst_pixel = ours;
+        check.averaged_rival = most ? most->rival->model : "";
+      }
+    }
+  }
+  check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px &&
+                 check.averaged_sigma_px <= check.bound_px;
   const Eigen::Vector2d where =
       ConvertPixelOrigin(check.worst_pixel, PixelOrigin::kCenter, options.fit.pixel_origin);
   check.summary = "uncertain by up to " + Px(check.max_sigma_px) +
@@ -628,6 +710,15 @@ DeterminationCheck CheckDetermination(const Selection& selection,
                   std::to_string(static_cast<long>(std::lround(where.x()))) + ", " +
                   std::to_string(static_cast<long>(std::lround(where.y()))) + "); bound " +
                   Px(check.bound_px);
+  if (check.averaged_sigma_px > 0.0) {
+    const Eigen::Vector2d at = ConvertPixelOrigin(check.averaged_worst_pixel, PixelOrigin::kCenter,
+                                                  options.fit.pixel_origin);
+    check.summary += "; averaged over the models fitted (BIC weights), " +
+                     Px(check.averaged_sigma_px) + " near pixel (" +
+                     std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
+                     std::to_string(static_cast<long>(std::lround(at.y()))) + ")" +
+                     (check.averaged_rival.empty() ? "" : ", most from " + check.averaged_rival);
+  }
   if (!check.rival.empty()) {
     check.summary += "; " + check.rival + " fits about as well" +
                      (check.rival_predicts_better
