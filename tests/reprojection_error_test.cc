@@ -2,6 +2,7 @@
 // Ceres' automatic differentiation of the templated functor the library's model is written in.
 #include "fit/reprojection_error.h"
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -56,6 +57,42 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
     expect_close(jq_a, jq_b, 8, "rotation");
     expect_close(jc_a, jc_b, 6, "center");
     expect_close(jk_a, jk_b, 2 * internal::kFitIntrinsicsSize, "intrinsics");
+  }
+}
+
+// The radial-only path (p1 = p2 = k3 = 0, what single-view fits run) is the general one with
+// those terms at zero, in the same order of operations: equal to the bit (a fit must not depend
+// on which ran: a knife-edge scene of fit_auto_test changed its answer at 1e-16), and it writes no
+// column for p1, p2, k3.
+TEST(ReprojectionErrorTest, RadialOnlyPathEqualsTheGeneralOneWithoutTangentialTerms) {
+  std::mt19937_64 rng(testing::Seed(22));
+  constexpr int kSize = internal::kFitIntrinsicsSize;
+  for (int i = 0; i < 500; ++i) {
+    double intrinsics[kSize] = {
+        testing::Uniform(rng, 300, 3000), testing::Uniform(rng, 0.8, 1.2),
+        testing::Uniform(rng, 0, 2000),   testing::Uniform(rng, 0, 2000),
+        testing::Uniform(rng, -50, 50),   testing::Uniform(rng, -0.3, 0.3),
+        testing::Uniform(rng, -0.1, 0.1), 0.0, 0.0, 0.0};
+    ASSERT_TRUE(internal::RadialOnly(intrinsics));
+    const Eigen::Vector3d p(testing::Uniform(rng, -1, 1), testing::Uniform(rng, -1, 1),
+                            testing::Uniform(rng, 1, 5));
+    const Eigen::Vector2d observed(testing::Uniform(rng, 0, 2000), testing::Uniform(rng, 0, 2000));
+    double r_general[2], r_radial[2], jk_general[2 * kSize], jp_general[6], jp_radial[6];
+    double jk_radial[2 * kSize];
+    std::fill(jk_radial, jk_radial + 2 * kSize, -7.0);  // the unwritten columns keep this
+    internal::ResidualOfCamPoint(intrinsics, p, observed, r_general, jk_general, jp_general);
+    internal::ResidualOfCamPoint<true>(intrinsics, p, observed, r_radial, jk_radial, jp_radial);
+    auto expect_equal = [&](const double* a, const double* b, int size, const char* name) {
+      for (int j = 0; j < size; ++j) {
+        EXPECT_EQ(a[j], b[j]) << name << " entry " << j << " case " << i;
+      }
+    };
+    expect_equal(r_general, r_radial, 2, "residual");
+    expect_equal(jp_general, jp_radial, 6, "d residual / d point");
+    for (int row = 0; row < 2; ++row) {
+      expect_equal(jk_general + row * kSize, jk_radial + row * kSize, 7, "d residual / d k");
+      for (int slot = 7; slot < kSize; ++slot) EXPECT_EQ(jk_radial[row * kSize + slot], -7.0);
+    }
   }
 }
 

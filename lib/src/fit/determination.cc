@@ -593,16 +593,12 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       }
     }
   }
-  // The unmirrored rivals are judged over the box widened to kRivalBoxThickness, each rival's
-  // sigmas there computed once for the rival check and the model average.
+  // The unmirrored rivals are judged over the box widened to kRivalBoxThickness.
   std::optional<TestPoints> rival_test;
-  std::vector<std::vector<double>> sigmas_there(fitted.size());
-  for (size_t m = 0; m < fitted.size(); ++m) {
-    if (fitted[m].rival->mirrored_world) continue;
-    if (!rival_test) {
+  for (const Counted& c : fitted) {
+    if (!rival_test && !c.rival->mirrored_world) {
       rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
     }
-    sigmas_there[m] = SigmasAt(fitted[m].uncertainty, *rival_test);
   }
   for (const Counted* counted_rival : counted) {
     const Counted& c = *counted_rival;
@@ -621,9 +617,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     // with a free intrinsic is undetermined, and a plane would always be refused. Measured on
     // the click benchmark with the model's vertices: docs/model-selection.md.) And except for
     // the rival that predicts the points better (above).
-    const std::vector<double> rival_sigmas =
-        rival.mirrored_world ? SigmasAt(c.uncertainty, their_test)
-                             : sigmas_there[static_cast<size_t>(&c - fitted.data())];
+    const std::vector<double> rival_sigmas = SigmasAt(c.uncertainty, their_test);
     const bool exempt = &c != predicts_better;
     double shift = 0.0;
     for (size_t i = 0; i < our_test.points.size(); ++i) {
@@ -644,37 +638,46 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.rival_predicts_better = !exempt;
     }
   }
-  // The model average: at each of the rivals' test points, the mixture of the returned camera
-  // (weight 1) and every rival in it (Counted::weight), each with its own sigma there. Coplanar
-  // points: over their own test points (in their plane, and the object points), as a plane
-  // determines no model with a free intrinsic off itself, and most planar scenes are mapped on
-  // the plane (measured: docs/model-selection.md).
+  // The model average: at each of the rivals' test points beyond the fitted ones, the mixture of
+  // the returned camera (weight 1) and every rival in it (Counted::weight), each with its own
+  // sigma there. Not at the fitted points: every model in the average is pinned there by the
+  // point itself, within a few sigmas of the noise of it (a rival 5 px from the returned camera at
+  // one adds about 25 / sigma^2 to its sum of squares, beyond kAveragedCriterion at the 1 px
+  // prior), and N of them would cost N sigmas per model (the click benchmark's answers are the
+  // same without them). Coplanar points: over their own test points (in their
+  // plane, and the object points), as a plane determines no model with a free intrinsic off
+  // itself, and most planar scenes are mapped on the plane (measured: docs/model-selection.md).
   double total_weight = 1.0;
   for (const Counted& c : fitted) total_weight += c.weight;
   if (total_weight > 1.0) {
-    const bool on_the_plane = selection.fit.planar;
-    const TestPoints& average_test = on_the_plane ? test_points : *rival_test;
-    const std::vector<double> own_sigmas =
-        on_the_plane ? sigmas : SigmasAt(uncertainty, average_test);
-    if (on_the_plane) {
-      for (size_t m = 0; m < fitted.size(); ++m) {
-        if (fitted[m].weight > 0.0) sigmas_there[m] = SigmasAt(fitted[m].uncertainty, test_points);
-      }
+    const TestPoints& around = selection.fit.planar ? test_points : *rival_test;
+    TestPoints beyond;
+    for (size_t i = 0; i < around.points.size(); ++i) {
+      if (around.fitted[i] >= 0) continue;
+      beyond.points.push_back(around.points[i]);
+      beyond.fitted.push_back(-1);
+      beyond.object.push_back(around.object[i]);
+    }
+    const std::vector<double> own_sigmas = SigmasAt(uncertainty, beyond);
+    std::vector<std::vector<double>> their_sigmas(fitted.size());
+    for (size_t m = 0; m < fitted.size(); ++m) {
+      if (fitted[m].weight > 0.0) their_sigmas[m] = SigmasAt(fitted[m].uncertainty, beyond);
     }
     std::vector<Eigen::Vector2d> pixels(fitted.size());
-    for (size_t i = 0; i < average_test.points.size(); ++i) {
-      const Eigen::Vector3d& x = average_test.points[i];
-      const std::optional<Eigen::Vector2d> own_pixel = PixelFromWorld(camera, x);
-      if (!own_pixel) continue;  // not a test point (every one is in the image)
-      const Eigen::Vector2d ours = *own_pixel;
+    for (size_t i = 0; i < beyond.points.size(); ++i) {
+      const Eigen::Vector3d& x = beyond.points[i];
+      const Eigen::Vector2d ours = *PixelFromWorld(camera, x);  // a test point is in its image
       Eigen::Vector2d mean = ours / total_weight;
       const Counted* behind = nullptr;
       for (size_t m = 0; m < fitted.size() && !behind; ++m) {
         if (fitted[m].weight == 0.0) continue;
         const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(fitted[m].camera, x);
-        if (!theirs) behind = &fitted[m];
-        else pixels[m] = *theirs;
-        if (theirs) mean += fitted[m].weight / total_weight * *theirs;
+        if (!theirs) {
+          behind = &fitted[m];
+        } else {
+          pixels[m] = *theirs;
+          mean += fitted[m].weight / total_weight * *theirs;
+        }
       }
       double variance = std::numeric_limits<double>::infinity();
       const Counted* most = behind;
@@ -683,9 +686,9 @@ DeterminationCheck CheckDetermination(const Selection& selection,
         double largest = 0.0;
         for (size_t m = 0; m < fitted.size(); ++m) {
           if (fitted[m].weight == 0.0) continue;
-          const double term = fitted[m].weight / total_weight *
-                              (sigmas_there[m][i] * sigmas_there[m][i] +
-                               (pixels[m] - mean).squaredNorm());
+          const double term =
+              fitted[m].weight / total_weight *
+              (their_sigmas[m][i] * their_sigmas[m][i] + (pixels[m] - mean).squaredNorm());
           variance += term;
           if (term > largest) {
             largest = term;

@@ -13,8 +13,8 @@ namespace {
 
 // LocalNormalEquations (normal_equations.h). kNumGeneral (the general columns) and
 // kPrincipalPoint (whether it is free) are template parameters so that the accumulation below is
-// unrolled.
-template <int kNumGeneral, bool kPrincipalPoint>
+// unrolled; kRadialOnly (ResidualOfCamPoint) where p1 = p2 = k3 = 0 and none of them is free.
+template <int kNumGeneral, bool kPrincipalPoint, bool kRadialOnly>
 bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
@@ -42,7 +42,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
     Eigen::Array2d r;
     double jk[2 * kFitIntrinsicsSize];  // row-major 2 x kFitIntrinsicsSize
     double jp[6];                                 // row-major 2 x 3: d residual / d p
-    ResidualOfCamPoint(intrinsics.data(), p, pixels[i], r.data(), jk, jp);
+    ResidualOfCamPoint<kRadialOnly>(intrinsics.data(), p, pixels[i], r.data(), jk, jp);
     Eigen::Array2d j[kNumGeneral];
     const Eigen::Array2d ax(jp[0], jp[3]);
     const Eigen::Array2d ay(jp[1], jp[4]);
@@ -99,7 +99,7 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
   return true;
 }
 
-template <bool kPrincipalPoint>
+template <bool kPrincipalPoint, bool kRadialOnly>
 bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
@@ -107,24 +107,19 @@ bool AccumulateLocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                                     const JacobianColumns& columns, NormalEquations* out) {
   // 6 (pose) + up to 5 general slots: focal, aspect, skew, k1, k2.
   switch (columns.num_general) {
-    case 6:
-      return AccumulateLocalNormalEquations<6, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                intrinsics, columns, out);
-    case 7:
-      return AccumulateLocalNormalEquations<7, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                intrinsics, columns, out);
-    case 8:
-      return AccumulateLocalNormalEquations<8, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                intrinsics, columns, out);
-    case 9:
-      return AccumulateLocalNormalEquations<9, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                intrinsics, columns, out);
-    case 10:
-      return AccumulateLocalNormalEquations<10, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                 intrinsics, columns, out);
+#define CAMPROJ_ACCUMULATE_CASE(n)                                                            \
+  case n:                                                                                     \
+    return AccumulateLocalNormalEquations<n, kPrincipalPoint, kRadialOnly>(                   \
+        points, pixels, rotation, center, intrinsics, columns, out);
+    CAMPROJ_ACCUMULATE_CASE(6)
+    CAMPROJ_ACCUMULATE_CASE(7)
+    CAMPROJ_ACCUMULATE_CASE(8)
+    CAMPROJ_ACCUMULATE_CASE(9)
+    CAMPROJ_ACCUMULATE_CASE(10)
+#undef CAMPROJ_ACCUMULATE_CASE
     default:
-      return AccumulateLocalNormalEquations<11, kPrincipalPoint>(points, pixels, rotation, center,
-                                                                 intrinsics, columns, out);
+      return AccumulateLocalNormalEquations<11, kPrincipalPoint, kRadialOnly>(
+          points, pixels, rotation, center, intrinsics, columns, out);
   }
 }
 
@@ -135,11 +130,19 @@ bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
                           const IntrinsicValues& intrinsics, const JacobianColumns& columns,
                           NormalEquations* out) {
-  return columns.cx_parameter >= 0
-             ? AccumulateLocalNormalEquations<true>(points, pixels, rotation, center, intrinsics,
-                                                    columns, out)
-             : AccumulateLocalNormalEquations<false>(points, pixels, rotation, center, intrinsics,
-                                                     columns, out);
+  bool radial_only = RadialOnly(intrinsics.data());
+  for (int g = 0; g < columns.num_general - 6; ++g) {
+    radial_only &= columns.general_slots[g] < 7;  // p1, p2, k3 fixed
+  }
+  const bool pp = columns.cx_parameter >= 0;
+  return pp ? (radial_only ? AccumulateLocalNormalEquations<true, true>(
+                                 points, pixels, rotation, center, intrinsics, columns, out)
+                           : AccumulateLocalNormalEquations<true, false>(
+                                 points, pixels, rotation, center, intrinsics, columns, out))
+            : (radial_only ? AccumulateLocalNormalEquations<false, true>(
+                                 points, pixels, rotation, center, intrinsics, columns, out)
+                           : AccumulateLocalNormalEquations<false, false>(
+                                 points, pixels, rotation, center, intrinsics, columns, out));
 }
 
 void ToChart(const Eigen::Matrix3d& d_theta_d_omega, const Eigen::Matrix3d& rotation,

@@ -67,6 +67,10 @@ struct ReprojectionError {
 // (2 x kFitIntrinsicsSize, row-major, layout above) and d residual / d point_in_cam (2 x 3, row-major), each
 // only if its pointer is given. The part of the model after the rotation, shared by
 // ProjectPointWithJacobian and the fitter's normal equations (which rotate with a matrix).
+// kRadialOnly: the caller knows p1 = p2 = k3 = 0 (RadialOnly) and reads no derivative by them:
+// their terms are left out, and jacobian_k's columns for them are not written (the single-view
+// fits hold them at 0 unless given). Every value written is the general path's to the bit.
+template <bool kRadialOnly = false>
 inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_cam,
                                const Eigen::Vector2d& observed, double* residual,
                                double* jacobian_k, double* jacobian_p) {
@@ -74,8 +78,37 @@ inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_
   const double inv_z = 1.0 / p.z();
   const double x = p.x() * inv_z;
   const double y = p.y() * inv_z;
-  const double f = k[0], a = k[1], s = k[4], k1 = k[5], k2 = k[6], p1 = k[7], p2 = k[8],
-               k3 = k[9];
+  const double f = k[0], a = k[1], s = k[4], k1 = k[5], k2 = k[6];
+  if constexpr (kRadialOnly) {
+    const double r2 = x * x + y * y;
+    const double d = 1.0 + r2 * (k1 + r2 * k2);
+    const double xd = d * x, yd = d * y;
+    residual[0] = f * xd + s * yd + k[2] - observed.x();
+    residual[1] = a * f * yd + k[3] - observed.y();
+    if (jacobian_k != nullptr) {
+      const double pu = f * x + s * y, pv = a * f * y, r4 = r2 * r2;
+      double* u = jacobian_k;
+      double* v = jacobian_k + kFitIntrinsicsSize;
+      u[0] = xd, u[1] = 0.0, u[2] = 1.0, u[3] = 0.0, u[4] = yd, u[5] = pu * r2, u[6] = pu * r4;
+      v[0] = a * yd, v[1] = f * yd, v[2] = 0.0, v[3] = 1.0, v[4] = 0.0, v[5] = pv * r2,
+      v[6] = pv * r4;
+    }
+    if (jacobian_p == nullptr) return;
+    const double dd = 2.0 * (k1 + 2.0 * k2 * r2);
+    const double off = x * y * dd;
+    const double dxd_dx = d + x * x * dd, dyd_dy = d + y * y * dd;
+    const double u_x = f * dxd_dx + s * off, u_y = f * off + s * dyd_dy;
+    const double v_x = a * f * off, v_y = a * f * dyd_dy;
+    // In the general path's order of operations (its 2 x 2 by 2 x 3 product), so that both
+    // round alike: a fit's result does not depend on which path ran.
+    const double x_z = -x * inv_z, y_z = -y * inv_z;
+    jacobian_p[0] = u_x * inv_z, jacobian_p[1] = u_y * inv_z;
+    jacobian_p[2] = u_x * x_z + u_y * y_z;
+    jacobian_p[3] = v_x * inv_z, jacobian_p[4] = v_y * inv_z;
+    jacobian_p[5] = v_x * x_z + v_y * y_z;
+    return;
+  }
+  const double p1 = k[7], p2 = k[8], k3 = k[9];
   const double xx = x * x, yy = y * y, xy = x * y;
   const double r2 = xx + yy;
   const double d = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
@@ -109,6 +142,9 @@ inline void ResidualOfCamPoint(const double* k, const Eigen::Vector3d& point_in_
   Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> jp(jacobian_p);
   jp = d_pixel_d_xy * d_xy_d_p;
 }
+
+// Whether `k` (fit layout) has no tangential distortion and no k3: ResidualOfCamPoint<true>.
+inline bool RadialOnly(const double* k) { return k[7] == 0.0 && k[8] == 0.0 && k[9] == 0.0; }
 
 // The same residual with analytic derivatives, for one point; the blocks are as above. Any
 // Jacobian pointer may be null. Returns false where the point is not in front (z <= 0).
