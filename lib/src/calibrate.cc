@@ -875,7 +875,7 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
   };
   const double w = options.image_size.width, h = options.image_size.height;
   result->projection_sigma_center_px = projection_sigma({0.5 * (w - 1.0), 0.5 * (h - 1.0)});
-  for (const Eigen::Vector2d corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
                                        Eigen::Vector2d(-0.5, h - 0.5),
                                        Eigen::Vector2d(w - 0.5, h - 0.5)}) {
     try {
