@@ -268,8 +268,11 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
         SceneError::Reason::kAmbiguous,
         "the points cannot tell which model is right well enough: " + model + " and the models "
         "that fit them nearly as well (" + check.averaged_rival + " most), averaged with weights "
-        "from their BIC, put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma) near "
-        "pixel (" + std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
+        "from their BIC, " +
+        (std::isfinite(check.averaged_sigma_px)
+             ? "put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma)"
+             : std::string("disagree: one puts a point of the scene behind its camera")) +
+        " near pixel (" + std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
         std::to_string(static_cast<long>(std::lround(at.y()))) + ") (bound " + Px(check.bound_px) +
         ", --max-uncertainty). " + advice);
   }

@@ -455,6 +455,81 @@ double PredictionSumOfSquares(const PixelUncertainty& uncertainty, const Camera&
   return press;
 }
 
+// A rival of the returned camera with its uncertainty at the kept points, in the unit world.
+struct FittedRival {
+  const Rival* rival;
+  Camera camera;
+  PixelUncertainty uncertainty;
+  bool about_as_well;  // within kEqualFitCriterion: the rival check's
+  double weight;       // in the model average, relative to the returned model's 1 (0: not in it)
+};
+
+// The model average (DeterminationCheck::averaged_sigma_px): at each point of `around` that is
+// not a fitted one, the mixture of `camera` (weight 1) and every rival with a weight, each with
+// its own sigma there. Not at the fitted points: every model in the average is pinned there by
+// the point itself, within a few sigmas of its noise (a rival 5 px from the returned camera at one
+// adds about 25 / sigma^2 to its sum of squares, beyond kAveragedCriterion at the 1 px prior), and
+// N of them would cost N sigmas per model (the click benchmark's answers are the same without
+// them). A rival that puts a point behind it makes the spread infinite there.
+void AverageOverModels(const Camera& camera, const PixelUncertainty& uncertainty,
+                       const std::vector<FittedRival>& rivals, const TestPoints& around,
+                       DeterminationCheck* check) {
+  double total_weight = 1.0;
+  for (const FittedRival& r : rivals) total_weight += r.weight;
+  if (total_weight == 1.0) return;
+  TestPoints beyond;
+  for (size_t i = 0; i < around.points.size(); ++i) {
+    if (around.fitted[i] >= 0) continue;
+    beyond.points.push_back(around.points[i]);
+    beyond.fitted.push_back(-1);
+    beyond.object.push_back(around.object[i]);
+  }
+  const std::vector<double> own_sigmas = SigmasAt(uncertainty, beyond);
+  std::vector<std::vector<double>> their_sigmas(rivals.size());
+  for (size_t m = 0; m < rivals.size(); ++m) {
+    if (rivals[m].weight > 0.0) their_sigmas[m] = SigmasAt(rivals[m].uncertainty, beyond);
+  }
+  std::vector<Eigen::Vector2d> pixels(rivals.size());
+  for (size_t i = 0; i < beyond.points.size(); ++i) {
+    const Eigen::Vector3d& x = beyond.points[i];
+    const Eigen::Vector2d ours = *PixelFromWorld(camera, x);  // a test point is in its image
+    Eigen::Vector2d mean = ours / total_weight;
+    const FittedRival* behind = nullptr;
+    for (size_t m = 0; m < rivals.size() && !behind; ++m) {
+      if (rivals[m].weight == 0.0) continue;
+      const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rivals[m].camera, x);
+      if (!theirs) {
+        behind = &rivals[m];
+      } else {
+        pixels[m] = *theirs;
+        mean += rivals[m].weight / total_weight * *theirs;
+      }
+    }
+    double variance = std::numeric_limits<double>::infinity();
+    const FittedRival* most = behind;
+    if (!behind) {
+      variance = (own_sigmas[i] * own_sigmas[i] + (ours - mean).squaredNorm()) / total_weight;
+      double largest = 0.0;
+      for (size_t m = 0; m < rivals.size(); ++m) {
+        if (rivals[m].weight == 0.0) continue;
+        const double term =
+            rivals[m].weight / total_weight *
+            (their_sigmas[m][i] * their_sigmas[m][i] + (pixels[m] - mean).squaredNorm());
+        variance += term;
+        if (term > largest) {
+          largest = term;
+          most = &rivals[m];
+        }
+      }
+    }
+    if (!(std::sqrt(variance) <= check->averaged_sigma_px)) {
+      check->averaged_sigma_px = std::sqrt(variance);
+      check->averaged_worst_pixel = ours;
+      check->averaged_rival = most ? most->rival->model : "";
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> SceneTestPoints(const Camera& camera,
@@ -540,14 +615,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   // kAveragedCriterion (the model average's), each with its uncertainty at the kept points (a
   // mirrored reading sees them with z negated); one with a kept point behind it is no reading of
   // them.
-  struct Counted {
-    const Rival* rival;
-    Camera camera;
-    PixelUncertainty uncertainty;
-    bool about_as_well;  // within kEqualFitCriterion: the rival check's
-    double weight;       // in the model average, relative to the returned model's 1 (0: not in it)
-  };
-  std::vector<Counted> fitted;
+  std::vector<FittedRival> fitted;
   fitted.reserve(selection.rivals.size());  // moved in once, never copied
   for (const Rival& rival : selection.rivals) {
     const double excess = rival.criterion - selection.criterion;
@@ -569,14 +637,14 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     } catch (const std::invalid_argument&) {
     }
   }
-  std::vector<const Counted*> counted;
-  for (const Counted& c : fitted) {
+  std::vector<const FittedRival*> counted;
+  for (const FittedRival& c : fitted) {
     if (c.about_as_well) counted.push_back(&c);
   }
   // At a handful of points, the unmirrored rival that predicts each kept point from the others
   // better than the chosen model and every other such rival (PRESS) is as good a reading of the
   // data: its shift counts even within its own 3 sigma.
-  const Counted* predicts_better = nullptr;
+  const FittedRival* predicts_better = nullptr;
   if (points.size() <= kCrossValidationMaxPoints &&
       selection.fit.residuals_px.size() == points.size()) {
     std::vector<Eigen::Vector2d> observed(points.size());
@@ -584,7 +652,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       observed[i] = *PixelFromWorld(camera, points[i]) - selection.fit.residuals_px[i];
     }
     double best = PredictionSumOfSquares(uncertainty, camera, points, observed);
-    for (const Counted* c : counted) {
+    for (const FittedRival* c : counted) {
       if (c->rival->mirrored_world) continue;
       const double press = PredictionSumOfSquares(c->uncertainty, c->camera, points, observed);
       if (press < best) {
@@ -595,13 +663,13 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   }
   // The unmirrored rivals are judged over the box widened to kRivalBoxThickness.
   std::optional<TestPoints> rival_test;
-  for (const Counted& c : fitted) {
+  for (const FittedRival& c : fitted) {
     if (!rival_test && !c.rival->mirrored_world) {
       rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
     }
   }
-  for (const Counted* counted_rival : counted) {
-    const Counted& c = *counted_rival;
+  for (const FittedRival* counted_rival : counted) {
+    const FittedRival& c = *counted_rival;
     const Rival& rival = *c.rival;
     const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
     // The mirrored reading is judged over the points' own box: off a plane (or a nearly flat
@@ -638,70 +706,12 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.rival_predicts_better = !exempt;
     }
   }
-  // The model average: at each of the rivals' test points beyond the fitted ones, the mixture of
-  // the returned camera (weight 1) and every rival in it (Counted::weight), each with its own
-  // sigma there. Not at the fitted points: every model in the average is pinned there by the
-  // point itself, within a few sigmas of the noise of it (a rival 5 px from the returned camera at
-  // one adds about 25 / sigma^2 to its sum of squares, beyond kAveragedCriterion at the 1 px
-  // prior), and N of them would cost N sigmas per model (the click benchmark's answers are the
-  // same without them). Coplanar points: over their own test points (in their
-  // plane, and the object points), as a plane determines no model with a free intrinsic off
-  // itself, and most planar scenes are mapped on the plane (measured: docs/model-selection.md).
-  double total_weight = 1.0;
-  for (const Counted& c : fitted) total_weight += c.weight;
-  if (total_weight > 1.0) {
-    const TestPoints& around = selection.fit.planar ? test_points : *rival_test;
-    TestPoints beyond;
-    for (size_t i = 0; i < around.points.size(); ++i) {
-      if (around.fitted[i] >= 0) continue;
-      beyond.points.push_back(around.points[i]);
-      beyond.fitted.push_back(-1);
-      beyond.object.push_back(around.object[i]);
-    }
-    const std::vector<double> own_sigmas = SigmasAt(uncertainty, beyond);
-    std::vector<std::vector<double>> their_sigmas(fitted.size());
-    for (size_t m = 0; m < fitted.size(); ++m) {
-      if (fitted[m].weight > 0.0) their_sigmas[m] = SigmasAt(fitted[m].uncertainty, beyond);
-    }
-    std::vector<Eigen::Vector2d> pixels(fitted.size());
-    for (size_t i = 0; i < beyond.points.size(); ++i) {
-      const Eigen::Vector3d& x = beyond.points[i];
-      const Eigen::Vector2d ours = *PixelFromWorld(camera, x);  // a test point is in its image
-      Eigen::Vector2d mean = ours / total_weight;
-      const Counted* behind = nullptr;
-      for (size_t m = 0; m < fitted.size() && !behind; ++m) {
-        if (fitted[m].weight == 0.0) continue;
-        const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(fitted[m].camera, x);
-        if (!theirs) {
-          behind = &fitted[m];
-        } else {
-          pixels[m] = *theirs;
-          mean += fitted[m].weight / total_weight * *theirs;
-        }
-      }
-      double variance = std::numeric_limits<double>::infinity();
-      const Counted* most = behind;
-      if (!behind) {
-        variance = (own_sigmas[i] * own_sigmas[i] + (ours - mean).squaredNorm()) / total_weight;
-        double largest = 0.0;
-        for (size_t m = 0; m < fitted.size(); ++m) {
-          if (fitted[m].weight == 0.0) continue;
-          const double term =
-              fitted[m].weight / total_weight *
-              (their_sigmas[m][i] * their_sigmas[m][i] + (pixels[m] - mean).squaredNorm());
-          variance += term;
-          if (term > largest) {
-            largest = term;
-            most = &fitted[m];
-          }
-        }
-      }
-      if (!(std::sqrt(variance) <= check.averaged_sigma_px)) {
-        check.averaged_sigma_px = std::sqrt(variance);
-        check.averaged_worst_pixel = ours;
-        check.averaged_rival = most ? most->rival->model : "";
-      }
-    }
+  // The model average over the rivals' test points; for coplanar points over their own (in their
+  // plane, and the object points): a plane determines no model with a free intrinsic off itself,
+  // and the bundled plane was refused at 30 px off it (docs/model-selection.md).
+  if (rival_test) {
+    AverageOverModels(camera, uncertainty, fitted,
+                      selection.fit.planar ? test_points : *rival_test, &check);
   }
   check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px &&
                  check.averaged_sigma_px <= check.bound_px;
@@ -717,7 +727,10 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     const Eigen::Vector2d at = ConvertPixelOrigin(check.averaged_worst_pixel, PixelOrigin::kCenter,
                                                   options.fit.pixel_origin);
     check.summary += "; averaged over the models fitted (BIC weights), " +
-                     Px(check.averaged_sigma_px) + " near pixel (" +
+                     (std::isfinite(check.averaged_sigma_px)
+                          ? Px(check.averaged_sigma_px)
+                          : std::string("a point behind one of their cameras")) +
+                     " near pixel (" +
                      std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
                      std::to_string(static_cast<long>(std::lround(at.y()))) + ")" +
                      (check.averaged_rival.empty() ? "" : ", most from " + check.averaged_rival);
