@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # What the default path costs on clean scenes, in instructions (docs/bench/stage_cost.md): builds
 # apps/bench in Release, runs `bench --stage-cost --n N` under callgrind for every N (instruction
-# counts do not depend on the machine's load) and once natively (wall time), and writes the
-# table with scripts/stage_cost.py: per N the instructions per fit of the baseline (recorded in
-# stage_cost.py), of this tree, and per stage. Single-threaded; about 5 minutes.
+# counts do not depend on the machine's load) and once natively (wall time), the same with
+# --one-fit (one fit of OpenCV's model on the same scenes), and writes the table with
+# scripts/stage_cost.py: per N the instructions per fit of the baseline (recorded in
+# stage_cost.py), of this tree, per stage, and of one fit. Single-threaded; about 6 minutes.
 #
 #   scripts/bench_stage_cost.sh [--out FILE] [--n N,N,...]   (default docs/bench/stage_cost.md)
 #   scripts/bench_stage_cost.sh --baseline REV
@@ -58,6 +59,16 @@ for n in ${counts//,/ }; do
   valgrind --tool=callgrind --callgrind-out-file="$work/cg.$n.out" "${bench[@]}" --n "$n" \
     >/dev/null 2>"$work/valgrind.$n.log"
 done
+# One fit of OpenCV's model on the same scenes (bench --stage-cost --one-fit), for the table's
+# default-path-to-one-fit ratio (issue #12).
+if [[ -z "$baseline" ]]; then
+  "${bench[@]}" --one-fit --n "$counts" >"$work/one_fit_wall.csv"
+  for n in ${counts//,/ }; do
+    echo "bench_stage_cost.sh: N = $n, one fit, under callgrind" >&2
+    valgrind --tool=callgrind --callgrind-out-file="$work/one_fit.$n.out" "${bench[@]}" \
+      --one-fit --n "$n" >/dev/null 2>"$work/valgrind.one_fit.$n.log"
+  done
+fi
 
 if [[ -n "$baseline" ]]; then
   echo "# $baseline ($(git -C "$root" rev-parse --short "$baseline")), $(valgrind --version)"

@@ -145,8 +145,17 @@ def measure(path):
     return total, stages
 
 
-def wall_rows(directory):
-    with open(os.path.join(directory, "wall.csv")) as f:
+def one_fit_total(path):
+    """Inclusive instructions of the bench's own calls into FitCamera (bench --stage-cost
+    --one-fit)."""
+    _, edges = parse(path)
+    return sum(cost for (caller, callee), (_, cost) in edges.items()
+               if short(caller).startswith("camproj::bench::")
+               and short(callee) == "camproj::FitCamera()")
+
+
+def wall_rows(directory, name="wall.csv"):
+    with open(os.path.join(directory, name)) as f:
         return {int(r["n"]): r for r in csv.DictReader(f)}
 
 
@@ -199,6 +208,24 @@ def table(directory):
           f"{mirror_fits[n]} of {rows[n]['scenes']} | {without:.2f} | "
           f"{float(rows[n]['time_median_us']) / 1000:.2f} ms |")
     w("")
+    one_fit_path = os.path.join(directory, "one_fit_wall.csv")
+    if os.path.exists(one_fit_path):
+        one_rows = wall_rows(directory, "one_fit_wall.csv")
+        w("## The default path against one fit\n")
+        w("One fit: `FitCamera` with OpenCV's model (focal and principal point free, aspect 1, no "
+          "covariance; apps/bench's ours-refine) on the same scenes, from scratch "
+          "(`bench --stage-cost --one-fit`). Issue #12 asks the default path for a tenth of "
+          "calibrateCamera's time and one fit for a bare refiner's.\n")
+        w("| N | one fit (M instr.) | default path (M instr.) | default ÷ one fit | "
+          "one fit, wall (median) | default, wall (median) |")
+        w("|---:|---:|---:|---:|---:|---:|")
+        for n, (total, _) in results.items():
+            one = one_fit_total(os.path.join(directory, f"one_fit.{n}.out")) / int(
+                one_rows[n]["scenes"])
+            w(f"| {n} | {mega(one)} | {mega(total)} | {total / one:.1f} | "
+              f"{float(one_rows[n]['time_median_us']):.0f} µs | "
+              f"{float(rows[n]['time_median_us']) / 1000:.2f} ms |")
+        w("")
     w("## Per stage (M instructions per fit; share of the fit)\n")
     w("Stages in pipeline order; \"new\": added by issue #10's default path (the model selection "
       f"was the whole default path at {BASELINE_REV}). Orchestration: the rest of "

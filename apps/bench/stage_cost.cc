@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include "camproj/fit.h"
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "point_counts.h"
@@ -28,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 const char* kUsage =
     "bench --stage-cost: the default path (FitCameraAuto, default options) on clean scenes.\n"
     "\n"
-    "Usage: bench --stage-cost [--n N,N,...] [--seeds K]\n"
+    "Usage: bench --stage-cost [--n N,N,...] [--seeds K] [--one-fit]\n"
     "\n"
     "Fits camproj::SynthesizeScene clouds (1920x1080, fovy 45 deg, sigma 0.5 px; a centred\n"
     "camera and a projector with its principal point at the bottom edge; seeds 1..K, so 2K\n"
@@ -38,6 +39,9 @@ const char* kUsage =
     "\n"
     "  --n N,N,...  point counts (default 6,8,12,20,100,1000)\n"
     "  --seeds K    seeds per N and camera (default 20 for N <= 20, 10 for N <= 100, 3 above)\n"
+    "  --one-fit    instead, one fit of OpenCV's model from scratch on the same scenes\n"
+    "               (FitCamera: focal and principal point free, aspect 1, no covariance; apps/bench's\n"
+    "               ours-refine)\n"
     "\n"
     "Example:\n"
     "  valgrind --tool=callgrind --toggle-collect='camproj::FitCameraAuto*' \\\n"
@@ -64,7 +68,17 @@ struct Row {
   uint64_t digest = 1469598103934665603ULL;
 };
 
-Row Measure(int n, int seeds) {
+// One fit of OpenCV's model from scratch (apps/bench's ours-refine): FitCamera's closed-form start
+// and refinement, no covariance.
+FitResult OneFit(const SynthScene& scene, const ImageSize& image_size) {
+  FitOptions options;
+  options.aspect = ParameterMode::Default();  // 1
+  options.compute_uncertainty = false;
+  return FitCamera(scene.correspondences.points_in_world, scene.correspondences.pixels,
+                   image_size, options);
+}
+
+Row Measure(int n, int seeds, bool one_fit) {
   Row row;
   row.n = n;
   std::vector<double> times_us;
@@ -81,8 +95,10 @@ Row Measure(int n, int seeds) {
       const SynthScene scene = SynthesizeScene(synth);
       const Clock::time_point start = Clock::now();
       try {
-        const FitResult fit = FitCameraAuto(scene.correspondences.points_in_world,
-                                            scene.correspondences.pixels, synth.image_size);
+        const FitResult fit =
+            one_fit ? OneFit(scene, synth.image_size)
+                    : FitCameraAuto(scene.correspondences.points_in_world,
+                                    scene.correspondences.pixels, synth.image_size);
         times_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
         Mix(&row.digest, fit.model.data(), fit.model.size());
         const Intrinsics& k = fit.camera.intrinsics;
@@ -110,6 +126,7 @@ Row Measure(int n, int seeds) {
 int StageCostMain(int argc, char** argv) {
   std::vector<int> counts = {6, 8, 12, 20, 100, 1000};
   int seeds = 0;  // 0: DefaultSeeds
+  bool one_fit = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -125,6 +142,8 @@ int StageCostMain(int argc, char** argv) {
       return 0;
     } else if (arg == "--n") {
       if (!ParsePointCounts(value(), &counts)) return 1;
+    } else if (arg == "--one-fit") {
+      one_fit = true;
     } else if (arg == "--seeds") {
       seeds = std::atoi(value().c_str());
       if (seeds < 1) {
@@ -138,7 +157,7 @@ int StageCostMain(int argc, char** argv) {
   }
   std::printf("n,scenes,refused,time_median_us,digest\n");
   for (const int n : counts) {
-    const Row row = Measure(n, seeds > 0 ? seeds : DefaultSeeds(n));
+    const Row row = Measure(n, seeds > 0 ? seeds : DefaultSeeds(n), one_fit);
     std::printf("%d,%d,%d,%.1f,%016llx\n", row.n, row.scenes, row.refused, row.time_median_us,
                 static_cast<unsigned long long>(row.digest));
     std::fflush(stdout);
