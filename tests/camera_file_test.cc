@@ -182,7 +182,7 @@ TEST(CameraFileTest, CalibrationViewsAreSelectedByName) {
     calibration.views.push_back(view);
   }
   calibration.intrinsics = calibration.views[0].camera.intrinsics;
-  calibration.refused_views.push_back({"left02", 54, 1.24, 0.25, 200.0, 40.0});
+  calibration.refused_views.push_back({"left02", 54, 1.24, 0.25, 200.0, 40.0, ""});
   const std::string text = CalibrationToJsonText(calibration);
   for (const CalibratedView& view : calibration.views) {
     const Camera back = CalibrationViewFromJsonText(text, "calib.json", view.name);

@@ -51,9 +51,9 @@ CalibrateOptions ModelOptions(const std::string& model, const std::vector<std::s
   options.num_radial = 0;
   for (const std::string& group : groups) {
     const bool fixed = std::find(fix.begin(), fix.end(), group) != fix.end() ||
-                       (group == "k2" || group == "k3") &&
-                           std::find(fix.begin(), fix.end(), "k1") != fix.end() ||
-                       group == "k3" && std::find(fix.begin(), fix.end(), "k2") != fix.end();
+                       ((group == "k2" || group == "k3") &&
+                        std::find(fix.begin(), fix.end(), "k1") != fix.end()) ||
+                       (group == "k3" && std::find(fix.begin(), fix.end(), "k2") != fix.end());
     if (fixed && model != "auto") {
       throw std::invalid_argument("--model " + model + " frees " + group + " but --fix holds it");
     }

@@ -449,8 +449,8 @@ double PinholeErrorAtWorstCornerPx(const Camera& camera) {
   const double w = camera.image_size.width;
   const double h = camera.image_size.height;
   double worst = 0.0;
-  for (const Eigen::Vector2d corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
-                                       Eigen::Vector2d(-0.5, h - 0.5), Eigen::Vector2d(w - 0.5, h - 0.5)}) {
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, -0.5),
+                                        Eigen::Vector2d(-0.5, h - 0.5), Eigen::Vector2d(w - 0.5, h - 0.5)}) {
     const Eigen::Vector3d ray = CamRayFromPixel(pinhole, corner);
     worst = std::max(worst, (PixelFromCam(camera.intrinsics, ray) - corner).norm());
   }

@@ -247,7 +247,8 @@ struct DeterminationCheck {
   // probabilities: Raftery 1995): its largest 1-sigma spread sqrt(sum_m w_m (sigma_m^2 +
   // |u_m - u_mean|^2)) over the rivals' test points, and where. Above the bound the points cannot
   // tell which model is right well enough (kAmbiguous); a model that puts a test point behind
-  // it makes this infinite. The returned model alone: its own sigma there.
+  // it makes this infinite. 0 when no rival is in the average (e.g. a forced model). Asked at the
+  // test points that are not fitted points (fit/determination.cc, AverageOverModels).
   double averaged_sigma_px = 0.0;
   Eigen::Vector2d averaged_worst_pixel = Eigen::Vector2d::Zero();  // kCenter
   std::string averaged_rival;  // the rival that adds most to the spread there ("": none)
