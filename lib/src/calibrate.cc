@@ -593,7 +593,8 @@ std::optional<std::string> ViewStart(const CalibrationView& view,
                      "its correspondences");
 }
 
-// The joint problem: a pose block per view (ViewStart) and one block of the free intrinsics shared by all views.
+// The joint problem: a pose block per view (from ViewStart) and one block of the free intrinsics
+// shared by all views.
 struct JointProblem {
   std::vector<Eigen::Matrix3d> reference_rotations;  // each view's start
   std::vector<std::array<double, kPoseSize>> poses;  // [w, C], see ViewCost

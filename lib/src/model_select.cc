@@ -262,8 +262,6 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
                          check.summary + " (--max-uncertainty). " + advice);
   }
   if (check.rival_shift_px <= check.bound_px) {
-    const Eigen::Vector2d at =
-        ConvertPixelOrigin(check.averaged_worst_pixel, PixelOrigin::kCenter, pixel_origin);
     throw SceneError(
         SceneError::Reason::kAmbiguous,
         "the points cannot tell which model is right well enough: " + model + " and the models "
@@ -272,9 +270,8 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
         (std::isfinite(check.averaged_sigma_px)
              ? "put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma)"
              : std::string("disagree: one puts a point of the scene behind its camera")) +
-        " near pixel (" + std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
-        std::to_string(static_cast<long>(std::lround(at.y()))) + ") (bound " + Px(check.bound_px) +
-        ", --max-uncertainty). " + advice);
+        " near pixel " + internal::PixelText(check.averaged_worst_pixel, pixel_origin) +
+        " (bound " + Px(check.bound_px) + ", --max-uncertainty). " + advice);
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
                    "the points cannot tell " + model + " from " + check.rival +

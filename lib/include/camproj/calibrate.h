@@ -61,11 +61,13 @@ struct CalibrateOptions {
   // remain. Needs >= 4 views.
   bool refuse_inconsistent_views = true;
   // Leave out single points that do not fit (a mis-detected corner, a mis-click): after the joint
-  // fit, every point whose residual |r| exceeds sigma sqrt(2 ln(N / 0.001)) — the level-0.001
-  // bound over all N points of a Rayleigh |r| with sigma = median |r| / sqrt(2 ln 2), robust to
-  // the outliers themselves — is left out and the rest calibrated again, until none is. A view
-  // with more than 30 % of its points beyond the bound keeps them: that is a view that does not
-  // fit (refuse_inconsistent_views), not a few bad points.
+  // fit (and the view refusal), every point whose residual |r| exceeds its view's bound
+  // sigma sqrt(2 ln(N / 0.001)) — the level-0.001 bound over all N points of a Rayleigh |r|,
+  // sigma = median |r| / sqrt(2 ln 2) (robust to the outliers themselves), the larger of the
+  // view's own and all views' together — is left out and the rest calibrated again, once (bounds
+  // taken again would peel the boards' edge columns). A view with more than 30 % of its points
+  // beyond the bound, or fewer than 4 left, keeps them: that is a view that does not fit
+  // (refuse_inconsistent_views), not a few bad points.
   bool remove_outliers = true;
   // Also calibrate the even and the odd views apart and compare them (Calibration::
   // cross_validation); needs compute_uncertainty and >= 4 views.
@@ -132,7 +134,6 @@ struct OutlierPoint {
   double bound_px = 0.0;     // the bound it exceeded
 };
 
-// A view left out because it does not fit the camera the other views share.
 // A view left out: it does not fit the camera the other views share (the numbers below), or it
 // cannot be started (`reason` says why; the numbers are 0).
 struct RefusedView {

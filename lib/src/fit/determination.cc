@@ -663,10 +663,9 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   }
   // The unmirrored rivals are judged over the box widened to kRivalBoxThickness.
   std::optional<TestPoints> rival_test;
-  for (const FittedRival& c : fitted) {
-    if (!rival_test && !c.rival->mirrored_world) {
-      rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
-    }
+  if (std::any_of(fitted.begin(), fitted.end(),
+                  [](const FittedRival& c) { return !c.rival->mirrored_world; })) {
+    rival_test = TestPointsOrFitted(camera, points, kRivalBoxThickness, object_points);
   }
   for (const FittedRival* counted_rival : counted) {
     const FittedRival& c = *counted_rival;
@@ -715,24 +714,18 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   }
   check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px &&
                  check.averaged_sigma_px <= check.bound_px;
-  const Eigen::Vector2d where =
-      ConvertPixelOrigin(check.worst_pixel, PixelOrigin::kCenter, options.fit.pixel_origin);
+  const PixelOrigin origin_convention = options.fit.pixel_origin;
   check.summary = "uncertain by up to " + Px(check.max_sigma_px) +
                   " (1 sigma) over the box the points span" +
-                  (object_points.empty() ? "" : " and the object points") + ", most near pixel (" +
-                  std::to_string(static_cast<long>(std::lround(where.x()))) + ", " +
-                  std::to_string(static_cast<long>(std::lround(where.y()))) + "); bound " +
+                  (object_points.empty() ? "" : " and the object points") + ", most near pixel " +
+                  PixelText(check.worst_pixel, origin_convention) + "; bound " +
                   Px(check.bound_px);
   if (check.averaged_sigma_px > 0.0) {
-    const Eigen::Vector2d at = ConvertPixelOrigin(check.averaged_worst_pixel, PixelOrigin::kCenter,
-                                                  options.fit.pixel_origin);
     check.summary += "; averaged over the models fitted (BIC weights), " +
                      (std::isfinite(check.averaged_sigma_px)
                           ? Px(check.averaged_sigma_px)
                           : std::string("a point behind one of their cameras")) +
-                     " near pixel (" +
-                     std::to_string(static_cast<long>(std::lround(at.x()))) + ", " +
-                     std::to_string(static_cast<long>(std::lround(at.y()))) + ")" +
+                     " near pixel " + PixelText(check.averaged_worst_pixel, origin_convention) +
                      (check.averaged_rival.empty() ? "" : ", most from " + check.averaged_rival);
   }
   if (!check.rival.empty()) {

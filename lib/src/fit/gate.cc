@@ -17,6 +17,12 @@ std::string Px(double value) {
   return buffer;
 }
 
+std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin) {
+  const Eigen::Vector2d u = ConvertPixelOrigin(pixel_center, PixelOrigin::kCenter, origin);
+  return "(" + std::to_string(static_cast<long>(std::lround(u.x()))) + ", " +
+         std::to_string(static_cast<long>(std::lround(u.y()))) + ")";
+}
+
 std::string NoiseReference::Source() const {
   return given ? "given" : "assumed: the default for clicked points; set it with --sigma";
 }

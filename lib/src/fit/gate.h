@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "camproj/conventions.h"
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
 
@@ -19,6 +20,9 @@ namespace internal {
 
 // "3.14 px": a pixel distance in messages.
 std::string Px(double value);
+
+// "(505, 714)": a pixel (kCenter) in messages, rounded, in `origin`'s convention.
+std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin);
 
 // The noise the residuals are tested against: FitOptions::pixel_sigma when given, else
 // AutoFitOptions::prior_sigma_px.
