@@ -1,45 +1,28 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of fuzz/ with clang in build/fuzz, replays each seed corpus, then
+# Builds the libFuzzer targets of fuzz/ in the sanitizer build (build/sanitize, clang:
+# scripts/build_sanitize.sh, shared with `scripts/test.sh --sanitize`), replays each seed corpus, then
 # fuzzes each target for SECONDS seconds (default 30; or CAMPROJ_FUZZ_SECONDS) on a temporary
 # copy of its corpus (the committed corpus is never modified).
 # Usage: scripts/fuzz.sh [SECONDS]
 # Prints one line per target on success. On a crash, leak, UB, timeout or escaped exception it
 # prints the fuzzer's log and where the reproducer is saved, and exits non-zero.
-# Reproduce: build/fuzz/fuzz/<target> <reproducer file>
+# Reproduce: build/sanitize/fuzz/<target>_fuzzer <reproducer file>
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-build="$root/build/fuzz"
+build="$root/build/sanitize"
 seconds=${1:-${CAMPROJ_FUZZ_SECONDS:-30}}
 if ! [[ "$seconds" =~ ^[0-9]+$ ]] || ((seconds < 1)); then
   echo "fuzz: SECONDS must be a positive integer, got '$seconds'" >&2
   exit 1
 fi
-for tool in clang clang++ cmake ninja; do
-  if ! command -v "$tool" >/dev/null; then
-    echo "fuzz: $tool not found; run scripts/install-deps.sh" >&2
-    exit 1
-  fi
-done
-
 mkdir -p "$build"
-logs="$build/logs"
+logs="$build/fuzz-logs"
 mkdir -p "$logs"
 
-# A cache made with another compiler cannot be switched to clang in place: start it over.
-if [[ -f "$build/CMakeCache.txt" ]] && ! grep -q '^CMAKE_CXX_COMPILER:.*clang' "$build/CMakeCache.txt"; then
-  rm -rf "$build/CMakeCache.txt" "$build/CMakeFiles"
-fi
-if ! CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCAMPROJ_FUZZ=ON \
-    -DCAMPROJ_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" >"$logs/configure.log" 2>&1; then
-  cat "$logs/configure.log" >&2
-  echo "fuzz: configuring $build failed" >&2
-  exit 1
-fi
 targets=(points_csv camera_json fit_scene)
-if ! cmake --build "$build" --target "${targets[@]/%/_fuzzer}" >"$logs/build.log" 2>&1; then
+if ! bash "$root/scripts/build_sanitize.sh" "${targets[@]/%/_fuzzer}" >"$logs/build.log" 2>&1; then
   cat "$logs/build.log" >&2
-  echo "fuzz: building the fuzzers failed" >&2
+  echo "fuzz: building the fuzzers in $build failed" >&2
   exit 1
 fi
 
@@ -53,7 +36,7 @@ trap 'rm -rf "$work"' EXIT
 # for the camera-file reader its own size limit, 1 MiB: a deep nesting needs ~130 KB to crash a
 # recursive reader (issue #11); and 4 KiB for the fitter's scenes, which read ~400 bytes at most.
 # The fitter's -timeout is 60 s: a scene of random pixels takes LO-RANSAC ~0.6 s in Release and
-# ~10 s under the fuzz build's sanitizers (measured); a hang is far beyond either.
+# ~10 s under the sanitizers (measured); a hang is far beyond either.
 common=(-rss_limit_mb=2048)
 declare -A max_len=([points_csv]=65536 [camera_json]=1048576 [fit_scene]=4096)
 declare -A timeout=([points_csv]=10 [camera_json]=10 [fit_scene]=60)

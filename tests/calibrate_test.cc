@@ -409,7 +409,9 @@ TEST(CalibrateTest, SinglePointsThatDoNotFitAreLeftOutByName) {
       }
     }
     const Calibration c = Calibrate(moved, options);
-    for (const auto& [v, p] : bad) {
+    for (const auto& bad_point : bad) {
+      // Not a structured binding: a lambda may capture one only from C++20 (clang rejects it).
+      const int v = bad_point.first, p = bad_point.second;
       const bool found = std::any_of(c.outliers.begin(), c.outliers.end(), [&](const OutlierPoint& o) {
         return o.view == moved[v].name && o.id == std::to_string(p + 1) && o.residual_px > o.bound_px;
       });

@@ -16,6 +16,7 @@
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "seeds.h"
+#include "test_scenes.h"
 
 namespace camproj {
 namespace {
@@ -174,7 +175,7 @@ TEST(DeterminationTest, PredictsTheScatterOfRepeatedFits) {
   std::vector<double> mean_ratio(test.size(), 0.0);
   for (int trial = 0; trial < kTrials; ++trial) {
     std::vector<Eigen::Vector2d> pixels = reference.correspondences.pixels;
-    for (Eigen::Vector2d& u : pixels) u += Eigen::Vector2d(normal(rng), normal(rng));
+    for (Eigen::Vector2d& u : pixels) u += testing::DrawVector2([&] { return normal(rng); });
     FitOptions options = model;
     options.compute_uncertainty = false;
     const FitResult fit = FitCamera(points, pixels, reference.truth.image_size, options);

@@ -653,8 +653,8 @@ TEST(ExportWorldOriginTest, GlFacingExportsAreRelativeToTheOriginAndSaySo) {
   for (int i = 0; i < 50; ++i) {
     TestCamera test = MakeTestCamera(rng, i % 2 == 0, false, false);
     Camera& camera = test.camera;
-    const Eigen::Vector3d offset(testing::Uniform(rng, 1e5, 9e5), testing::Uniform(rng, 1e6, 9e6),
-                                 testing::Uniform(rng, -100, 1000));
+    const Eigen::Vector3d offset = testing::UniformVector3(rng, Eigen::Vector3d(1e5, 1e6, -100),
+                                                           Eigen::Vector3d(9e5, 9e6, 1000));
     camera.cam_from_world = camera.cam_from_world * Rigid3{Eigen::Matrix3d::Identity(), -offset};
     const std::string plain = ExportCamera(camera, ExportFormat::kGl);
     EXPECT_NE(plain.find("\n# world origin: none: "), std::string::npos) << plain;

@@ -118,7 +118,7 @@ double PixelNoise(std::mt19937_64& rng) { return OneIn(rng, 5) ? 0.0 : Uniform(r
 
 Eigen::Vector3d RandomDirection(std::mt19937_64& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  return testing::DrawVector3([&] { return normal(rng); }).normalized();
 }
 
 Eigen::Vector2d Gaussian2(std::mt19937_64& rng, double sigma) {
@@ -194,7 +194,8 @@ StressScene GoodScene(std::mt19937_64& rng, const testing::RandomCamera& camera,
 
 StressScene ExtremeScale(std::mt19937_64& rng) {
   const testing::RandomCamera camera = ProjectorCamera(rng);
-  StressScene s = GoodScene(rng, camera, NumPoints(rng), PixelNoise(rng));
+  const double noise = PixelNoise(rng);  // before the count (testing::DrawVector3 says why)
+  StressScene s = GoodScene(rng, camera, NumPoints(rng), noise);
   s.unscaled_points = s.points;
   // World times 2^k, k in [-660, 660] (1e-199 ... 1e199; the extremes and 2^+-40 ~ 1e+-12 named
   // in half the scenes): exact, so the fit must not change at all.
@@ -207,7 +208,8 @@ StressScene ExtremeScale(std::mt19937_64& rng) {
 
 StressScene LargeOffset(std::mt19937_64& rng) {
   const testing::RandomCamera camera = ProjectorCamera(rng);
-  StressScene s = GoodScene(rng, camera, NumPoints(rng), PixelNoise(rng));
+  const double noise = PixelNoise(rng);  // before the count (testing::DrawVector3 says why)
+  StressScene s = GoodScene(rng, camera, NumPoints(rng), noise);
   s.unmoved_points = s.points;
   const double named[] = {1e3, 1e6, 1e9, 1e12};
   const double factor =
@@ -228,7 +230,7 @@ StressScene NearDuplicates(std::mt19937_64& rng) {
   StressScene s = GoodScene(rng, camera, n, noise);
   std::normal_distribution<double> normal;
   auto nudged = [&](const Eigen::Vector3d& x) {  // moved by ~1e-12 of its norm
-    const Eigen::Vector3d step(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d step = testing::DrawVector3([&] { return normal(rng); });
     return Eigen::Vector3d(x + 1e-12 * x.norm() * step);
   };
   switch (UniformInt(rng, 0, 3)) {
@@ -325,8 +327,9 @@ StressScene WildPixels(std::mt19937_64& rng) {
     case 0: {  // pixels up to `reach` image sizes around the image
       const double reach = LogUniform(rng, 0.5, 10.0);
       for (int i = 0; i < n; ++i) {
-        const Eigen::Vector2d pixel(Uniform(rng, -reach, 1.0 + reach) * w,
-                                    Uniform(rng, -reach, 1.0 + reach) * h);
+        const Eigen::Vector2d pixel =
+            testing::DrawVector2([&] { return Uniform(rng, -reach, 1.0 + reach); })
+                .cwiseProduct(Eigen::Vector2d(w, h));
         s.points.push_back(PointAt(rng, camera, pixel));
         s.pixels.push_back(pixel + Gaussian2(rng, noise));
       }
@@ -334,8 +337,10 @@ StressScene WildPixels(std::mt19937_64& rng) {
       break;
     }
     case 1: {  // every pixel shifted by up to 20 image sizes, or by 1e9 px
-      const Eigen::Vector2d shift(OneIn(rng, 4) ? 1e9 : Uniform(rng, -20.0, 20.0) * w,
-                                  OneIn(rng, 4) ? -1e9 : Uniform(rng, -20.0, 20.0) * h);
+      // y before x (testing::DrawVector3 says why).
+      const double shift_y = OneIn(rng, 4) ? -1e9 : Uniform(rng, -20.0, 20.0) * h;
+      const double shift_x = OneIn(rng, 4) ? 1e9 : Uniform(rng, -20.0, 20.0) * w;
+      const Eigen::Vector2d shift(shift_x, shift_y);
       s = GoodScene(rng, camera, n, noise);
       for (auto& u : s.pixels) u += shift;
       s.description += ", pixels shifted by (" + Format("%.3g", shift.x()) + ", " +
@@ -351,7 +356,7 @@ StressScene WildPixels(std::mt19937_64& rng) {
       const Eigen::Vector2d principal(k.cx, k.cy);
       for (int i = 0; i < n; ++i) {
         const Eigen::Vector2d pixel =
-            principal + spread * Eigen::Vector2d(Uniform(rng, -0.5, 0.5), Uniform(rng, -0.5, 0.5));
+            principal + spread * testing::DrawVector2([&] { return Uniform(rng, -0.5, 0.5); });
         s.points.push_back(PointAt(rng, camera, pixel));
         s.pixels.push_back(pixel + Gaussian2(rng, noise));
       }
@@ -390,21 +395,27 @@ StressScene OneBadPoint(std::mt19937_64& rng) {
   StressScene s = GoodScene(rng, camera, n, PixelNoise(rng));
   const int i = UniformInt(rng, 0, n - 1);
   switch (UniformInt(rng, 0, 3)) {
-    case 0:  // a mis-click: 20 to 500 px off
-      s.pixels[i] += LogUniform(rng, 20.0, 500.0) * RandomDirection(rng).head<2>().normalized();
+    case 0: {  // a mis-click: 20 to 500 px off; the direction drawn before the distance
+               // (testing::DrawVector3 says why)
+      const Eigen::Vector2d direction = RandomDirection(rng).head<2>().normalized();
+      s.pixels[i] += LogUniform(rng, 20.0, 500.0) * direction;
       s.description += ", point " + std::to_string(i) + " mis-clicked";
       break;
+    }
     case 1:  // at the camera centre, its pixel anywhere
       s.points[i] = CameraCenterInWorld(camera.cam_from_world);
       s.pixels[i] = testing::RandomPixelInImage(rng, camera.size);
       s.description += ", point " + std::to_string(i) + " at the camera centre";
       break;
-    case 2:  // behind the camera, seen where the pinhole formula puts it
-      s.points[i] = testing::WorldPointAtPixel(
-          camera, testing::RandomPixelInImage(rng, camera.size), -Uniform(rng, 2.0, 4.0));
+    case 2: {  // behind the camera, seen where the pinhole formula puts it; the depth drawn
+               // before the pixel (testing::DrawVector3 says why)
+      const double depth = -Uniform(rng, 2.0, 4.0);
+      s.points[i] =
+          testing::WorldPointAtPixel(camera, testing::RandomPixelInImage(rng, camera.size), depth);
       s.pixels[i] = ThroughProjection(camera, s.points[i]);
       s.description += ", point " + std::to_string(i) + " behind the camera";
       break;
+    }
     default: {  // two pixels swapped
       const int j = UniformInt(rng, 0, n - 1);
       std::swap(s.pixels[i], s.pixels[j]);

@@ -20,6 +20,15 @@
 namespace camproj {
 namespace {
 
+// A pixel anywhere in a 1920 x 1080 image; y drawn before x, the order in which these tests'
+// scenes were drawn when written (GCC evaluates a call's arguments right to left; C++ leaves the
+// order unspecified).
+Eigen::Vector2d RandomPixel(std::mt19937_64& rng) {
+  const double y = std::uniform_real_distribution<double>(0, 1079)(rng);
+  const double x = std::uniform_real_distribution<double>(0, 1919)(rng);
+  return {x, y};
+}
+
 // A projector (lens shift to 0.4 of the image height below the centre) in front of a box, the
 // clicks rounded to whole pixels after 0.7 px of noise, as a person clicks corners.
 SynthScene Clicks(uint64_t seed, int num_points, SynthObject object = SynthObject::kBox) {
@@ -616,8 +625,7 @@ TEST(FitAutoTest, OutliersAreLeftOutWithoutOptions) {
       std::mt19937_64 rng(testing::Seed(seed));
       const int num_outliers = static_cast<int>(fraction * 100);
       for (int i = 0; i < num_outliers; ++i) {
-        pixels[i] = Eigen::Vector2d(std::uniform_real_distribution<double>(0, 1919)(rng),
-                                    std::uniform_real_distribution<double>(0, 1079)(rng));
+        pixels[i] = RandomPixel(rng);
       }
       const auto& points = scene.correspondences.points_in_world;
       FitResult fit;
@@ -655,8 +663,7 @@ TEST(FitAutoTest, RandomPixelsAreRefused) {
       SynthScene scene = Clicks(seed, n, SynthObject::kCloud);
       std::mt19937_64 rng(testing::Seed(seed));
       for (auto& u : scene.correspondences.pixels) {
-        u = Eigen::Vector2d(std::uniform_real_distribution<double>(0, 1919)(rng),
-                            std::uniform_real_distribution<double>(0, 1079)(rng));
+        u = RandomPixel(rng);
       }
       try {
         const FitResult fit = Auto(scene.correspondences.points_in_world, scene.correspondences.pixels);

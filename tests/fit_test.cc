@@ -203,10 +203,9 @@ RandomCamera ProjectorLikeCamera(std::mt19937_64& rng) {
   camera.intrinsics.fy = camera.intrinsics.fx * testing::Uniform(rng, 0.97, 1.03);
   camera.intrinsics.cx = testing::Uniform(rng, 500, 780);
   camera.intrinsics.cy = testing::Uniform(rng, 500, 799);
-  camera.cam_from_world =
-      CamFromWorldFromCenter(testing::RandomRotation(rng),
-                             Eigen::Vector3d(testing::Uniform(rng, -5, 5),
-                                             testing::Uniform(rng, -5, 5), testing::Uniform(rng, -5, 5)));
+  // The centre is drawn before the rotation (testing::DrawVector3 says why).
+  const Eigen::Vector3d center = testing::UniformVector3(rng, -5, 5);
+  camera.cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng), center);
   return camera;
 }
 
@@ -1047,9 +1046,10 @@ TEST(OrthographicFitTest, RecoversTheCameraAndReportsItsUncertainty) {
     truth.intrinsics.skew = truth.intrinsics.fx * testing::Uniform(rng, -0.05, 0.05);
     truth.intrinsics.cx = 639.5;
     truth.intrinsics.cy = 359.5;
-    truth.cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng),
-                                                  Eigen::Vector3d(testing::Uniform(rng, -5, 5),
-                                                                  testing::Uniform(rng, -5, 5), 50.0));
+    // The centre is drawn before the rotation (testing::DrawVector3 says why).
+    const Eigen::Vector2d center_xy = testing::DrawVector2([&] { return testing::Uniform(rng, -5, 5); });
+    const Eigen::Vector3d center(center_xy.x(), center_xy.y(), 50.0);
+    truth.cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng), center);
     const Rigid3 world_from_cam = Inverse(truth.cam_from_world);
     const double half_width = 600.0 / truth.intrinsics.fx;  // world units across half the image
     for (const double noise : {0.0, 0.5}) {
@@ -1057,12 +1057,12 @@ TEST(OrthographicFitTest, RecoversTheCameraAndReportsItsUncertainty) {
       std::vector<Eigen::Vector3d> points;
       std::vector<Eigen::Vector2d> pixels;
       for (int i = 0; i < 40; ++i) {
-        const Eigen::Vector3d in_cam(testing::Uniform(rng, -0.9, 0.9) * half_width,
-                                     testing::Uniform(rng, -0.5, 0.5) * half_width,
-                                     testing::Uniform(rng, 5, 5 + half_width));
+        const Eigen::Vector3d in_cam = testing::UniformVector3(
+            rng, Eigen::Vector3d(-0.9 * half_width, -0.5 * half_width, 5),
+            Eigen::Vector3d(0.9 * half_width, 0.5 * half_width, 5 + half_width));
         points.push_back(world_from_cam * in_cam);
         pixels.push_back(*PixelFromWorld(truth, points.back()) +
-                         Eigen::Vector2d(gaussian(rng), gaussian(rng)));
+                         testing::DrawVector2([&] { return gaussian(rng); }));
       }
       FitOptions options;
       options.projection = Projection::kOrthographic;

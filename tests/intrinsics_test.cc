@@ -76,8 +76,8 @@ TEST(IntrinsicsTest, RayFromPixelInvertsProjection) {
       k.k3 = testing::Uniform(rng, -0.05, 0.05);
     }
     // Normalized radius below 0.8 keeps d increasing for these k1, k2.
-    const Eigen::Vector3d point(testing::Uniform(rng, -0.5, 0.5), testing::Uniform(rng, -0.5, 0.5),
-                                1.0);
+    const Eigen::Vector3d point =
+        testing::DrawVector2([&] { return testing::Uniform(rng, -0.5, 0.5); }).homogeneous();
     const double depth = testing::LogUniform(rng, 0.01, 100);
     const Eigen::Vector2d pixel = PixelFromCam(k, depth * point);
     const Eigen::Vector3d ray = CamRayFromPixel(k, pixel);

@@ -53,10 +53,9 @@ TEST(LookAtTest, ViewMatrixEqualsGlmLookAt) {
 TEST(LookAtTest, PoseToLookAtAndBackIsExact) {
   std::mt19937_64 rng(testing::Seed(5));
   for (int i = 0; i < 1000; ++i) {
-    const Rigid3 cam_from_world = CamFromWorldFromCenter(
-        testing::RandomRotation(rng), Eigen::Vector3d(testing::Uniform(rng, -10, 10),
-                                                      testing::Uniform(rng, -10, 10),
-                                                      testing::Uniform(rng, -10, 10)));
+    // The centre is drawn before the rotation (testing::DrawVector3 says why).
+    const Eigen::Vector3d center = testing::UniformVector3(rng, -10, 10);
+    const Rigid3 cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng), center);
     const double distance = testing::LogUniform(rng, 1e-3, 1e3);
     const LookAt look_at = LookAtFromCamFromWorld(cam_from_world, distance);
     EXPECT_NEAR((look_at.target - look_at.eye).norm(), distance, kExactRelative * (distance + 10));

@@ -227,7 +227,11 @@ TEST(PointsFileTest, WritingThenReadingGivesBitIdenticalDoubles) {
                              123456789.125};
   auto next = [&](int i) {
     if (i % 3 == 0) return specials[static_cast<size_t>(i / 3) % std::size(specials)];
-    if (i % 3 == 1) return unit(rng) * std::pow(10.0, static_cast<int>(unit(rng) * 20));
+    if (i % 3 == 1) {
+      // Two statements: the order of a product's operands is unspecified.
+      const double mantissa = unit(rng);
+      return mantissa * std::pow(10.0, static_cast<int>(unit(rng) * 20));
+    }
     double value = 0;
     do {
       const uint64_t bits = any_bits(rng);

@@ -17,8 +17,7 @@ using testing::kExactRelative;
 TEST(PoseTest, InverseComposesToIdentityAndCentreMapsToOrigin) {
   std::mt19937_64 rng(testing::Seed(7));
   for (int i = 0; i < 100; ++i) {
-    const Eigen::Vector3d center(testing::Uniform(rng, -5, 5), testing::Uniform(rng, -5, 5),
-                                 testing::Uniform(rng, -5, 5));
+    const Eigen::Vector3d center = testing::UniformVector3(rng, -5, 5);
     const Rigid3 cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng), center);
     EXPECT_LT((CameraCenterInWorld(cam_from_world) - center).norm(), kExactRelative * 10);
     EXPECT_LT((cam_from_world * center).norm(), kExactRelative * 10);

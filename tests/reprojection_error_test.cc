@@ -21,8 +21,7 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
   std::mt19937_64 rng(testing::Seed(21));
   for (int i = 0; i < 500; ++i) {
     const Eigen::Quaterniond q(testing::RandomRotation(rng));
-    const Eigen::Vector3d center(testing::Uniform(rng, -2, 2), testing::Uniform(rng, -2, 2),
-                                 testing::Uniform(rng, -2, 2));
+    const Eigen::Vector3d center = testing::UniformVector3(rng, -2, 2);
     // Every slot non-zero, p1, p2 and k3 (OpenCV's lens) included.
     double intrinsics[internal::kFitIntrinsicsSize] = {
         testing::Uniform(rng, 300, 3000),  testing::Uniform(rng, 0.8, 1.2),
@@ -30,10 +29,10 @@ TEST(ReprojectionErrorTest, AnalyticJacobianMatchesAutomaticDifferentiation) {
         testing::Uniform(rng, -50, 50),    testing::Uniform(rng, -0.3, 0.3),
         testing::Uniform(rng, -0.1, 0.1),  testing::Uniform(rng, -0.01, 0.01),
         testing::Uniform(rng, -0.01, 0.01), testing::Uniform(rng, -0.05, 0.05)};
-    const Eigen::Vector3d point_in_cam(testing::Uniform(rng, -1, 1), testing::Uniform(rng, -1, 1),
-                                       testing::Uniform(rng, 1, 5));
+    const Eigen::Vector3d point_in_cam =
+        testing::UniformVector3(rng, Eigen::Vector3d(-1, -1, 1), Eigen::Vector3d(1, 1, 5));
     const Eigen::Vector3d point = q.inverse() * point_in_cam + center;
-    const Eigen::Vector2d observed(testing::Uniform(rng, 0, 2000), testing::Uniform(rng, 0, 2000));
+    const Eigen::Vector2d observed = testing::DrawVector2([&] { return testing::Uniform(rng, 0, 2000); });
 
     std::unique_ptr<ceres::CostFunction> automatic(internal::ReprojectionError::Create(point, observed));
     const internal::PointReprojectionCost analytic(point, observed);
@@ -74,9 +73,9 @@ TEST(ReprojectionErrorTest, RadialOnlyPathEqualsTheGeneralOneWithoutTangentialTe
         testing::Uniform(rng, -50, 50),   testing::Uniform(rng, -0.3, 0.3),
         testing::Uniform(rng, -0.1, 0.1), 0.0, 0.0, 0.0};
     ASSERT_TRUE(internal::RadialOnly(intrinsics));
-    const Eigen::Vector3d p(testing::Uniform(rng, -1, 1), testing::Uniform(rng, -1, 1),
-                            testing::Uniform(rng, 1, 5));
-    const Eigen::Vector2d observed(testing::Uniform(rng, 0, 2000), testing::Uniform(rng, 0, 2000));
+    const Eigen::Vector3d p =
+        testing::UniformVector3(rng, Eigen::Vector3d(-1, -1, 1), Eigen::Vector3d(1, 1, 5));
+    const Eigen::Vector2d observed = testing::DrawVector2([&] { return testing::Uniform(rng, 0, 2000); });
     double r_general[2], r_radial[2], jk_general[2 * kSize], jp_general[6], jp_radial[6];
     double jk_radial[2 * kSize];
     std::fill(jk_radial, jk_radial + 2 * kSize, -7.0);  // the unwritten columns keep this

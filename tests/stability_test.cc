@@ -331,10 +331,9 @@ Scenario FromIntrinsics(const Intrinsics& k, const ImageSize& size, uint64_t see
   testing::RandomCamera camera;
   camera.size = size;
   camera.intrinsics = k;
-  camera.cam_from_world = CamFromWorldFromCenter(
-      testing::RandomRotation(rng),
-      Eigen::Vector3d(testing::Uniform(rng, -5, 5), testing::Uniform(rng, -5, 5),
-                      testing::Uniform(rng, -5, 5)));
+  // The centre is drawn before the rotation (testing::DrawVector3 says why).
+  const Eigen::Vector3d center = testing::UniformVector3(rng, -5, 5);
+  camera.cam_from_world = CamFromWorldFromCenter(testing::RandomRotation(rng), center);
   testing::SceneOptions scene_options;
   scene_options.num_points = num_points;
   scene_options.pixel_noise = noise_px;
@@ -756,7 +755,7 @@ Row RunAutoOrthographic(const Case& c, const Scenario& s, double sigma) {
 Scenario WithNoise(Scenario s, double sigma, uint64_t seed) {
   std::mt19937_64 rng(testing::Seed(seed));
   std::normal_distribution<double> normal;
-  for (auto& pixel : s.pixels) pixel += sigma * Eigen::Vector2d(normal(rng), normal(rng));
+  for (auto& pixel : s.pixels) pixel += sigma * testing::DrawVector2([&] { return normal(rng); });
   s.noisy = true;
   return s;
 }
@@ -860,8 +859,7 @@ Scenario CameraInsideCloud() {
   s.points.clear();
   s.pixels.clear();
   while (front + back < 40) {
-    const Eigen::Vector3d direction =
-        Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Vector3d direction = testing::DrawVector3([&] { return normal(rng); }).normalized();
     const Eigen::Vector3d p = testing::Uniform(rng, 1.0, 2.0) * direction;  // in cam
     if (std::abs(p.z()) < 0.2) continue;
     const double slots[kIntrinsicsArraySize] = {s.truth.intrinsics.fx, s.truth.intrinsics.fy,

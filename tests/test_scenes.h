@@ -51,10 +51,43 @@ inline double LogUniform(std::mt19937_64& rng, double lo, double hi) {
   return std::exp(Uniform(rng, std::log(lo), std::log(hi)));
 }
 
+// Independent draws as a vector: `draw()` is called once per coordinate, the last coordinate
+// first. C++ leaves the order in which a call's arguments are evaluated unspecified (GCC: right
+// to left, clang: left to right), so Eigen::Vector3d(Uniform(rng, ...), ...) drew another scene
+// from the same seed with each compiler; last-first is the order the tests' scenes were drawn in
+// when they were written (GCC). A braced list {a(), b()} is evaluated left to right.
+template <typename Draw>
+Eigen::Vector2d DrawVector2(Draw&& draw) {
+  const double y = draw();
+  const double x = draw();
+  return {x, y};
+}
+template <typename Draw>
+Eigen::Vector3d DrawVector3(Draw&& draw) {
+  const double z = draw();
+  const double y = draw();
+  const double x = draw();
+  return {x, y, z};
+}
+
+// Each coordinate uniform in [lo, hi), in DrawVector3's order.
+inline Eigen::Vector3d UniformVector3(std::mt19937_64& rng, double lo, double hi) {
+  return DrawVector3([&] { return Uniform(rng, lo, hi); });
+}
+// Coordinate i uniform in [lo(i), hi(i)), in DrawVector3's order.
+inline Eigen::Vector3d UniformVector3(std::mt19937_64& rng, const Eigen::Vector3d& lo,
+                                      const Eigen::Vector3d& hi) {
+  const double z = Uniform(rng, lo.z(), hi.z());
+  const double y = Uniform(rng, lo.y(), hi.y());
+  const double x = Uniform(rng, lo.x(), hi.x());
+  return {x, y, z};
+}
+
 inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
   std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-  return q.normalized().toRotationMatrix();
+  // Drawn z, y, x, w (see DrawVector3).
+  const double z = normal(rng), y = normal(rng), x = normal(rng), w = normal(rng);
+  return Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
 }
 
 struct RandomCameraOptions {
@@ -91,9 +124,7 @@ inline RandomCamera MakeRandomCamera(std::mt19937_64& rng, const RandomCameraOpt
   k.cx = Uniform(rng, -options.max_principal_offset * w, (1.0 + options.max_principal_offset) * w);
   k.cy = Uniform(rng, -options.max_principal_offset * h, (1.0 + options.max_principal_offset) * h);
   k.skew = Uniform(rng, -options.max_skew_ratio, options.max_skew_ratio) * k.fx;
-  const Eigen::Vector3d center =
-      options.max_center_distance *
-      Eigen::Vector3d(Uniform(rng, -1, 1), Uniform(rng, -1, 1), Uniform(rng, -1, 1));
+  const Eigen::Vector3d center = options.max_center_distance * UniformVector3(rng, -1, 1);
   camera.cam_from_world = CamFromWorldFromCenter(RandomRotation(rng), center);
   return camera;
 }
@@ -166,7 +197,7 @@ inline Scene MakeScene(std::mt19937_64& rng, const RandomCamera& camera,
     scene.points_in_world.push_back(world_from_cam * (depth * ray));
     scene.true_pixels.push_back(PixelFromCam(camera.intrinsics, depth * ray));
     scene.observed_pixels.push_back(scene.true_pixels.back() +
-                                    options.pixel_noise * Eigen::Vector2d(noise(rng), noise(rng)));
+                                    options.pixel_noise * DrawVector2([&] { return noise(rng); }));
   }
   return scene;
 }

@@ -53,8 +53,8 @@ TEST(WorldOriginTest, RoundOriginRoundsToAPowerOfTenOfTheExtent) {
 TEST(WorldOriginTest, RoundedOriginLiesWithinHalfAStepPerAxis) {
   std::mt19937_64 rng(testing::Seed(1301));
   for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d center(testing::Uniform(rng, -1e7, 1e7), testing::Uniform(rng, -1e7, 1e7),
-                                 testing::Uniform(rng, -1e3, 1e3));
+    const Eigen::Vector3d center = testing::UniformVector3(rng, Eigen::Vector3d(-1e7, -1e7, -1e3),
+                                                           Eigen::Vector3d(1e7, 1e7, 1e3));
     const double extent = testing::LogUniform(rng, 1e-3, 1e5);
     const Eigen::Vector3d origin = RoundOrigin(center, extent);
     const double step = std::pow(10.0, std::floor(std::log10(extent)));
@@ -103,17 +103,15 @@ TEST(WorldOriginTest, ViewMatrixRelativeToTheOriginSeesTheSamePoints) {
   std::mt19937_64 rng(testing::Seed(1302));
   for (int i = 0; i < 500; ++i) {
     const testing::RandomCamera random = testing::MakeRandomCamera(rng);
-    const Eigen::Vector3d offset(testing::Uniform(rng, -1e7, 1e7), testing::Uniform(rng, -1e7, 1e7),
-                                 testing::Uniform(rng, -1e4, 1e4));
+    const Eigen::Vector3d offset = testing::UniformVector3(rng, Eigen::Vector3d(-1e7, -1e7, -1e4),
+                                                           Eigen::Vector3d(1e7, 1e7, 1e4));
     // The camera and its scene moved to survey coordinates.
     const Rigid3 cam_from_world = random.cam_from_world * Rigid3{Eigen::Matrix3d::Identity(), -offset};
     const Eigen::Vector3d origin = RoundOrigin(offset, 10.0);
     const Eigen::Matrix4d absolute = GlEyeFromWorld(cam_from_world);
     const Eigen::Matrix4d relative = GlEyeFromOriginWorld(cam_from_world, origin);
     EXPECT_EQ(Eigen::Matrix3d(relative.topLeftCorner<3, 3>()), Eigen::Matrix3d(absolute.topLeftCorner<3, 3>()));
-    const Eigen::Vector3d point = offset + Eigen::Vector3d(testing::Uniform(rng, -5, 5),
-                                                           testing::Uniform(rng, -5, 5),
-                                                           testing::Uniform(rng, -5, 5));
+    const Eigen::Vector3d point = offset + testing::UniformVector3(rng, -5, 5);
     const Eigen::Vector4d from_absolute = absolute * point.homogeneous();
     const Eigen::Vector4d from_relative = relative * (point - origin).homogeneous();
     const double tolerance =

@@ -99,6 +99,23 @@ class Rng {
     const double u2 = Uniform(0.0, 1.0);
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
   }
+  // Independent draws (each a fresh call of `draw`) as a vector, drawn last coordinate first.
+  // C++ leaves the order of a call's arguments unspecified (GCC goes right to left, clang left
+  // to right): Vector3d(draw(), draw(), draw()) would make other scenes with another compiler.
+  // Last-first is the order the published tables' scenes were drawn in (GCC).
+  template <typename Draw>
+  static Eigen::Vector2d Vector2(Draw&& draw) {
+    const double y = draw();
+    const double x = draw();
+    return {x, y};
+  }
+  template <typename Draw>
+  static Eigen::Vector3d Vector3(Draw&& draw) {
+    const double z = draw();
+    const double y = draw();
+    const double x = draw();
+    return {x, y, z};
+  }
   // The first k entries of a uniformly random permutation of 0..n-1 (partial Fisher-Yates).
   std::vector<int> Choose(int n, int k) {
     std::vector<int> v(n);
@@ -150,7 +167,7 @@ bool InteriorsOverlap(const Box& a, const Box& b) {
 std::vector<Box> GenerateBuilding(Rng& rng) {
   auto size = [&rng] { return rng.Uniform(0.5, 3.0); };
   std::vector<Box> boxes;
-  const Eigen::Vector3d first(size(), size(), size());
+  const Eigen::Vector3d first = Rng::Vector3(size);
   boxes.push_back({Eigen::Vector3d(-0.5 * first.x(), -0.5 * first.y(), 0.0),
                    Eigen::Vector3d(0.5 * first.x(), 0.5 * first.y(), first.z())});
   const int count = rng.UniformInt(1, 3);
@@ -176,7 +193,7 @@ std::vector<Box> GenerateBuilding(Rng& rng) {
       const int axis = rng.UniformInt(0, 1);
       const int other = 1 - axis;
       const bool positive = rng.Uniform(0.0, 1.0) < 0.5;
-      const Eigen::Vector3d s(size(), size(), size());
+      const Eigen::Vector3d s = Rng::Vector3(size);
       if (positive) {
         box.lo(axis) = neighbour.hi(axis);
       } else {
@@ -335,8 +352,9 @@ std::optional<Camera> PlaceProjector(const std::vector<Box>& boxes, Rng& rng,
     const double horizontal = std::sqrt(distance * distance - dz * dz);
     const Eigen::Vector3d eye(centre.x() + horizontal * std::cos(azimuth),
                               centre.y() + horizontal * std::sin(azimuth), eye_z);
-    const Eigen::Vector2d target(0.5 * (width - 1) + rng.Uniform(-0.1, 0.1) * width,
-                                 0.5 * (height - 1) + rng.Uniform(-0.1, 0.1) * height);
+    const Eigen::Vector2d target =
+        Eigen::Vector2d(0.5 * (width - 1), 0.5 * (height - 1)) +
+        Rng::Vector2([&rng] { return rng.Uniform(-0.1, 0.1); }).cwiseProduct(Eigen::Vector2d(width, height));
     const Eigen::Matrix3d look =
         CamFromWorldFromLookAt({eye, centre, Eigen::Vector3d::UnitZ()}).rotation;
     const Eigen::Vector3d ray((target.x() - k.cx) / f, (target.y() - k.cy) / f, 1.0);
@@ -528,8 +546,8 @@ Case MakeCase(const std::vector<Band>& bands, int band_index, int index) {
           pick -= FaceArea(c.scene.boxes, toward[f]);
           ++f;
         }
-        const Eigen::Vector3d p =
-            PointOnFace(c.scene.boxes, toward[f], rng.Uniform(0.0, 1.0), rng.Uniform(0.0, 1.0));
+        const Eigen::Vector2d on_face = Rng::Vector2([&rng] { return rng.Uniform(0.0, 1.0); });
+        const Eigen::Vector3d p = PointOnFace(c.scene.boxes, toward[f], on_face.x(), on_face.y());
         if (!Occluded(c.scene.boxes, p, c.scene.eye)) {
           c.points.push_back(p);
           ++per_direction[2 * toward[f].axis + (toward[f].side > 0 ? 1 : 0)];

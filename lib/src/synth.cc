@@ -29,6 +29,22 @@ double Normal(std::mt19937_64& rng) {
   return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kPi * v);
 }
 
+// Vectors of independent draws, drawn last coordinate first. C++ leaves the order in which a
+// call's arguments are evaluated unspecified (GCC goes right to left, clang left to right), so
+// Vector3d(Uniform(rng, ...), ...) would make another scene from the same seed with another
+// compiler; last-first is the order the files written so far (GCC) were drawn in.
+Eigen::Vector3d UniformVector3(std::mt19937_64& rng, double lo, double hi) {
+  const double z = Uniform(rng, lo, hi);
+  const double y = Uniform(rng, lo, hi);
+  const double x = Uniform(rng, lo, hi);
+  return {x, y, z};
+}
+Eigen::Vector2d NormalVector2(std::mt19937_64& rng) {
+  const double y = Normal(rng);
+  const double x = Normal(rng);
+  return {x, y};
+}
+
 }  // namespace
 
 void SynthOptions::Check() const {
@@ -82,7 +98,7 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
   const Eigen::Vector3d plane_u = plane_normal.unitOrthogonal();
   const Eigen::Vector3d plane_v = plane_normal.cross(plane_u);
   while (static_cast<int>(points.size()) < options.num_points) {
-    Eigen::Vector3d x(Uniform(rng, -1, 1), Uniform(rng, -1, 1), Uniform(rng, -1, 1));
+    Eigen::Vector3d x = UniformVector3(rng, -1, 1);
     if (options.object == SynthObject::kCloud) {
       points.push_back(x.cwiseProduct(half));
     } else if (options.object == SynthObject::kPlane) {
@@ -138,7 +154,7 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
     const Eigen::Vector3d p = camera.cam_from_world * points[i];
     min_depth = std::min(min_depth, p.z());
     max_depth = std::max(max_depth, p.z());
-    const Eigen::Vector2d noise(Normal(rng), Normal(rng));
+    const Eigen::Vector2d noise = NormalVector2(rng);
     c.points_in_world.push_back(points[i]);
     c.pixels.push_back(PixelFromCam(k, p) + options.noise_px * noise);
     c.ids.push_back(std::to_string(i + 1));
@@ -211,7 +227,7 @@ std::vector<CalibrationView> SynthesizeCalibrationViews(const CalibrationSynthOp
     }
     if (!inside) continue;
     for (auto& pixel : view.pixels) {
-      pixel += options.noise_px * Eigen::Vector2d(Normal(rng), Normal(rng));
+      pixel += options.noise_px * NormalVector2(rng);
     }
     views.push_back(std::move(view));
   }

@@ -22,7 +22,6 @@ enum Group { kPrincipalPoint, kAspect, kSkew, kK1, kK2, kNumGroups };
 const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew", "k1", "k2"};
 // FitResult::fixed_parameters' name of each group.
 const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
-const int kGroupSize[kNumGroups] = {2, 1, 1, 1, 1};
 
 ParameterMode& ModeOf(FitOptions& options, int group) {
   switch (group) {
