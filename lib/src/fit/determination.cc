@@ -41,6 +41,12 @@ constexpr double kRivalBoxThickness = 0.25;
 // up to this far above the returned model's BIC: weight exp(-13.8 / 2) = 1e-3 of its.
 constexpr double kAveragedCriterion = 13.8;
 
+// The chosen model refitted from another start (fit/other_minima.h) that lands within this of
+// the returned camera at every test point has found the same minimum again, not another: LM's
+// runs into one minimum agree to ~1e-12 px (seen: 2.5e-12 px, then named as the rival that
+// "moves a point by 2.5e-12 px"), and no reading of clicked pixels turns on a micro-pixel.
+constexpr double kSameMinimumPx = 1e-6;
+
 // A point whose leverage is within this of 1 in some direction is one the others cannot predict
 // there (their fit moves with it): its leave-one-out error counts as at this leverage, so that
 // PRESS stays finite and one such point does not decide it alone.
@@ -464,6 +470,16 @@ struct FittedRival {
   double weight;       // in the model average, relative to the returned model's 1 (0: not in it)
 };
 
+// True if `other` puts every point of `test` within kSameMinimumPx of where `camera` does.
+bool SameMinimum(const Camera& camera, const Camera& other, const std::vector<Eigen::Vector3d>& test) {
+  for (const Eigen::Vector3d& x : test) {
+    const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, x);
+    const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(other, x);
+    if (!ours || !theirs || !((*theirs - *ours).norm() <= kSameMinimumPx)) return false;
+  }
+  return true;
+}
+
 // The model average (DeterminationCheck::averaged_sigma_px): at each point of `around` that is
 // not a fitted one, the mixture of `camera` (weight 1) and every rival with a weight, each with
 // its own sigma there. Not at the fitted points: every model in the average is pinned there by
@@ -629,6 +645,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     // world about the centroid, whose mirror image is the mirrored points' centroid.
     const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
     const Camera rival_camera = InUnitWorld(rival.camera, flip.asDiagonal() * origin, unit);
+    if (rival.same_model && SameMinimum(camera, rival_camera, test)) continue;
     try {
       fitted.push_back({&rival, rival_camera,
                         PixelUncertainty(rival_camera, rival.options, points, sigma,
