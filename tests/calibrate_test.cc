@@ -78,6 +78,49 @@ void ExpectTrueIntrinsics(const Intrinsics& k) {
   EXPECT_NEAR(k.k2, t.k2, kExact);
 }
 
+// The model names of `camproj calibrate --model` / --fix.
+TEST(CalibrateTest, OptionsForModelFreeExactlyTheGroupsNamed) {
+  const CalibrateOptions automatic = CalibrateOptionsForModel("auto", {"k2"});
+  EXPECT_TRUE(automatic.select_model);
+  EXPECT_TRUE(automatic.principal_point_free && automatic.aspect_free && automatic.tangential_free);
+  EXPECT_FALSE(automatic.skew_free);   // never a candidate of auto
+  EXPECT_EQ(automatic.num_radial, 1);  // fixing k2 holds k3 too
+  EXPECT_EQ(CalibrateOptionsForModel("auto", {"k1"}).num_radial, 0);
+
+  const CalibrateOptions opencv = CalibrateOptionsForModel("opencv", {});
+  EXPECT_FALSE(opencv.select_model);
+  EXPECT_TRUE(opencv.principal_point_free && opencv.aspect_free && opencv.tangential_free);
+  EXPECT_FALSE(opencv.skew_free);
+  EXPECT_EQ(opencv.num_radial, 3);
+
+  const CalibrateOptions listed = CalibrateOptionsForModel("focal+skew+k1+k2", {"aspect"});
+  EXPECT_FALSE(listed.select_model || listed.principal_point_free || listed.aspect_free ||
+               listed.tangential_free);
+  EXPECT_TRUE(listed.skew_free);
+  EXPECT_EQ(listed.num_radial, 2);
+  const CalibrateOptions focal = CalibrateOptionsForModel("focal", {});
+  EXPECT_FALSE(focal.principal_point_free || focal.aspect_free || focal.skew_free ||
+               focal.tangential_free);
+  EXPECT_EQ(focal.num_radial, 0);
+
+  auto message = [](const std::string& model, const std::vector<std::string>& fixed) {
+    try {
+      CalibrateOptionsForModel(model, fixed);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no exception");
+  };
+  EXPECT_EQ(message("k2", {}), "k2 needs k1 too");
+  EXPECT_EQ(message("k1+k3", {}), "k3 needs k2 too");
+  EXPECT_EQ(message("opencv", {"k3"}), "k3 is both freed and fixed");
+  EXPECT_EQ(message("k1+k2", {"k1"}), "k1 is both freed and fixed");
+  EXPECT_EQ(message("k1+k2+k3", {"k2"}), "k2 is both freed and fixed");
+  EXPECT_EQ(message("aspect+k3", {"k2"}), "k3 is both freed and fixed");  // held by k2
+  EXPECT_NE(message("k4", {}).find("unknown group \"k4\""), std::string::npos);
+  EXPECT_NE(message("auto", {"lens"}).find("unknown group \"lens\" to fix"), std::string::npos);
+}
+
 TEST(CalibrateTest, NoiseFreePlanarViewsGiveTheCameraExactly) {
   const std::vector<CalibrationView> views = Views(Seed(1), 5, true, 0.0);
   const Calibration c = Calibrate(views, Options());

@@ -1121,7 +1121,7 @@ PY
     expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model k2 -o "$work/bad.json"
     expect_in err "--model k2: k2 needs k1 too"
     expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model opencv --fix k3 -o "$work/bad.json"
-    expect_in err "--model opencv frees k3 but --fix holds it"
+    expect_in err "--model opencv --fix k3: k3 is both freed and fixed"
     [[ ! -e "$work/bad.json" ]] || fail "a bad --model wrote a file"
     expect_not_in out "^refused view"
     ;;

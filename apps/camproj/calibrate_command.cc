@@ -32,52 +32,15 @@ struct CalibrateArgs {
   std::string pixel_origin = "center";
 };
 
-// The model --model and --fix ask for: with auto, every group a candidate but those fixed; else
-// exactly the groups listed (a fixed one among them is a contradiction).
+// The model --model and --fix ask for (CalibrateOptionsForModel); a bad one names both flags.
 CalibrateOptions ModelOptions(const std::string& model, const std::vector<std::string>& fix) {
-  CalibrateOptions options;
-  std::vector<std::string> groups;
-  if (model == "auto" || model == "opencv") {
-    // Skew is no candidate of auto: sensors have square grids, and a fitted skew takes up other
-    // model errors (the left chessboards: 0.39 +- 0.12 px at BIC -4.3, docs/calibration.md).
-    groups = {"principal-point", "aspect", "k1", "k2", "tangential", "k3"};
-  } else {
-    std::stringstream list(model);
-    for (std::string group; std::getline(list, group, '+');) groups.push_back(group);
+  try {
+    return CalibrateOptionsForModel(model, fix);
+  } catch (const std::invalid_argument& e) {
+    std::string flags = "--model " + model;
+    for (size_t i = 0; i < fix.size(); ++i) flags += (i == 0 ? " --fix " : ",") + fix[i];
+    throw std::invalid_argument(flags + ": " + e.what());
   }
-  options.select_model = model == "auto";
-  options.aspect_free = options.principal_point_free = options.skew_free = false;
-  options.tangential_free = false;
-  options.num_radial = 0;
-  for (const std::string& group : groups) {
-    const bool fixed = std::find(fix.begin(), fix.end(), group) != fix.end() ||
-                       ((group == "k2" || group == "k3") &&
-                        std::find(fix.begin(), fix.end(), "k1") != fix.end()) ||
-                       (group == "k3" && std::find(fix.begin(), fix.end(), "k2") != fix.end());
-    if (fixed && model != "auto") {
-      throw std::invalid_argument("--model " + model + " frees " + group + " but --fix holds it");
-    }
-    if (fixed) continue;
-    if (group == "principal-point") options.principal_point_free = true;
-    else if (group == "aspect") options.aspect_free = true;
-    else if (group == "skew") options.skew_free = true;
-    else if (group == "tangential") options.tangential_free = true;
-    else if (group == "k1") options.num_radial = std::max(options.num_radial, 1);
-    else if (group == "k2" || group == "k3") {
-      const int terms = group == "k2" ? 2 : 3;
-      if (model != "auto" && model != "opencv" &&
-          std::find(groups.begin(), groups.end(), terms == 2 ? "k1" : "k2") == groups.end()) {
-        throw std::invalid_argument("--model " + model + ": " + group + " needs " +
-                                    (terms == 2 ? "k1" : "k2") + " too");
-      }
-      options.num_radial = std::max(options.num_radial, terms);
-    } else if (group != "focal") {
-      throw std::invalid_argument("--model: unknown group \"" + group + "\"; expected auto, opencv "
-                                  "or groups among principal-point, aspect, skew, k1, k2, "
-                                  "tangential, k3 joined by '+'");
-    }
-  }
-  return options;
 }
 
 // Calibrate's own minimum (calibrate.h), checked here first so that the message can name the

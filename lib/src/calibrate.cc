@@ -925,6 +925,13 @@ bool IsFreeIn(const char* group_name, const CalibrateOptions& options) {
   return false;
 }
 
+const LadderGroup* FindGroup(const std::string& name) {
+  for (const LadderGroup& group : kLadder) {
+    if (name == group.name) return &group;
+  }
+  return nullptr;
+}
+
 // "+1.234" / "-1.234".
 std::string Signed(double value) {
   std::ostringstream text;
@@ -934,6 +941,57 @@ std::string Signed(double value) {
 }
 
 }  // namespace
+
+CalibrateOptions CalibrateOptionsForModel(const std::string& model,
+                                          const std::vector<std::string>& fixed) {
+  const bool automatic = model == "auto";
+  const bool opencv = model == "opencv";
+  std::vector<std::string> groups;
+  if (automatic || opencv) {
+    groups = {"principal-point", "aspect", "k1", "k2", "tangential", "k3"};
+  } else {
+    std::stringstream list(model);
+    for (std::string group; std::getline(list, group, '+');) groups.push_back(group);
+  }
+  auto listed = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  const std::string expected =
+      "expected groups among principal-point, aspect, skew, k1, k2, tangential, k3";
+  for (const std::string& name : fixed) {
+    if (!FindGroup(name)) throw std::invalid_argument("unknown group \"" + name + "\" to fix; " + expected);
+  }
+  // A fixed group holds every group that needs it: k1 holds k2 and k3, k2 holds k3.
+  auto is_fixed = [&](const LadderGroup& group) {
+    for (const LadderGroup* g = &group; g; g = g->needs ? FindGroup(g->needs) : nullptr) {
+      if (listed(fixed, g->name)) return true;
+    }
+    return false;
+  };
+  CalibrateOptions options;
+  options.select_model = automatic;
+  options.aspect_free = options.principal_point_free = options.skew_free = false;
+  options.tangential_free = false;
+  options.num_radial = 0;
+  for (const std::string& name : groups) {
+    if (name == "focal") continue;  // always free
+    const LadderGroup* group = FindGroup(name);
+    if (!group) {
+      throw std::invalid_argument("unknown group \"" + name + "\"; expected auto, opencv or " +
+                                  expected.substr(std::string("expected ").size()) +
+                                  " joined by '+'");
+    }
+    if (is_fixed(*group)) {
+      if (automatic) continue;  // not a candidate
+      throw std::invalid_argument(name + " is both freed and fixed");
+    }
+    if (group->needs && !automatic && !opencv && !listed(groups, group->needs)) {
+      throw std::invalid_argument(name + " needs " + group->needs + " too");
+    }
+    group->free(&options);
+  }
+  return options;
+}
 
 CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& views,
                                         const CalibrateOptions& options,

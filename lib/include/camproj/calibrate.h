@@ -1,8 +1,8 @@
 // Calibration from many views (issue #14): one camera or projector seen in several views of known
 // points — a chessboard moved in front of it, or a 3D rig — with its intrinsics shared by every
 // view and one pose per view, refined jointly by Ceres. Conventions: docs/conventions.md; the
-// intrinsics are the fitter's pinhole with two radial terms (intrinsics.h): OpenCV's model with
-// p1 = p2 = k3 = 0.
+// intrinsics are the fitter's pinhole with OpenCV's lens (intrinsics.h): k1, k2, p1, p2, k3, each
+// free only where the options say.
 //
 // What runs (docs/calibration.md):
 //   start      planar views: a homography each, then Zhang's closed form for K (pixels scaled to
@@ -186,6 +186,19 @@ struct Calibration {
 // determine the free intrinsics (fewer equations than unknowns, or no closed-form start: say
 // which intrinsics to fix), kNumerical when the refinement fails.
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options);
+
+// The options of a model named by its intrinsics groups (`camproj calibrate --model`, --fix):
+//   "auto"    select_model on, every ladder group a candidate but skew (sensors have square
+//             grids, and a fitted skew takes up other model errors) and those `fixed`;
+//   "opencv"  cv::calibrateCamera's default model: principal point, aspect, k1, k2, tangential
+//             (p1, p2), k3 free;
+//   groups    among focal, principal-point, aspect, skew, k1, k2, tangential, k3 joined by '+':
+//             exactly those free (k2 needs k1, k3 needs k2: the ladder's order).
+// Fixing k1 fixes k2 and k3, fixing k2 fixes k3. Throws std::invalid_argument naming the group:
+// an unknown one, a radial term without the one before it, or (but for auto) one both freed and
+// fixed. image_size and the other options keep their defaults.
+CalibrateOptions CalibrateOptionsForModel(const std::string& model,
+                                          const std::vector<std::string>& fixed);
 
 // The model ladder across views (CalibrateOptions::select_model; docs/calibration.md). From the
 // focal length alone (square pixels, the principal point at the image centre, no skew, no lens)
