@@ -66,9 +66,10 @@ inline double RmsRowLength(const Eigen::MatrixXd& centred) {
 // What a fit may leave out when the model selection only scores it (fit/candidate.h). The
 // default leaves out nothing: every FitCamera call.
 struct FitEffort {
-  // Skip the refinement's restarts from beyond the image's edges (radial distortion with the
-  // principal point free; refine.cc) when the best fit's sum of squares is within the
-  // chi-square quantile at this pixel sigma.
+  // Skip the refinement's restarts (from the image centre after a DLT start at few points;
+  // from beyond the image's edges with radial distortion and the principal point free;
+  // refine.cc) when the best fit's sum of squares is within the chi-square quantile at this
+  // pixel sigma.
   std::optional<double> skip_restarts_when_consistent_at_px;
   // Check the covariance's linearization (FitResult::linearity; assess.cc).
   bool check_linearity = true;
