@@ -956,10 +956,11 @@ CalibrateOptions CalibrateOptionsForModel(const std::string& model,
   auto listed = [](const std::vector<std::string>& names, const std::string& name) {
     return std::find(names.begin(), names.end(), name) != names.end();
   };
-  const std::string expected =
-      "expected groups among principal-point, aspect, skew, k1, k2, tangential, k3";
+  const std::string kGroups = "groups among principal-point, aspect, skew, k1, k2, tangential, k3";
   for (const std::string& name : fixed) {
-    if (!FindGroup(name)) throw std::invalid_argument("unknown group \"" + name + "\" to fix; " + expected);
+    if (!FindGroup(name)) {
+      throw std::invalid_argument("unknown group \"" + name + "\" to fix; expected " + kGroups);
+    }
   }
   // A fixed group holds every group that needs it: k1 holds k2 and k3, k2 holds k3.
   auto is_fixed = [&](const LadderGroup& group) {
@@ -978,8 +979,7 @@ CalibrateOptions CalibrateOptionsForModel(const std::string& model,
     const LadderGroup* group = FindGroup(name);
     if (!group) {
       throw std::invalid_argument("unknown group \"" + name + "\"; expected auto, opencv or " +
-                                  expected.substr(std::string("expected ").size()) +
-                                  " joined by '+'");
+                                  kGroups + " joined by '+'");
     }
     if (is_fixed(*group)) {
       if (automatic) continue;  // not a candidate
