@@ -78,8 +78,8 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
     // (seen at 6 points: cy 96 px for 540). Refine also from the image centre (SQPnP pose for
     // the DLT's focal length there) and keep the lower cost. A candidate of the model selection
     // whose first fit is already consistent with the noise skips it (FitEffort): on the click
-    // benchmark the same silent failures and answers but one in 4400 scenes, at 9 % fewer
-    // instructions for the default path at N = 6 and 24 % at N = 12 (docs/bench/stage_cost.md).
+    // benchmark the same silent failures and answers but one in 4400 scenes, at 11 / 21 / 24 %
+    // fewer instructions for the default path at N = 6 / 8 / 12 (docs/bench/stage_cost.md).
     Model centred = start.model;
     centred.value[2] = scene.model.value[2];
     centred.value[3] = scene.model.value[3];
