@@ -5,10 +5,9 @@
 #include <limits>
 
 #include <Eigen/Dense>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core.hpp>
 
 #include "camproj/fit.h"
+#include "fit/sqpnp.h"
 
 namespace camproj {
 namespace internal {
@@ -64,36 +63,12 @@ Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
 
 namespace {
 
-std::vector<cv::Point3d> ToCv(const std::vector<Eigen::Vector3d>& points) {
-  std::vector<cv::Point3d> out;
-  out.reserve(points.size());
-  for (const auto& p : points) out.emplace_back(p.x(), p.y(), p.z());
-  return out;
-}
-
-// SQPnP on normalized image coordinates (x, y) = (X/Z, Y/Z): K = I.
-bool SqPnp(const std::vector<Eigen::Vector3d>& points, const std::vector<cv::Point2d>& normalized,
-           StartCamera* start) {
-  if (points.size() < 3) return false;
-  cv::Mat rvec;
-  cv::Mat tvec;
-  bool ok = false;
-  try {
-    ok = cv::solvePnP(ToCv(points), normalized, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
-                      false, cv::SOLVEPNP_SQPNP);
-  } catch (const cv::Exception&) {
-    return false;
-  }
-  if (!ok) return false;
-  cv::Mat r;
-  cv::Rodrigues(rvec, r);
+// SQPnP on normalized image coordinates (x, y) = (X/Z, Y/Z): K = I (fit/sqpnp.h).
+bool SqPnp(const std::vector<Eigen::Vector3d>& points,
+           const std::vector<Eigen::Vector2d>& normalized, StartCamera* start) {
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation;
-  for (int i = 0; i < 3; ++i) {
-    translation(i) = tvec.at<double>(i);
-    for (int j = 0; j < 3; ++j) rotation(i, j) = r.at<double>(i, j);
-  }
-  if (!rotation.allFinite() || !translation.allFinite()) return false;
+  if (!SolveSqPnp(points, normalized, &rotation, &translation)) return false;
   start->rotation = rotation;
   start->center = -rotation.transpose() * translation;
   return true;
@@ -277,7 +252,7 @@ bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
 bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
               StartCamera* start) {
-  std::vector<cv::Point2d> normalized;
+  std::vector<Eigen::Vector2d> normalized;
   normalized.reserve(pixels.size());
   try {
     for (const auto& pixel : pixels) {

@@ -53,8 +53,8 @@ bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
                      const Eigen::Matrix3d& plane_basis, const Intrinsics& guess, bool focal_free,
                      bool aspect_free, StartCamera* start);
 
-// Pose from known intrinsics (distortion included) by OpenCV's SQPnP, >= 3 points.
-// Returns false if SQPnP fails.
+// Pose from known intrinsics (distortion included) by SQPnP (fit/sqpnp.h: OpenCV's
+// SOLVEPNP_SQPNP pose), >= 3 points. Returns false if SQPnP refuses.
 bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
               StartCamera* start);
