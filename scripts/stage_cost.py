@@ -115,10 +115,9 @@ STAGES = [
 ]
 # Parts of the stages above, shown separately: (key, label, predicate).
 PARTS = [
-    ("second", "every fit below 20 points: the second start's SQPnP (refine.cc, as at "
-     + BASELINE_REV + ")",
-     lambda a, b: (a == "camproj::internal::RefineCamera()"
-                   and b == "camproj::internal::PnpStart()")),
+    ("sqpnp", "every SQPnP pose (fit/sqpnp.cc: the focal sweep, the DLT's second start, the "
+     "mirror test's and the other minima's starts)",
+     lambda a, b: b == "camproj::internal::SolveSqPnp()"),
 ]
 
 
