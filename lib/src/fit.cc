@@ -113,7 +113,9 @@ FitResult Fit(const std::vector<Eigen::Vector3d>& points_in_world,
     return result;
   }
 
-  const internal::Start start = internal::ClosedFormStart(scene, options, start_time);
+  const internal::Start start = effort.warm_start
+                                    ? internal::WarmStart(scene, *effort.warm_start)
+                                    : internal::ClosedFormStart(scene, options, start_time);
   internal::RefinedCamera refined =
       internal::RefineCamera(scene, start, options, effort, start_time);
   FitResult result = internal::AssessFit(scene, start.method, std::move(refined), options, effort);
@@ -134,10 +136,11 @@ namespace internal {
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px) {
+                       double consistent_at_px, const Camera* warm_start) {
   Require(std::isfinite(consistent_at_px) && consistent_at_px > 0.0,
           "a candidate's noise must be positive (px), got ", consistent_at_px);
   FitEffort effort;
+  if (warm_start != nullptr) effort.warm_start = *warm_start;
   effort.skip_restarts_when_consistent_at_px = consistent_at_px;
   effort.check_linearity = false;
   return Fit(points_in_world, observed_pixels, image_size, options, effort);

@@ -1,5 +1,7 @@
 // FitCamera as the model selection scores a candidate model (private): the same stages and the
-// same result, except for two things a candidate does not need (fit/common.h, FitEffort).
+// same result, except for two things a candidate does not need (fit/common.h, FitEffort), and
+// that a candidate one group richer than the ladder's current model starts where that model's
+// fit ended (fit/start.h, WarmStart) instead of at a closed form.
 //
 // With radial distortion and the principal point free, the refinement also restarts from a
 // principal point beyond each edge of the image (refine.cc: minima on either side of a principal
@@ -11,6 +13,12 @@
 //
 // Nor does a candidate check its covariance's linearization (FitResult::linearity, 2p more
 // evaluations of the residuals): the chosen model's fit reports it.
+//
+// The warm start leaves out the closed form (at 6 points the DLT, its pose re-solved, and the
+// second start from the image centre) and reaches the same minimum wherever the scene has one
+// (tests/candidate_test.cc); where it has several, the nested model's minimum is the one the
+// ladder asks about: whether freeing the group pays at this camera. The chosen model is
+// refitted from scratch, restarts included.
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
@@ -24,11 +32,13 @@ namespace camproj {
 namespace internal {
 
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`
-// (> 0, px per axis) and FitResult::linearity not checked.
+// (> 0, px per axis) and FitResult::linearity not checked; from `warm_start` (a camera of a
+// model nested in this one, fitted to the same points) instead of the closed form when it is
+// not null.
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px);
+                       double consistent_at_px, const Camera* warm_start = nullptr);
 
 }  // namespace internal
 }  // namespace camproj

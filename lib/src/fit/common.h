@@ -73,6 +73,8 @@ struct FitEffort {
   std::optional<double> skip_restarts_when_consistent_at_px;
   // Check the covariance's linearization (FitResult::linearity; assess.cc).
   bool check_linearity = true;
+  // Start at this camera (fit/start.h, WarmStart) instead of the closed form.
+  std::optional<Camera> warm_start;
 };
 
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest

@@ -47,12 +47,13 @@ struct Evaluation {
 // (fit/candidate.h).
 Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
-                    const FitOptions& options, double consistent_at_px) {
+                    const FitOptions& options, double consistent_at_px,
+                    const Camera* warm_start = nullptr) {
   Evaluation e;
   e.options = options;
   e.num_params = NumParameters(options);
   try {
-    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px);
+    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, warm_start);
     e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
   } catch (const SceneError& error) {
@@ -139,9 +140,9 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // one, else the prior until the selection's own noise is known.
   double candidate_sigma = options.fit.pixel_sigma.value_or(options.prior_sigma_px);
   // One model fitted: the prefit's fit where it is that model.
-  auto evaluate = [&](const FitOptions& model) {
+  auto evaluate = [&](const FitOptions& model, const Camera* warm_start = nullptr) {
     if (prefit == nullptr || !SameModel(prefit->model, model)) {
-      return Evaluate(points, pixels, image_size, model, candidate_sigma);
+      return Evaluate(points, pixels, image_size, model, candidate_sigma, warm_start);
     }
     Evaluation e;
     e.options = model;
@@ -310,7 +311,8 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
           tried.push_back(c);
           continue;
         }
-        Evaluation trial = evaluate(trial_options);
+        Evaluation trial = evaluate(
+            trial_options, ladder.final.fit ? &ladder.final.fit->camera : nullptr);
         if (!trial.fit) {
           ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
                                    trial.refusal + ")";

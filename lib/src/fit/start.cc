@@ -9,9 +9,11 @@
 
 #include <Eigen/Core>
 
+#include "camproj/pose.h"
 #include "check.h"
 #include "fit/common.h"
 #include "fit/least_squares.h"
+#include "fit/reading.h"
 
 namespace camproj {
 namespace internal {
@@ -185,6 +187,17 @@ Start ClosedFormStart(const Scene& scene, const FitOptions& options,
       }
     }
   }
+  return start;
+}
+
+Start WarmStart(const Scene& scene, const Camera& fitted) {
+  Start start;
+  start.method = "warm";
+  start.camera.rotation = fitted.cam_from_world.rotation;
+  start.camera.center =
+      (CameraCenterInWorld(fitted.cam_from_world) - scene.centroid) / scene.scale;
+  start.camera.intrinsics = fitted.intrinsics;
+  start.model = ModelAt(scene.model, fitted.intrinsics);
   return start;
 }
 

@@ -38,6 +38,13 @@ struct Start {
 Start ClosedFormStart(const Scene& scene, const FitOptions& options,
                       Clock::time_point start_time);
 
+// The start at a camera already fitted to the same points with a nested model (the model
+// selection's current model, of which the scene's model frees one more group): its pose in the
+// scene's normalized world and the scene's model at its intrinsics, distortion included.
+// Method "warm". No closed form, no second start (refine.cc): the candidate's least squares
+// start where the nested model's ended.
+Start WarmStart(const Scene& scene, const Camera& fitted);
+
 }  // namespace internal
 }  // namespace camproj
 

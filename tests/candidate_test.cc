@@ -1,0 +1,118 @@
+// The model selection's candidate fit (lib/src/fit/candidate.h) warm-started from the nested
+// model's camera (fit/start.h, WarmStart): where the scene has one minimum, the same optimum as
+// the closed-form start reaches.
+#include "fit/candidate.h"
+
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "camproj/synth.h"
+#include "seeds.h"
+
+namespace camproj {
+namespace {
+
+// Two least-squares runs that end at the same minimum agree to the polish's convergence: the
+// last Gauss-Newton step below 1e-12 relative, with the conditioning of a 10-parameter fit
+// (~1e3) on top (the same bound as FitTest.CeresRefinerFindsTheSameOptimum).
+constexpr double kSameOptimum = 1e-9;
+// With k1 free the minimum is flat along the focal-distance-k1 direction; both runs stop within
+// a small fraction of that direction's sigma (the Ceres comparison's bound, for the same reason).
+constexpr double kSameOptimumSigmas = 2e-3;
+// LM started at the minimum: its first step is rejected or negligible and it stops.
+constexpr int kIterationsAtTheOptimum = 1;
+// Px per axis at which a candidate may skip its restarts: the scenes' noise.
+constexpr double kNoisePx = 0.5;
+
+void ExpectSameOptimum(const FitResult& a, const FitResult& b, bool pinhole) {
+  if (pinhole) {
+    const Intrinsics& ka = a.camera.intrinsics;
+    const Intrinsics& kb = b.camera.intrinsics;
+    const double px = ka.fx;
+    EXPECT_NEAR(kb.fx, ka.fx, kSameOptimum * px);
+    EXPECT_NEAR(kb.fy, ka.fy, kSameOptimum * px);
+    EXPECT_NEAR(kb.cx, ka.cx, kSameOptimum * px);
+    EXPECT_NEAR(kb.cy, ka.cy, kSameOptimum * px);
+    const Eigen::Vector3d& ta = a.camera.cam_from_world.translation;
+    EXPECT_LE((b.camera.cam_from_world.translation - ta).norm(), kSameOptimum * ta.norm());
+    EXPECT_LE((b.camera.cam_from_world.rotation - a.camera.cam_from_world.rotation).norm(),
+              kSameOptimum);
+    return;
+  }
+  ASSERT_TRUE(a.covariance_available);
+  for (const ParameterSigma& pa : a.sigmas) {
+    for (const ParameterSigma& pb : b.sigmas) {
+      if (pb.name == pa.name) {
+        EXPECT_LE(std::abs(pb.value - pa.value), kSameOptimumSigmas * pa.sigma) << pa.name;
+      }
+    }
+  }
+}
+
+// Each step of the ladder (pose + focal -> + principal point -> + aspect, and -> + k1) fitted
+// from the closed form and from the previous step's camera, on clouds of 20-1000 points seen by
+// a centred camera and by a projector with lens shift (σ 0.5 px): the same optimum, every time.
+TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
+  int compared = 0;
+  for (const int n : {20, 100, 1000}) {
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      for (const double offset_y : {0.0, 0.4}) {
+        SynthOptions synth;
+        synth.seed = testing::Seed(seed);
+        synth.num_points = n;
+        synth.object = SynthObject::kCloud;
+        synth.image_size = ImageSize{1920, 1080};
+        synth.fovy_deg = 45.0;
+        synth.principal_point_offset = Eigen::Vector2d(0.0, offset_y);
+        synth.noise_px = kNoisePx;
+        const SynthScene scene = SynthesizeScene(synth);
+        const auto& points = scene.correspondences.points_in_world;
+        const auto& pixels = scene.correspondences.pixels;
+        FitOptions focal;  // pose + focal
+        focal.aspect = ParameterMode::Default();
+        focal.principal_point = ParameterMode::Default();
+        FitOptions principal_point = focal;
+        principal_point.principal_point = ParameterMode::Free();
+        FitOptions aspect = principal_point;
+        aspect.aspect = ParameterMode::Free();
+        FitOptions k1 = principal_point;
+        k1.k1 = ParameterMode::Free();
+        struct Step {
+          const FitOptions* nested;
+          const FitOptions* model;
+          bool pinhole;
+        };
+        for (const Step& step : {Step{&focal, &principal_point, true},
+                                 Step{&principal_point, &aspect, true},
+                                 Step{&principal_point, &k1, false}}) {
+          SCOPED_TRACE(::testing::Message() << "N " << n << " seed " << seed << " offset "
+                                            << offset_y << " free " << step.model->aspect.IsFree()
+                                            << step.model->k1.IsFree());
+          const FitResult nested = internal::FitCandidate(points, pixels, synth.image_size,
+                                                          *step.nested, kNoisePx);
+          const FitResult cold =
+              internal::FitCandidate(points, pixels, synth.image_size, *step.model, kNoisePx);
+          const FitResult warm = internal::FitCandidate(points, pixels, synth.image_size,
+                                                        *step.model, kNoisePx, &nested.camera);
+          EXPECT_EQ(warm.start_method, "warm");
+          EXPECT_NE(cold.start_method, "warm");
+          ExpectSameOptimum(cold, warm, step.pinhole);
+          // Started at its own optimum, a model stays there: the start is the camera given
+          // (pose and intrinsics in the scene's normalized frame), not merely near it.
+          const FitResult again = internal::FitCandidate(points, pixels, synth.image_size,
+                                                         *step.model, kNoisePx, &cold.camera);
+          EXPECT_LE(again.iterations, kIterationsAtTheOptimum);
+          ExpectSameOptimum(cold, again, step.pinhole);
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 3 * 8 * 2 * 3);
+}
+
+}  // namespace
+}  // namespace camproj
