@@ -143,6 +143,7 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
   if (warm_start != nullptr) effort.warm_start = *warm_start;
   effort.skip_restarts_when_consistent_at_px = consistent_at_px;
   effort.check_linearity = false;
+  effort.describe = false;
   return Fit(points_in_world, observed_pixels, image_size, options, effort);
 }
 

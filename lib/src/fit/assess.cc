@@ -325,7 +325,7 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   camera.z_far = options.z_far.value_or(*max_depth * (1.0 + options.depth_margin));
   Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
           camera.z_far, ")");
-  result.views = ViewsOfCamera(camera, Median(depths));
+  if (effort.describe) result.views = ViewsOfCamera(camera, Median(depths));
 
   const std::vector<std::string> names = ParameterNames(model);
   result.free_parameters = names;
@@ -338,7 +338,7 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   if (!(scaled_normal.rcond > kSingularRcond)) RefuseUndetermined(scaled_normal, names);
   result.jacobian_condition = scaled_normal.JacobianCondition();
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
-  if (options.compute_uncertainty && have_sigma) {
+  if (options.compute_uncertainty && have_sigma && effort.describe) {
     SetCovariance(scaled_normal, names, model, scene.scale, options, &result);
     if (effort.check_linearity && refined.normal.jtr.size() == refined.normal.jtj.rows()) {
       result.linearity =

@@ -12,7 +12,8 @@
 // a fit can be consistent with the noise and still sit in a minimum far from the truth.
 //
 // Nor does a candidate check its covariance's linearization (FitResult::linearity, 2p more
-// evaluations of the residuals): the chosen model's fit reports it.
+// evaluations of the residuals), compute its covariance or its views (FitResult::views): the
+// selection reads a candidate's residuals and camera, and the chosen model's fit reports the rest.
 //
 // The warm start leaves out the closed form (at 6 points the DLT, its pose re-solved, and the
 // second start from the image centre) and reaches the same minimum wherever the scene has one
@@ -32,9 +33,9 @@ namespace camproj {
 namespace internal {
 
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`
-// (> 0, px per axis) and FitResult::linearity not checked; from `warm_start` (a camera of a
-// model nested in this one, fitted to the same points) instead of the closed form when it is
-// not null.
+// (> 0, px per axis), FitResult::linearity, ::views and the covariance not computed, and from
+// `warm_start` (a camera of a model nested in this one, fitted to the same points) instead of
+// the closed form when it is not null.
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,

@@ -73,6 +73,9 @@ struct FitEffort {
   std::optional<double> skip_restarts_when_consistent_at_px;
   // Check the covariance's linearization (FitResult::linearity; assess.cc).
   bool check_linearity = true;
+  // Describe the camera: FitResult::views and, with options.compute_uncertainty, the covariance
+  // and sigmas (assess.cc). A candidate's score reads its residuals and camera only.
+  bool describe = true;
   // Start at this camera (fit/start.h, WarmStart) instead of the closed form.
   std::optional<Camera> warm_start;
 };
