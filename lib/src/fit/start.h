@@ -24,7 +24,9 @@ namespace internal {
 struct Start {
   // rotation and center: the start pose; intrinsics: the closed form's K, before projection.
   StartCamera camera;
-  std::string method;  // FitResult::start_method: "pnp", "homography", "pnp-focal-sweep", "dlt"
+  // FitResult::start_method: "pnp", "homography", "pnp-focal-sweep", "dlt"; "warm" (WarmStart)
+  // only in the model selection's candidates, never in a fit it returns.
+  std::string method;
   Model model;         // the scene's model, its free slots from the closed form
   // "pnp-focal-sweep" only: the sweep's other local minima, best first (FocalSweepStart).
   std::vector<StartCamera> other_sweep_minima;
