@@ -92,6 +92,14 @@ std::vector<Parameter> ParametersOf(const Camera& camera, const FitOptions& mode
   return params;
 }
 
+// At least every parameter ParametersOf gives (at most 14: the pose's 6, the perspective
+// strength and 7 intrinsics).
+constexpr int kMaxParameters = 16;
+// One point's rows of the Jacobian (2 x params), on the stack.
+using PointRows = Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxParameters>;
+using ParameterMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParameters, kMaxParameters>;
+
 // The camera linearized along `params` (ParametersOf): the rotation turns about the camera's
 // own axes (R -> exp([a e]x) R), the eye moves along them in units of length_scale, the focal
 // length and aspect scale (fx, fy by 1 + a; fy by 1 + a), the principal point and skew move by
@@ -107,13 +115,14 @@ struct Linearization {
 // incomplete. A kPerspective column (orthographic) is -(pixel - principal point) * z_cam /
 // length_scale: the derivative at e = 0 of pixel = c + (u_ortho - c) / (1 + e z_cam) per unit of
 // e * length_scale.
-std::optional<size_t> PixelJacobian(const Linearization& at,
-                                    const std::vector<Eigen::Vector3d>& points,
-                                    Eigen::MatrixXd* jacobian) {
+// `Matrix`: Eigen::MatrixXd, or PointRows for one point.
+template <typename Matrix>
+std::optional<size_t> PixelJacobian(const Linearization& at, const Eigen::Vector3d* points,
+                                    size_t count, Matrix* jacobian) {
   const Intrinsics& k = at.camera.intrinsics;
   const bool orthographic = at.camera.projection == Projection::kOrthographic;
-  jacobian->resize(2 * points.size(), at.params.size());
-  for (size_t i = 0; i < points.size(); ++i) {
+  jacobian->resize(2 * count, at.params.size());
+  for (size_t i = 0; i < count; ++i) {
     const Eigen::Vector3d p = at.camera.cam_from_world * points[i];
     if (!(p.z() > 0.0)) return i;
     // d pixel / d point_in_cam, and the pixel's parts the intrinsics scale.
@@ -165,7 +174,7 @@ std::optional<size_t> PixelJacobian(const Linearization& at,
           break;
         }
       }
-      jacobian->block<2, 1>(2 * i, j) = column;
+      jacobian->template block<2, 1>(2 * i, j) = column;
     }
   }
   return std::nullopt;
@@ -226,6 +235,8 @@ class PixelUncertainty {
       : sigma_px_(sigma_px), fitted_(&fitted_points), mirrored_z_(mirrored_z) {
     Require(!fitted_points.empty(), "no fitted points");
     const std::vector<Parameter> params = ParametersOf(camera, model);
+    Require(params.size() <= static_cast<size_t>(kMaxParameters), "too many parameters: ",
+            params.size());
     // The eye's step scale: the median distance from the eye to the fitted points.
     const Eigen::Vector3d eye = CameraCenterInWorld(camera.cam_from_world);
     std::vector<double> distances;
@@ -244,7 +255,8 @@ class PixelUncertainty {
       for (size_t i = begin; i < std::min(begin + kBlock, fitted_points.size()); ++i) {
         block.push_back(Fitted(i));
       }
-      const std::optional<size_t> behind = PixelJacobian(at_, block, &block_jacobian);
+      const std::optional<size_t> behind =
+          PixelJacobian(at_, block.data(), block.size(), &block_jacobian);
       Require(!behind, "point ", begin + behind.value_or(0), " is not in front of the camera");
       normal.noalias() += block_jacobian.transpose() * block_jacobian;
     }
@@ -267,9 +279,9 @@ class PixelUncertainty {
   double SigmaAt(const Eigen::Vector3d& x) const {
     const double infinity = std::numeric_limits<double>::infinity();
     if (singular_) return infinity;
-    Eigen::MatrixXd jacobian;
+    PointRows jacobian;
     try {
-      if (PixelJacobian(at_, {x}, &jacobian)) return infinity;
+      if (PixelJacobian(at_, &x, 1, &jacobian)) return infinity;
     } catch (const std::invalid_argument&) {
       return infinity;
     }
@@ -280,7 +292,7 @@ class PixelUncertainty {
   // moves its prediction (identity where J^T J is singular).
   Eigen::Matrix2d HatAt(size_t i) const {
     if (singular_) return Eigen::Matrix2d::Identity();
-    const Eigen::MatrixXd rows = FittedRows(i) * whitening_;
+    const PointRows rows = FittedRows(i).lazyProduct(whitening_);
     return rows * rows.transpose();
   }
 
@@ -289,11 +301,12 @@ class PixelUncertainty {
   // lowers their sum of squares. 0 where J^T J is singular.
   double HatQuadratic(const std::vector<Eigen::Vector2d>& residuals) const {
     if (singular_) return 0.0;
-    Eigen::VectorXd gradient = Eigen::VectorXd::Zero(whitening_.rows());
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxParameters, 1> gradient =
+        Eigen::VectorXd::Zero(whitening_.rows());
     for (size_t i = 0; i < residuals.size(); ++i) {
       gradient.noalias() += FittedRows(i).transpose() * residuals[i];
     }
-    return (whitening_.transpose() * gradient).squaredNorm();
+    return whitening_.transpose().lazyProduct(gradient).squaredNorm();
   }
 
   // SigmaAt of fitted point i (J's rows 2i, 2i+1; in front of the camera, as the constructor
@@ -311,22 +324,23 @@ class PixelUncertainty {
   }
 
   // Rows 2i, 2i + 1 of J.
-  Eigen::MatrixXd FittedRows(size_t i) const {
-    Eigen::MatrixXd jacobian;
-    PixelJacobian(at_, {Fitted(i)}, &jacobian);
+  PointRows FittedRows(size_t i) const {
+    const Eigen::Vector3d x = Fitted(i);
+    PointRows jacobian;
+    PixelJacobian(at_, &x, 1, &jacobian);
     return jacobian;
   }
 
   // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
-  double SigmaOf(const Eigen::MatrixXd& jacobian) const {
-    return sigma_px_ * std::sqrt((jacobian * whitening_).squaredNorm());
+  double SigmaOf(const PointRows& jacobian) const {
+    return sigma_px_ * std::sqrt(jacobian.lazyProduct(whitening_).squaredNorm());
   }
 
   double sigma_px_;
   const std::vector<Eigen::Vector3d>* fitted_;
   bool mirrored_z_ = false;
   Linearization at_;
-  Eigen::MatrixXd whitening_;  // W: (J^T J)^-1 = W W^T
+  ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
   bool singular_ = false;
 };
 
