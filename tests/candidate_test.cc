@@ -109,7 +109,7 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
           const FitResult cold =
               internal::FitCandidate(points, pixels, synth.image_size, *step.model, kNoisePx);
           const FitResult warm = internal::FitCandidate(points, pixels, synth.image_size,
-                                                        *step.model, kNoisePx, &nested.camera);
+                                                        *step.model, kNoisePx, {&nested.camera});
           EXPECT_EQ(warm.start_method, "warm");
           EXPECT_NE(cold.start_method, "warm");
           std::vector<ParameterSigma> sigmas;
@@ -120,7 +120,7 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
           // Started at its own optimum, a model stays there: the start is the camera given
           // (pose and intrinsics in the scene's normalized frame), not merely near it.
           const FitResult again = internal::FitCandidate(points, pixels, synth.image_size,
-                                                         *step.model, kNoisePx, &cold.camera);
+                                                         *step.model, kNoisePx, {&cold.camera});
           EXPECT_LE(again.iterations, kIterationsAtTheOptimum);
           ExpectSameOptimum(cold, again, step.pinhole, sigmas);
           ++compared;
@@ -129,6 +129,101 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
     }
   }
   EXPECT_EQ(compared, 3 * 8 * 2 * 3);
+}
+
+// The reason and message of `fit`'s refusal, or "answered".
+template <typename Fit>
+std::string Refusal(Fit fit) {
+  try {
+    fit();
+  } catch (const SceneError& error) {
+    return std::to_string(static_cast<int>(error.reason())) + ": " + error.what();
+  }
+  return "answered";
+}
+
+// The points prepared once for every candidate (fit/scene.h, PrepareScene) give each model the
+// refusal, with the same message, that preparing them for that model alone gives: too few
+// (distinct) points, coordinates too large, collinear points, an offset beyond double precision,
+// a plane asked for too many intrinsics -- and scenes where several of these hold at once.
+TEST(CandidateTest, PreparedPointsRefuseAsTheirOwnScene) {
+  const SynthScene base = [] {
+    SynthOptions synth;
+    synth.seed = testing::Seed(3);
+    synth.num_points = 8;
+    synth.noise_px = kNoisePx;
+    return SynthesizeScene(synth);
+  }();
+  const ImageSize size = base.truth.image_size;
+  struct Case {
+    const char* name;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector2d> pixels;
+  };
+  std::vector<Case> cases;
+  const auto& points = base.correspondences.points_in_world;
+  const auto& pixels = base.correspondences.pixels;
+  cases.push_back({"well-formed", points, pixels});
+  cases.push_back({"five points", {points.begin(), points.begin() + 5},
+                   {pixels.begin(), pixels.begin() + 5}});
+  {
+    Case c{"three points repeated", {}, {}};
+    for (int i = 0; i < 8; ++i) {
+      c.points.push_back(points[i % 3]);
+      c.pixels.push_back(pixels[i]);
+    }
+    cases.push_back(c);
+  }
+  {
+    Case c{"collinear", {}, pixels};
+    for (int i = 0; i < 8; ++i) c.points.push_back(Eigen::Vector3d(i, 2.0 * i, 0.5 * i));
+    cases.push_back(c);
+  }
+  {
+    Case c{"coplanar", {}, pixels};
+    for (const Eigen::Vector3d& x : points) c.points.push_back(Eigen::Vector3d(x.x(), x.y(), 0.0));
+    cases.push_back(c);
+  }
+  {
+    Case c{"offset 1e12", points, pixels};
+    for (Eigen::Vector3d& x : c.points) x += Eigen::Vector3d(1e12, 0.0, 0.0);
+    cases.push_back(c);
+  }
+  {
+    // The spread is finite, the extents of the cloud are not: once refused or not depending
+    // on the stack's contents (Eigen's SVD left its singular values unset).
+    Case c{"coordinates near the largest double", points, pixels};
+    for (int i = 0; i < 4; ++i) c.points[i].x() = i % 2 ? 1.7e308 : -1.7e308;  // spread: inf
+    cases.push_back(c);
+  }
+  FitOptions focal;
+  focal.aspect = ParameterMode::Default();
+  focal.principal_point = ParameterMode::Default();
+  FitOptions full = focal;  // focal, aspect, principal point, skew: 4 linear intrinsics
+  full.aspect = ParameterMode::Free();
+  full.principal_point = ParameterMode::Free();
+  full.skew = ParameterMode::Free();
+  for (const Case& c : cases) {
+    const internal::SceneGeometry geometry =
+        internal::PrepareScene(c.points, c.pixels, size, focal.pixel_origin);
+    for (const FitOptions* model : {&focal, &full}) {
+      SCOPED_TRACE(::testing::Message() << c.name << (model == &full ? ", full model" : ""));
+      const std::string own = Refusal([&] {
+        internal::FitCandidate(c.points, c.pixels, size, *model, kNoisePx);
+      });
+      const std::string shared = Refusal([&] {
+        internal::FitCandidate(c.points, c.pixels, size, *model, kNoisePx, {nullptr, &geometry});
+      });
+      EXPECT_EQ(shared, own);
+      if (std::string(c.name) == "coordinates near the largest double") {
+        EXPECT_EQ(own.rfind(std::to_string(static_cast<int>(SceneError::Reason::kNonFiniteInput)) +
+                                ": the 3D points' coordinates are too large",
+                            0),
+                  0u)
+            << own;
+      }
+    }
+  }
 }
 
 }  // namespace

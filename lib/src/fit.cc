@@ -87,7 +87,9 @@ FitResult Fit(const std::vector<Eigen::Vector3d>& points_in_world,
     return internal::FitOrthographic(points_in_world, observed_pixels, image_size, options);
   }
   const internal::Scene scene =
-      internal::ValidateScene(points_in_world, observed_pixels, image_size, options);
+      effort.geometry != nullptr
+          ? internal::ValidateScene(*effort.geometry, options)
+          : internal::ValidateScene(points_in_world, observed_pixels, image_size, options);
 
   if (options.ransac) {
     // Find the consensus, fit it without RANSAC, then report every point against that camera.
@@ -136,11 +138,12 @@ namespace internal {
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px, const Camera* warm_start) {
+                       double consistent_at_px, const CandidateReuse& reuse) {
   Require(std::isfinite(consistent_at_px) && consistent_at_px > 0.0,
           "a candidate's noise must be positive (px), got ", consistent_at_px);
   FitEffort effort;
-  if (warm_start != nullptr) effort.warm_start = *warm_start;
+  if (reuse.warm_start != nullptr) effort.warm_start = *reuse.warm_start;
+  effort.geometry = reuse.geometry;
   effort.skip_restarts_when_consistent_at_px = consistent_at_px;
   effort.check_linearity = false;
   effort.describe = false;

@@ -28,18 +28,27 @@
 #include <Eigen/Core>
 
 #include "camproj/fit.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
 
+// What a candidate may take from the selection instead of computing it; either may be null.
+struct CandidateReuse {
+  // A camera of a model nested in this one, fitted to the same points: the start instead of
+  // the closed form (fit/start.h, WarmStart).
+  const Camera* warm_start = nullptr;
+  // The same points prepared once (fit/scene.h, PrepareScene), for options.pixel_origin.
+  const SceneGeometry* geometry = nullptr;
+};
+
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`
-// (> 0, px per axis), FitResult::linearity, ::views and the covariance not computed, and from
-// `warm_start` (a camera of a model nested in this one, fitted to the same points) instead of
-// the closed form when it is not null.
+// (> 0, px per axis), FitResult::linearity, ::views and the covariance not computed, and what
+// `reuse` holds reused.
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px, const Camera* warm_start = nullptr);
+                       double consistent_at_px, const CandidateReuse& reuse = {});
 
 }  // namespace internal
 }  // namespace camproj

@@ -63,6 +63,8 @@ inline double RmsRowLength(const Eigen::MatrixXd& centred) {
   return std::sqrt((unit * centred).squaredNorm() / static_cast<double>(centred.rows())) / unit;
 }
 
+struct SceneGeometry;  // fit/scene.h
+
 // What a fit may leave out when the model selection only scores it (fit/candidate.h). The
 // default leaves out nothing: every FitCamera call.
 struct FitEffort {
@@ -78,6 +80,9 @@ struct FitEffort {
   bool describe = true;
   // Start at this camera (fit/start.h, WarmStart) instead of the closed form.
   std::optional<Camera> warm_start;
+  // The correspondences already prepared (fit/scene.h, PrepareScene): the scene is made from
+  // them instead of again from the points.
+  const SceneGeometry* geometry = nullptr;
 };
 
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest

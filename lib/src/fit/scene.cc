@@ -4,7 +4,9 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -108,43 +110,47 @@ void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
   }
 }
 
-Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
-                    const std::vector<Eigen::Vector2d>& observed_pixels,
-                    const ImageSize& image_size, const FitOptions& options) {
-  Scene scene;
+SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                           const std::vector<Eigen::Vector2d>& observed_pixels,
+                           const ImageSize& image_size, PixelOrigin pixel_origin) {
+  SceneGeometry geometry;
+  geometry.pixel_origin = pixel_origin;
+  geometry.num_points = static_cast<int>(points_in_world.size());
+  Scene& scene = geometry.scene;
   scene.image_size = image_size;
-  scene.model = MakeModel(options, image_size);
-  const int n = static_cast<int>(points_in_world.size());
-  const int num_params = 6 + scene.model.NumFree();
-  // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
-  // `count`: the distinct points, as a point given twice adds no equation.
-  auto require_points = [&](int count) {
-    if (2 * count >= num_params && count >= 4) return;
-    throw SceneError(SceneError::Reason::kTooFewPoints,
-                     Concat(n, " points", count < n ? Concat(" (", count, " distinct)") : "",
-                            " give ", 2 * count, " equations, but the model has ",
-                            num_params, " unknowns (pose 6 + ", scene.model.NumFree(),
-                            " free intrinsics) and a unique pose needs 4 points: add points (at "
-                            "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
-  };
-  require_points(n);
+  const int n = geometry.num_points;
+  // Fewer than 4 points never pass ValidateScene's first check; nothing below is defined for
+  // them.
+  if (n < 4) return geometry;
 
   // Pixels in kCenter; the world centred and scaled to unit RMS distance, so neither units nor
   // offsets reach the numerics.
-  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  const double shift = PixelOriginShift(pixel_origin, PixelOrigin::kCenter);
   scene.pixels = observed_pixels;
   for (auto& p : scene.pixels) p += Eigen::Vector2d(shift, shift);
   const Eigen::Vector3d centroid = Centroid(points_in_world);
   Eigen::MatrixXd centred(n, 3);
   for (int i = 0; i < n; ++i) centred.row(i) = (points_in_world[i] - centroid).transpose();
   const double scale = RmsRowLength(centred);
-  if (!std::isfinite(scale)) throw TooLargeForDouble();
+  if (!std::isfinite(scale)) {
+    geometry.refusal = TooLargeForDouble();
+    return geometry;
+  }
   const Eigen::JacobiSVD<Eigen::Matrix3d> shape = SvdOfRows(centred);
+  if (shape.info() != Eigen::Success) {
+    // The extents overflow where each coordinate and the RMS spread do not (coordinates near
+    // 1e308 of both signs): Eigen leaves the singular values unset, and reading them made the
+    // refusal depend on the stack's contents.
+    geometry.refusal = TooLargeForDouble();
+    return geometry;
+  }
   const Eigen::Vector3d extents = shape.singularValues();
   if (!(scale > 0.0) || extents(1) <= kCollinearRatio * extents(0)) {
-    throw SceneError(SceneError::Reason::kCollinearPoints,
-                     "the 3D points are collinear (or coincide): a line does not determine a "
-                     "camera's rotation about it; add points off the line");
+    geometry.refusal = SceneError(
+        SceneError::Reason::kCollinearPoints,
+        "the 3D points are collinear (or coincide): a line does not determine a camera's "
+        "rotation about it; add points off the line");
+    return geometry;
   }
   // The distinct points, counted on sorted indices (4 bytes a point, not a copy of 24).
   std::vector<int> sorted(n);
@@ -158,29 +164,65 @@ Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
   auto same = [&](int a, int b) { return points_in_world[a] == points_in_world[b]; };
   scene.num_distinct_points =
       static_cast<int>(std::unique(sorted.begin(), sorted.end(), same) - sorted.begin());
-  require_points(scene.num_distinct_points);
-  CheckOffset(points_in_world, scale, scene.pixels);
+  try {
+    CheckOffset(points_in_world, scale, scene.pixels);
+  } catch (const SceneError& error) {
+    geometry.offset_refusal = error;
+  }
   scene.centroid = centroid;
   scene.scale = scale;
   scene.points.resize(n);
   for (int i = 0; i < n; ++i) scene.points[i] = centred.row(i).transpose() / scale;
   scene.planar = extents(2) <= kPlanarRatio * extents(1);
   scene.planar_start = extents(2) <= kPlanarStartRatio * extents(1);
-
-  if (scene.planar && scene.model.NumFreeLinear() > 2) {
-    throw SceneError(
-        SceneError::Reason::kPlanarUnderdetermined,
-        "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
-        "principal point (2) and skew, but " + FreeLinearNames(scene.model) +
-            " are free. Fix the principal point (at the image centre by default) and the "
-            "aspect (square pixels), or add points off the plane");
-  }
-
   scene.plane_basis =
       shape.matrixV().determinant() > 0
           ? Eigen::Matrix3d(shape.matrixV())
           : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal());
+  return geometry;
+}
+
+Scene ValidateScene(const SceneGeometry& geometry, const FitOptions& options) {
+  Require(options.pixel_origin == geometry.pixel_origin,
+          "the scene was prepared for another pixel origin");
+  Model model = MakeModel(options, geometry.scene.image_size);
+  const int n = geometry.num_points;
+  const int num_params = 6 + model.NumFree();
+  // Three points fix a pose only up to P3P's four-fold ambiguity: four is the least for one.
+  // `count`: the distinct points, as a point given twice adds no equation.
+  auto require_points = [&](int count) {
+    if (2 * count >= num_params && count >= 4) return;
+    throw SceneError(SceneError::Reason::kTooFewPoints,
+                     Concat(n, " points", count < n ? Concat(" (", count, " distinct)") : "",
+                            " give ", 2 * count, " equations, but the model has ",
+                            num_params, " unknowns (pose 6 + ", model.NumFree(),
+                            " free intrinsics) and a unique pose needs 4 points: add points (at "
+                            "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
+  };
+  // In the order of the checks of one scene: the count, the coordinates' range, the shape, the
+  // distinct count, the offset, what a plane determines.
+  require_points(n);
+  if (geometry.refusal) throw *geometry.refusal;
+  require_points(geometry.scene.num_distinct_points);
+  if (geometry.offset_refusal) throw *geometry.offset_refusal;
+  if (geometry.scene.planar && model.NumFreeLinear() > 2) {
+    throw SceneError(
+        SceneError::Reason::kPlanarUnderdetermined,
+        "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
+        "principal point (2) and skew, but " + FreeLinearNames(model) +
+            " are free. Fix the principal point (at the image centre by default) and the "
+            "aspect (square pixels), or add points off the plane");
+  }
+  Scene scene = geometry.scene;
+  scene.model = std::move(model);
   return scene;
+}
+
+Scene ValidateScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options) {
+  return ValidateScene(
+      PrepareScene(points_in_world, observed_pixels, image_size, options.pixel_origin), options);
 }
 
 }  // namespace internal

@@ -8,6 +8,7 @@
 #ifndef CAMPROJ_SRC_FIT_SCENE_H_
 #define CAMPROJ_SRC_FIT_SCENE_H_
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,6 +60,28 @@ SceneError TooLargeForDouble();
 // above ~5e7 times the points' spread.) The message says to subtract an offset.
 void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
                  const std::vector<Eigen::Vector2d>& pixels);
+
+// What ValidateScene reads from the correspondences alone, whatever the model: computed once
+// for every model fitted to the same points (the model selection's candidates). `refusal`
+// (coordinates too large, collinear points) and `offset_refusal` (CheckOffset) are thrown by
+// ValidateScene in the order one scene's checks run.
+struct SceneGeometry {
+  Scene scene;  // without its model
+  PixelOrigin pixel_origin = PixelOrigin::kCenter;
+  int num_points = 0;
+  std::optional<SceneError> refusal;
+  std::optional<SceneError> offset_refusal;
+};
+
+// The geometry of correspondences that passed CheckCorrespondences, pixels in `pixel_origin`.
+// Never throws a SceneError (it keeps them); fewer than 4 points: only the count.
+SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                           const std::vector<Eigen::Vector2d>& observed_pixels,
+                           const ImageSize& image_size, PixelOrigin pixel_origin);
+
+// The scene for `options`' model from the prepared geometry (options.pixel_origin must be the
+// geometry's): the refusals of the overload below, in the same order, with the same messages.
+Scene ValidateScene(const SceneGeometry& geometry, const FitOptions& options);
 
 // The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
 // `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when

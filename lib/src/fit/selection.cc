@@ -48,12 +48,12 @@ struct Evaluation {
 Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                     const FitOptions& options, double consistent_at_px,
-                    const Camera* warm_start = nullptr) {
+                    const CandidateReuse& reuse = {}) {
   Evaluation e;
   e.options = options;
   e.num_params = NumParameters(options);
   try {
-    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, warm_start);
+    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, reuse);
     e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
   } catch (const SceneError& error) {
@@ -140,9 +140,13 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // one, else the prior until the selection's own noise is known.
   double candidate_sigma = options.fit.pixel_sigma.value_or(options.prior_sigma_px);
   // One model fitted: the prefit's fit where it is that model.
+  // The points prepared once for every candidate (fit/scene.h).
+  const SceneGeometry geometry =
+      PrepareScene(points, pixels, image_size, options.fit.pixel_origin);
   auto evaluate = [&](const FitOptions& model, const Camera* warm_start = nullptr) {
     if (prefit == nullptr || !SameModel(prefit->model, model)) {
-      return Evaluate(points, pixels, image_size, model, candidate_sigma, warm_start);
+      return Evaluate(points, pixels, image_size, model, candidate_sigma,
+                      CandidateReuse{warm_start, &geometry});
     }
     Evaluation e;
     e.options = model;
