@@ -182,7 +182,7 @@ SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
   return geometry;
 }
 
-Scene ValidateScene(const SceneGeometry& geometry, const FitOptions& options) {
+Scene ValidateScene(SceneGeometry geometry, const FitOptions& options) {
   Require(options.pixel_origin == geometry.pixel_origin,
           "the scene was prepared for another pixel origin");
   Model model = MakeModel(options, geometry.scene.image_size);
@@ -213,7 +213,7 @@ Scene ValidateScene(const SceneGeometry& geometry, const FitOptions& options) {
             " are free. Fix the principal point (at the image centre by default) and the "
             "aspect (square pixels), or add points off the plane");
   }
-  Scene scene = geometry.scene;
+  Scene scene = std::move(geometry.scene);
   scene.model = std::move(model);
   return scene;
 }

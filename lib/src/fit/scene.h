@@ -81,7 +81,8 @@ SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
 
 // The scene for `options`' model from the prepared geometry (options.pixel_origin must be the
 // geometry's): the refusals of the overload below, in the same order, with the same messages.
-Scene ValidateScene(const SceneGeometry& geometry, const FitOptions& options);
+// (By value: the overload below moves its geometry in; a candidate's is copied.)
+Scene ValidateScene(SceneGeometry geometry, const FitOptions& options);
 
 // The scene of correspondences that passed CheckCorrespondences, for a perspective fit with
 // `options` (checked; pixels in options.pixel_origin). Throws SceneError kTooFewPoints when
