@@ -139,10 +139,11 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // The noise at which a candidate's fit is consistent enough to skip its restarts: the given
   // one, else the prior until the selection's own noise is known.
   double candidate_sigma = options.fit.pixel_sigma.value_or(options.prior_sigma_px);
-  // One model fitted: the prefit's fit where it is that model.
   // The points prepared once for every candidate (fit/scene.h).
   const SceneGeometry geometry =
       PrepareScene(points, pixels, image_size, options.fit.pixel_origin);
+  // One model fitted, from `warm_start` if not null (fit/candidate.h): the prefit's fit where it
+  // is that model.
   auto evaluate = [&](const FitOptions& model, const Camera* warm_start = nullptr) {
     if (prefit == nullptr || !SameModel(prefit->model, model)) {
       return Evaluate(points, pixels, image_size, model, candidate_sigma,
