@@ -36,14 +36,31 @@ PendingTemporary pending_temporaries[kMaxPendingTemporaries];
 // temporary after that point removes it itself (AbandonIfDying), so none is created behind the
 // handler's back.
 std::atomic<bool> dying{false};
+// Threads between registering a temporary's name and AbandonIfDying (CreationWindow): the
+// handler waits for them before it removes the registered temporaries. Otherwise a thread could
+// create its file just after the handler's unlink and the process die before that thread's
+// AbandonIfDying (seen: a SIGTERM at the start of a 2-thread batch under the sanitizers left a
+// .camproj-*.tmp).
+std::atomic<int> creating{0};
 
 // Called after a temporary's name is registered and created: if a handler has started, removes
 // it and waits for the process to die of the signal.
 void AbandonIfDying(const std::string& name) {
   if (!dying) return;
   unlink(name.c_str());
+  --creating;  // this thread's file is gone: the handler need not wait for it
   for (;;) pause();
 }
+
+// Counts the calling thread in `creating` from before a temporary's name is registered until
+// AbandonIfDying has run on it (or the creation failed).
+class CreationWindow {
+ public:
+  CreationWindow() { ++creating; }
+  ~CreationWindow() { --creating; }
+  CreationWindow(const CreationWindow&) = delete;
+  CreationWindow& operator=(const CreationWindow&) = delete;
+};
 
 // Registers a temporary's path for removal on a signal, until cleared or destroyed; silently
 // does nothing if the table is full or the path too long (the temporary then just is not removed
@@ -81,6 +98,12 @@ class SignalCleanup {
 
 extern "C" void RemoveTemporariesAndDie(int signal_number) {
   dying = true;
+  // Let the threads creating a temporary finish creating it (it is then registered, and removed
+  // below) or see `dying` and remove it themselves. Bounded: if this handler interrupted such a
+  // thread, that thread cannot move on, and its temporary, if created, is registered already.
+  constexpr int kWaits = 100;
+  const timespec millisecond{0, 1000000};
+  for (int i = 0; i < kWaits && creating.load() > 0; ++i) nanosleep(&millisecond, nullptr);
   for (PendingTemporary& slot : pending_temporaries) {
     if (slot.ready) unlink(slot.path);
   }
@@ -220,6 +243,7 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   std::string name;
   SignalCleanup cleanup;
   if (!unnamed) {
+    const CreationWindow window;
     for (int attempt = 0; attempt < 100 && temporary.fd < 0; ++attempt) {
       name = TemporaryName(folder);
       cleanup.Set(name);
@@ -264,6 +288,7 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
       // Created meanwhile: replace it as below.
     }
     // Give it a name only now, for the instant before rename (linkat cannot replace a file).
+    const CreationWindow window;
     for (int attempt = 0; attempt < 100; ++attempt) {
       name = TemporaryName(folder);
       cleanup.Set(name);
