@@ -43,12 +43,13 @@ std::atomic<bool> dying{false};
 // .camproj-*.tmp).
 std::atomic<int> creating{0};
 
-// Called after a temporary's name is registered and created: if a handler has started, removes
-// it and waits for the process to die of the signal.
+// Called after a temporary's name is registered and created, inside that creation's
+// CreationWindow: if a handler has started, removes it, leaves the window (the handler need not
+// wait for this thread) and waits for the process to die of the signal.
 void AbandonIfDying(const std::string& name) {
   if (!dying) return;
   unlink(name.c_str());
-  --creating;  // this thread's file is gone: the handler need not wait for it
+  --creating;
   for (;;) pause();
 }
 

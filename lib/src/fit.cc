@@ -115,7 +115,7 @@ FitResult Fit(const std::vector<Eigen::Vector3d>& points_in_world,
     return result;
   }
 
-  const internal::Start start = effort.warm_start
+  const internal::Start start = effort.warm_start != nullptr
                                     ? internal::WarmStart(scene, *effort.warm_start)
                                     : internal::ClosedFormStart(scene, options, start_time);
   internal::RefinedCamera refined =
@@ -142,7 +142,7 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
   Require(std::isfinite(consistent_at_px) && consistent_at_px > 0.0,
           "a candidate's noise must be positive (px), got ", consistent_at_px);
   FitEffort effort;
-  if (reuse.warm_start != nullptr) effort.warm_start = *reuse.warm_start;
+  effort.warm_start = reuse.warm_start;
   effort.geometry = reuse.geometry;
   effort.skip_restarts_when_consistent_at_px = consistent_at_px;
   effort.check_linearity = false;

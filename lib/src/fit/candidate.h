@@ -1,7 +1,8 @@
 // FitCamera as the model selection scores a candidate model (private): the same stages and the
-// same result, except for two things a candidate does not need (fit/common.h, FitEffort), and
-// that a candidate one group richer than the ladder's current model starts where that model's
-// fit ended (fit/start.h, WarmStart) instead of at a closed form.
+// same result, except for what a candidate does not need (fit/common.h, FitEffort: below) and
+// what it takes from the selection (CandidateReuse): a candidate one group richer than the
+// ladder's current model starts where that model's fit ended (fit/start.h, WarmStart) instead
+// of at a closed form, and every candidate's scene is made from the points prepared once.
 //
 // With radial distortion and the principal point free, the refinement also restarts from a
 // principal point beyond each edge of the image (refine.cc: minima on either side of a principal

@@ -29,17 +29,6 @@ Eigen::Matrix3d HartleyTransform(const std::vector<Eigen::Vector2d>& pixels) {
   return t;
 }
 
-Eigen::Matrix3d ClosestRotation(const Eigen::Matrix3d& m) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
-  if (r.determinant() < 0.0) {
-    Eigen::Matrix3d u = svd.matrixU();
-    u.col(2) *= -1.0;
-    r = u * svd.matrixV().transpose();
-  }
-  return r;
-}
-
 }  // namespace
 
 Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
@@ -240,7 +229,7 @@ bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
   r_plane.col(0) = scale * m.col(0);
   r_plane.col(1) = scale * m.col(1);
   r_plane.col(2) = r_plane.col(0).cross(r_plane.col(1));
-  r_plane = ClosestRotation(r_plane);
+  r_plane = NearestRotationSvd(r_plane);
   const Eigen::Vector3d translation = scale * m.col(2);
   // point_in_cam = r_plane * plane_basis^T * point + translation.
   start->rotation = r_plane * plane_basis.transpose();

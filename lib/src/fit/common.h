@@ -78,8 +78,8 @@ struct FitEffort {
   // Describe the camera: FitResult::views and, with options.compute_uncertainty, the covariance
   // and sigmas (assess.cc). A candidate's score reads its residuals and camera only.
   bool describe = true;
-  // Start at this camera (fit/start.h, WarmStart) instead of the closed form.
-  std::optional<Camera> warm_start;
+  // Start at this camera (fit/start.h, WarmStart) instead of the closed form, if not null.
+  const Camera* warm_start = nullptr;
   // The correspondences already prepared (fit/scene.h, PrepareScene): the scene is made from
   // them instead of again from the points.
   const SceneGeometry* geometry = nullptr;

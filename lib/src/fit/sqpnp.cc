@@ -10,6 +10,13 @@
 namespace camproj {
 namespace internal {
 
+Eigen::Matrix3d NearestRotationSvd(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d u = svd.matrixU();
+  if ((u * svd.matrixV().transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
+  return u * svd.matrixV().transpose();
+}
+
 namespace {
 
 using Vector9 = Eigen::Matrix<double, 9, 1>;
@@ -133,15 +140,6 @@ Eigen::Matrix3d Cofactors(const Eigen::Matrix3d& m) {
 double OrthogonalityError(const Vector9& e) {
   const Eigen::Matrix3d m = AsMatrix(e);
   return (m * m.transpose() - Eigen::Matrix3d::Identity()).squaredNorm();
-}
-
-// The proper rotation nearest to m in the Frobenius norm, by SVD: U diag(1, 1, det(U V^T)) V^T.
-// Any of them where it is not unique.
-Eigen::Matrix3d NearestRotationSvd(const Eigen::Matrix3d& m) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d u = svd.matrixU();
-  if ((u * svd.matrixV().transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
-  return u * svd.matrixV().transpose();
 }
 
 // The proper rotation nearest to m (det(m) > 0 expected; else the SVD's) by FOAM: F. L. Markley,

@@ -70,6 +70,11 @@ bool SolveSqPnp(const std::vector<Eigen::Vector3d>& points_in_world,
                 const std::vector<Eigen::Vector2d>& normalized, Eigen::Matrix3d* rotation,
                 Eigen::Vector3d* translation);
 
+// The proper rotation nearest to m in the Frobenius norm, by SVD: U diag(1, 1, det(U V^T)) V^T;
+// any of them where it is not unique. SQPnP's fall-back, and the homography start's
+// (closed_form.cc).
+Eigen::Matrix3d NearestRotationSvd(const Eigen::Matrix3d& m);
+
 }  // namespace internal
 }  // namespace camproj
 
