@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "camproj/model_select.h"
 #include "camproj/pose.h"
 #include "camproj/synth.h"
 #include "seeds.h"
@@ -129,6 +130,54 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
     }
   }
   EXPECT_EQ(compared, 3 * 8 * 2 * 3);
+}
+
+// The chosen model refitted from the ladder's camera (FitChosen, what FitCameraAuto does from 20
+// points on) is FitCamera's fit from scratch: the same optimum, sigmas, views and linearity
+// check; and FitCameraAuto names the closed form its selection began at, never "warm".
+TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
+  int compared = 0;
+  for (const int n : {20, 100, 1000}) {
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      for (const double offset_y : {0.0, 0.4}) {
+        SynthOptions synth;
+        synth.seed = testing::Seed(100 + seed);
+        synth.num_points = n;
+        synth.object = SynthObject::kCloud;
+        synth.image_size = ImageSize{1920, 1080};
+        synth.fovy_deg = 45.0;
+        synth.principal_point_offset = Eigen::Vector2d(0.0, offset_y);
+        synth.noise_px = kNoisePx;
+        const SynthScene scene = SynthesizeScene(synth);
+        const auto& points = scene.correspondences.points_in_world;
+        const auto& pixels = scene.correspondences.pixels;
+        SCOPED_TRACE(::testing::Message() << "N " << n << " seed " << seed << " offset "
+                                          << offset_y);
+        FitOptions nested;  // pose + focal + principal point, the ladder's step before k1
+        nested.aspect = ParameterMode::Default();
+        FitOptions model = nested;
+        model.k1 = ParameterMode::Free();
+        model.pixel_sigma = kNoisePx;
+        const FitResult before =
+            internal::FitCandidate(points, pixels, synth.image_size, nested, kNoisePx);
+        const FitResult ladder = internal::FitCandidate(points, pixels, synth.image_size, model,
+                                                        kNoisePx, {&before.camera});
+        const FitResult scratch = FitCamera(points, pixels, synth.image_size, model);
+        const FitResult chosen =
+            internal::FitChosen(points, pixels, synth.image_size, model, {&ladder.camera});
+        EXPECT_EQ(chosen.start_method, "warm");
+        ExpectSameOptimum(scratch, chosen, false, scratch.sigmas);
+        EXPECT_EQ(chosen.sigmas.size(), scratch.sigmas.size());
+        EXPECT_TRUE(chosen.views.clip_from_gl_eye.allFinite());
+        EXPECT_EQ(chosen.linearity.checked, scratch.linearity.checked);
+        const FitResult automatic = FitCameraAuto(points, pixels, synth.image_size);
+        EXPECT_NE(automatic.start_method, "warm");
+        EXPECT_FALSE(automatic.start_method.empty());
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 3 * 8 * 2);
 }
 
 // The reason and message of `fit`'s refusal, or "answered".

@@ -308,7 +308,9 @@ struct FitResult {
   std::string criterion;
   double selection_sigma_px = 0.0;
 
-  std::string start_method;  // "dlt", "homography", "pnp", "pnp-focal-sweep"
+  // "dlt", "homography", "pnp", "pnp-focal-sweep" ("affine": orthographic; "ransac+...": the
+  // consensus's). FitCameraAuto from 20 points on: the closed form its model selection began at.
+  std::string start_method;
   bool planar = false;       // the points are (numerically) coplanar
   std::vector<std::string> free_parameters;   // names in the covariance's order
   std::vector<FixedParameter> fixed_parameters;

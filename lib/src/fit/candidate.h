@@ -19,8 +19,11 @@
 // The warm start leaves out the closed form (at 6 points the DLT, its pose re-solved, and the
 // second start from the image centre) and reaches the same minimum wherever the scene has one
 // (tests/candidate_test.cc); where it has several, the nested model's minimum is the one the
-// ladder asks about: whether freeing the group pays at this camera. The chosen model is
-// refitted from scratch, restarts included.
+// ladder asks about: whether freeing the group pays at this camera. A warm start goes straight
+// to the Gauss-Newton polish (least_squares.h): from the nested minimum the new one is usually a
+// step or two away, and Levenberg-Marquardt runs only where the polish does not settle. The
+// chosen model is refitted with everything computed and its restarts: from scratch below 20
+// points, else from the ladder's camera (FitChosen; selection.cc says why).
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
@@ -50,6 +53,14 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
                        double consistent_at_px, const CandidateReuse& reuse = {});
+
+// As FitCamera (fit.h), everything computed, restarts included, but started and prepared as
+// `reuse` says: the model selection's chosen model refitted with its covariance from the
+// ladder's fit of it. FitResult::start_method is "warm" where reuse.warm_start is not null.
+FitResult FitChosen(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options,
+                    const CandidateReuse& reuse);
 
 }  // namespace internal
 }  // namespace camproj

@@ -422,12 +422,25 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
-                                       int max_rounds) {
+                                       int max_rounds, bool polish_first) {
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
   outcome.center = start_center;
   outcome.model = model;
   bool have_normal = false;
+  if (polish_first && options.refiner != Refiner::kCeres &&
+      ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center, outcome.model,
+                             &outcome.normal)) {
+    // From a start at a nested model's minimum the new minimum is usually a Gauss-Newton step
+    // or two away; where the polish does not settle (it never raises the cost), LM goes on from
+    // where it stopped.
+    outcome.trace.push_back({0, MicrosecondsSince(start_time),
+                             std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
+    outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
+                                          &outcome.model, &outcome.normal);
+    have_normal = true;
+    if (outcome.converged) outcome.termination = "CONVERGENCE: Gauss-Newton from a nested minimum";
+  }
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
     have_normal = false;
     if (options.refiner == Refiner::kCeres) {

@@ -48,12 +48,16 @@ struct LeastSquaresOutcome {
 // ends behind the camera or the focal length or aspect is not positive (normal is then empty if
 // the normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one
 // settling step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
+// With `polish_first` (a start at a nested model's minimum, fit/start.h WarmStart), the polish
+// runs first and LM only if it does not settle (not with Refiner::kCeres); the termination then
+// says "Gauss-Newton from a nested minimum" and no LM iteration is counted.
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
-                                       int max_rounds = kMaxLeastSquaresRounds);
+                                       int max_rounds = kMaxLeastSquaresRounds,
+                                       bool polish_first = false);
 
 }  // namespace internal
 }  // namespace camproj

@@ -69,9 +69,9 @@ bool MayBeAboveTheMinimum(const LeastSquaresOutcome& outcome, const Scene& scene
 LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
                                      const FitOptions& options, const FitEffort& effort,
                                      Clock::time_point start_time) {
-  LeastSquaresOutcome best = RefineLeastSquares(scene.points, scene.pixels, start.camera.rotation,
-                                                start.camera.center, start.model, options,
-                                                start_time);
+  LeastSquaresOutcome best = RefineLeastSquares(
+      scene.points, scene.pixels, start.camera.rotation, start.camera.center, start.model, options,
+      start_time, kMaxLeastSquaresRounds, start.method == "warm");
   if (start.method == "dlt" && scene.NumPoints() < kSecondStartBelowPoints &&
       scene.model.free[2] && MayBeAboveTheMinimum(best, scene, effort)) {
     // With few points the DLT's principal point can be far off and LM stop in a local minimum

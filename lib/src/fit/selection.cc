@@ -23,6 +23,18 @@ const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew"
 // FitResult::fixed_parameters' name of each group.
 const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
 
+// Below this many points the chosen model is refitted with its covariance from its own closed
+// form, restarts included; from there on from the ladder's camera (fit/candidate.h, FitChosen).
+// Measured on the click benchmark (bench --clicks): at 6-12 clicks the refit from scratch is
+// what refuses two mirrored 6-point scenes as mirrored (the DLT's two readings, fit/start.h)
+// rather than as undetermined, and the second start from the image centre runs only below 20
+// points (refine.cc). From 20 points on, the same answers and refusals on the benchmark's
+// 60-300-point bands but one (a refusal at 100 points, 50 % outliers, now answered 0.6 px
+// off), and 10-14 % fewer instructions for the default path at 20-1000 points
+// (docs/bench/stage_cost.md); the refit then returns the ladder's own minimum, the camera the
+// criterion was computed for.
+constexpr size_t kFromScratchBelowPoints = 20;
+
 ParameterMode& ModeOf(FitOptions& options, int group) {
   switch (group) {
     case kPrincipalPoint: return options.principal_point;
@@ -205,6 +217,10 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
   // residual degrees of freedom to spare).
   double sigma = base.pixel_sigma.value_or(0.0);
   if (!base.pixel_sigma) {
+    // The richest model is fitted from its closed form. Started where the screen's or the
+    // base's fit ended (five groups richer) it stopped in higher minima (bench --clicks, 54 kept
+    // points: a sum of squares of 57 px^2 for the closed form's 36), which changed the model
+    // chosen in 18 of the 2700 scenes at 60-300 points.
     bool found = false;
     for (int top = static_cast<int>(candidates.size()); top >= 0 && !found; --top) {
       FitOptions richest = base;
@@ -269,6 +285,9 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     size_t final_index = 0;
     std::vector<int> included;
     std::string why_left_out[kNumGroups];
+    // The closed form the ladder's chain of fits began at (each later one started where the
+    // last ended: its method "warm").
+    std::string start_method;
   };
   auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
                         const std::vector<int>& groups, const Evaluation* evaluated_base) {
@@ -277,6 +296,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
     // The base fitted before the noise was known has the same camera and residuals (the noise
     // only scales its sigmas, which the ladder does not read for the base).
     ladder.final = evaluated_base != nullptr ? *evaluated_base : evaluate(base_options);
+    if (ladder.final.fit) ladder.start_method = ladder.final.fit->start_method;
     ladder.final_index = record(ladder.final, base_name,
                                 ladder.final.fit ? "simplest model"
                                                  : "not determined: " + ladder.final.refusal);
@@ -336,6 +356,7 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       }
       if (best_group < 0) break;
       ladder.included.push_back(best_group);
+      if (best.fit->start_method != "warm") ladder.start_method = best.fit->start_method;
       ladder.final = std::move(best);
       ladder.final_options = best_options;
       ladder.final_index = best_index;
@@ -434,7 +455,14 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
           ? *options.fit.pixel_sigma
           : CombinedNoise(options, chosen.final.sum_squares, num_equations - chosen.final.num_params);
   selection.options.compute_uncertainty = options.fit.compute_uncertainty;
-  selection.fit = FitCamera(points, pixels, image_size, selection.options);
+  // From its closed form below kFromScratchBelowPoints, else where the ladder's fit of it ended.
+  if (points.size() < kFromScratchBelowPoints) {
+    selection.fit = FitCamera(points, pixels, image_size, selection.options);
+  } else {
+    selection.fit = FitChosen(points, pixels, image_size, selection.options,
+                              CandidateReuse{&chosen.final.fit->camera, &geometry});
+    if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
+  }
   if (!options.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
   tried[chosen.final_index].verdict = "chosen";
   for (const int g : candidates) {
