@@ -145,326 +145,337 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
                                          (options.prior_weight + std::max(0.0, dof))));
 }
 
-Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
-                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
-                      const AutoFitOptions& options, const Prefit* prefit) {
-  // The noise at which a candidate's fit is consistent enough to skip its restarts: the given
-  // one, else the prior until the selection's own noise is known.
-  double candidate_sigma = options.fit.pixel_sigma.value_or(options.prior_sigma_px);
-  // The points prepared once for every candidate (fit/scene.h).
-  const SceneGeometry geometry =
-      PrepareScene(points, pixels, image_size, options.fit.pixel_origin);
-  // One model fitted, from `warm_start` if not null (fit/candidate.h): the prefit's fit where it
-  // is that model.
-  auto evaluate = [&](const FitOptions& model, const Camera* warm_start = nullptr) {
-    if (prefit == nullptr || !SameModel(prefit->model, model)) {
-      return Evaluate(points, pixels, image_size, model, candidate_sigma,
-                      CandidateReuse{warm_start, &geometry});
+namespace {
+
+// One family's ladder as run_ladder leaves it: the model it ended at, and why each group it did
+// not take was left out.
+struct Ladder {
+  Evaluation final;
+  FitOptions final_options;
+  size_t final_index = 0;  // in ModelSelector::tried_
+  std::vector<int> included;
+  std::string why_left_out[kNumGroups];
+  // The closed form the ladder's chain of fits began at (each later one started where the
+  // last ended: its method "warm").
+  std::string start_method;
+};
+
+// SelectModel's stages over the state they share: the points and their preparation, the noise
+// the criterion uses, and every model tried.
+class ModelSelector {
+ public:
+  ModelSelector(const std::vector<Eigen::Vector3d>& points,
+                const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
+                const AutoFitOptions& options, const Prefit* prefit)
+      : points_(points), pixels_(pixels), image_size_(image_size), options_(options),
+        prefit_(prefit),
+        // The noise at which a candidate's fit is consistent enough to skip its restarts: the
+        // given one, else the prior until the selection's own noise is known.
+        candidate_sigma_(options.fit.pixel_sigma.value_or(options.prior_sigma_px)),
+        geometry_(PrepareScene(points, pixels, image_size, options.fit.pixel_origin)),
+        n_(static_cast<int>(points.size())),
+        num_equations_(2.0 * n_),
+        aic_(options.criterion == ModelCriterion::kAic),
+        penalty_(aic_ ? 2.0 : std::log(num_equations_)),
+        criterion_name_(aic_ ? "AIC" : "BIC") {}
+
+  Selection Run();
+
+ private:
+  Evaluation FitModel(const FitOptions& model, const Camera* warm_start = nullptr) const;
+  const Evaluation& Affine(const FitOptions& base);
+  double Noise(const FitOptions& base, const std::vector<int>& candidates,
+               const Evaluation& base_fit, bool orthographic_allowed);
+  double CriterionOf(const Evaluation& e) const {
+    return e.sum_squares / (sigma_ * sigma_) + penalty_ * e.num_params;
+  }
+  double CriterionOrInf(const Evaluation& e) const {
+    return e.fit ? CriterionOf(e) : std::numeric_limits<double>::infinity();
+  }
+  size_t Record(const Evaluation& e, const std::string& name, const std::string& verdict);
+  Ladder RunLadder(const FitOptions& base_options, const std::string& base_name,
+                   const std::vector<int>& groups, const Evaluation* evaluated_base);
+  bool ChooseOrthographic(const FitOptions& base, const std::vector<int>& candidates,
+                          Ladder* chosen);
+  void RefuseMirroredIfPerspectiveFits(const FitOptions& base, const Ladder& chosen) const;
+  Selection Refit(const Ladder& chosen, const std::vector<int>& candidates);
+
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& pixels_;
+  const ImageSize& image_size_;
+  const AutoFitOptions& options_;
+  const Prefit* prefit_;
+  double candidate_sigma_;
+  const SceneGeometry geometry_;  // the points prepared once for every candidate (fit/scene.h)
+  const int n_;
+  const double num_equations_;
+  const bool aic_;
+  const double penalty_;  // per parameter
+  const char* const criterion_name_;
+  double sigma_ = 0.0;  // the criterion's noise (Noise)
+  std::optional<Evaluation> affine_;
+  std::vector<ModelCandidate> tried_;
+  std::vector<Rival> rivals_;  // every fitted model
+};
+
+// One model fitted, from `warm_start` if not null (fit/candidate.h): the prefit's fit where it
+// is that model.
+Evaluation ModelSelector::FitModel(const FitOptions& model, const Camera* warm_start) const {
+  if (prefit_ == nullptr || !SameModel(prefit_->model, model)) {
+    return Evaluate(points_, pixels_, image_size_, model, candidate_sigma_,
+                    CandidateReuse{warm_start, &geometry_});
+  }
+  Evaluation e;
+  e.options = model;
+  e.fit = prefit_->fit;
+  e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points_.size());
+  e.num_params = static_cast<int>(e.fit->free_parameters.size());
+  return e;
+}
+
+// The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
+// orthographic family's best fit, evaluated at most once.
+const Evaluation& ModelSelector::Affine(const FitOptions& base) {
+  if (!affine_) {
+    FitOptions affine_options = base;
+    affine_options.projection = Projection::kOrthographic;
+    for (const int g : {kAspect, kSkew}) {
+      if (ModeOf(affine_options, g).kind == ParameterMode::Kind::kDefault) {
+        ModeOf(affine_options, g) = ParameterMode::Free();
+      }
     }
-    Evaluation e;
-    e.options = model;
-    e.fit = prefit->fit;
-    e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
-    e.num_params = static_cast<int>(e.fit->free_parameters.size());
-    return e;
-  };
-  FitOptions base = options.fit;
-  base.ransac = false;
-  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
-  std::vector<int> candidates;  // groups the ladder may free
-  if (base.projection == Projection::kPerspective && !base.known_intrinsics) {
-    for (int g = 0; g < kNumGroups; ++g) {
-      if (ModeOf(base, g).kind == ParameterMode::Kind::kDefault) candidates.push_back(g);
+    affine_ = FitModel(affine_options);
+  }
+  return *affine_;
+}
+
+// The criterion's noise: given, or the prior combined with the residuals of the richest model
+// the scene supports (groups dropped from the top of the ladder until one is fitted with
+// residual degrees of freedom to spare).
+double ModelSelector::Noise(const FitOptions& base, const std::vector<int>& candidates,
+                            const Evaluation& base_fit, bool orthographic_allowed) {
+  if (base.pixel_sigma) return *base.pixel_sigma;
+  // The richest model is fitted from its closed form. Started where the screen's or the
+  // base's fit ended (five groups richer) it stopped in higher minima (bench --clicks, 54 kept
+  // points: a sum of squares of 57 px^2 for the closed form's 36), which changed the model
+  // chosen in 18 of the 2700 scenes at 60-300 points.
+  for (int top = static_cast<int>(candidates.size()); top >= 0; --top) {
+    FitOptions richest = base;
+    for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
+    // Only its sum of squares is used.
+    if (num_equations_ - NumParameters(richest) < 1) continue;
+    const Evaluation e = top == 0 ? base_fit : FitModel(richest);
+    if (e.fit && num_equations_ > e.num_params) {
+      return CombinedNoise(options_, e.sum_squares, num_equations_ - e.num_params);
     }
   }
-  const int n = static_cast<int>(points.size());
-  const double num_equations = 2.0 * n;
-  const bool aic = options.criterion == ModelCriterion::kAic;
-  const double penalty = aic ? 2.0 : std::log(num_equations);  // per parameter
-  const char* criterion_name = aic ? "AIC" : "BIC";
-
-  // The perspective base (pose + focal and whatever the caller forced) decides whether an
-  // orthographic camera may answer: only where the perspective is fitted, not determined or
-  // ambiguous (the depth spread too small against the distance to show it, or to tell a
-  // mirrored world from a proper one), never where it was refused as mirrored, behind the
-  // points, or short of points.
-  base.compute_uncertainty = false;
-  const Evaluation base_fit = evaluate(base);
-  const bool orthographic_allowed =
-      options.allow_orthographic && OrthographicIsPossible(base) &&
-      (base_fit.fit || base_fit.reason == SceneError::Reason::kDegenerate ||
-       base_fit.reason == SceneError::Reason::kAmbiguous);
-
-  // The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
-  // orthographic family's best fit, evaluated at most once.
-  std::optional<Evaluation> affine;
-  auto affine_evaluation = [&]() -> const Evaluation& {
-    if (!affine) {
-      FitOptions affine_options = base;
-      affine_options.projection = Projection::kOrthographic;
-      for (const int g : {kAspect, kSkew}) {
-        if (ModeOf(affine_options, g).kind == ParameterMode::Kind::kDefault) {
-          ModeOf(affine_options, g) = ParameterMode::Free();
-        }
-      }
-      affine = evaluate(affine_options);
-    }
-    return *affine;
-  };
-
-  // The criterion's noise: given, or the prior combined with the residuals of the richest model
-  // the scene supports (groups dropped from the top of the ladder until one is fitted with
-  // residual degrees of freedom to spare).
-  double sigma = base.pixel_sigma.value_or(0.0);
-  if (!base.pixel_sigma) {
-    // The richest model is fitted from its closed form. Started where the screen's or the
-    // base's fit ended (five groups richer) it stopped in higher minima (bench --clicks, 54 kept
-    // points: a sum of squares of 57 px^2 for the closed form's 36), which changed the model
-    // chosen in 18 of the 2700 scenes at 60-300 points.
-    bool found = false;
-    for (int top = static_cast<int>(candidates.size()); top >= 0 && !found; --top) {
-      FitOptions richest = base;
-      for (int i = 0; i < top; ++i) ModeOf(richest, candidates[i]) = ParameterMode::Free();
-      // Only its sum of squares is used.
-      if (num_equations - NumParameters(richest) < 1) continue;
-      const Evaluation e = top == 0 ? base_fit : evaluate(richest);
-      if (e.fit && num_equations > e.num_params) {
-        sigma = CombinedNoise(options, e.sum_squares, num_equations - e.num_params);
-        found = true;
-      }
-    }
-    if (!found && orthographic_allowed) {
-      const Evaluation& e = affine_evaluation();
-      if (e.fit && num_equations > e.num_params) {
-        sigma = CombinedNoise(options, e.sum_squares, num_equations - e.num_params);
-        found = true;
-      }
-    }
-    if (!found) sigma = CombinedNoise(options, 0.0, 0.0);  // the prior alone
-  }
-  auto criterion_of = [&](const Evaluation& e) {
-    return e.sum_squares / (sigma * sigma) + penalty * e.num_params;
-  };
-  auto criterion_or_inf = [&](const Evaluation& e) {
-    return e.fit ? criterion_of(e) : std::numeric_limits<double>::infinity();
-  };
-  std::vector<ModelCandidate> tried;
-  std::vector<Rival> rivals;  // every fitted model
-  auto record = [&](const Evaluation& e, const std::string& name, const std::string& verdict) {
-    ModelCandidate c;
-    c.name = name;
-    c.fitted = e.fit.has_value();
-    c.num_params = e.num_params;
-    if (e.fit) {
-      c.name = e.fit->model;
-      c.sum_squares_px2 = e.sum_squares;
-      c.rms_px = e.fit->rms_px;
-      c.criterion = criterion_of(e);
-      rivals.push_back({e.fit->model, e.options, e.fit->camera, c.criterion});
-    }
-    c.verdict = verdict;
-    tried.push_back(c);
-    return tried.size() - 1;
-  };
-
-  // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
-  base.pixel_sigma = sigma;
-  candidate_sigma = sigma;
-  base.compute_uncertainty = true;
-
-  // One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
-  // improves, the fit with it is not refused and the model keeps min_redundancy equations to
-  // spare (whether the chosen camera is determined well enough is the assessment's question:
-  // leaving out a group the residuals ask for only hides its uncertainty in a biased camera).
-  // A refused base is a model of infinite criterion that any fitted trial improves on (so a
-  // perspective camera whose principal point is far from the centre is still found). Records
-  // every model tried and why each group was left out.
-  struct Ladder {
-    Evaluation final;
-    FitOptions final_options;
-    size_t final_index = 0;
-    std::vector<int> included;
-    std::string why_left_out[kNumGroups];
-    // The closed form the ladder's chain of fits began at (each later one started where the
-    // last ended: its method "warm").
-    std::string start_method;
-  };
-  auto run_ladder = [&](const FitOptions& base_options, const std::string& base_name,
-                        const std::vector<int>& groups, const Evaluation* evaluated_base) {
-    Ladder ladder;
-    ladder.final_options = base_options;
-    // The base fitted before the noise was known has the same camera and residuals (the noise
-    // only scales its sigmas, which the ladder does not read for the base).
-    ladder.final = evaluated_base != nullptr ? *evaluated_base : evaluate(base_options);
-    if (ladder.final.fit) ladder.start_method = ladder.final.fit->start_method;
-    ladder.final_index = record(ladder.final, base_name,
-                                ladder.final.fit ? "simplest model"
-                                                 : "not determined: " + ladder.final.refusal);
-    for (;;) {
-      const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
-      int best_group = -1;
-      size_t best_index = 0;
-      Evaluation best;
-      FitOptions best_options;
-      auto included = [&](int g) {
-        return std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end();
-      };
-      for (const int g : groups) {
-        if (included(g)) continue;
-        if (g == kK2 && !included(kK1) && std::find(groups.begin(), groups.end(), kK1) != groups.end()) {
-          ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
-          continue;
-        }
-        if (g == kSkew && !included(kPrincipalPoint) &&
-            std::find(groups.begin(), groups.end(), kPrincipalPoint) != groups.end()) {
-          // Skew only describes resampled or cropped pixels; before the principal point it
-          // stands in for a lens shift at a few points and bends the camera to match.
-          ladder.why_left_out[g] = "left out: not tried, the principal point is not in the model";
-          continue;
-        }
-        FitOptions trial_options = ladder.final_options;
-        ModeOf(trial_options, g) = ParameterMode::Free();
-        const std::string name = current_name + "+" + kGroupNames[g];
-        const int redundancy = 2 * n - NumParameters(trial_options);
-        if (redundancy < options.min_redundancy) {
-          const std::string why = TooFewRedundant(redundancy, options.min_redundancy);
-          ladder.why_left_out[g] = "left out: not tried: " + why;
-          ModelCandidate c;
-          c.name = name;
-          c.num_params = NumParameters(trial_options);
-          c.verdict = "not tried: " + why;
-          tried.push_back(c);
-          continue;
-        }
-        Evaluation trial = evaluate(
-            trial_options, ladder.final.fit ? &ladder.final.fit->camera : nullptr);
-        if (!trial.fit) {
-          ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
-                                   trial.refusal + ")";
-          record(trial, name, "not determined: refused");
-          continue;
-        }
-        const double delta = criterion_of(trial) - criterion_or_inf(ladder.final);
-        ladder.why_left_out[g] = "left out: " + Versus(criterion_name, delta, current_name);
-        const size_t index = record(trial, name, Versus(criterion_name, delta, current_name));
-        if (delta < 0.0 && (best_group < 0 || criterion_of(trial) < criterion_of(best))) {
-          best_group = g;
-          best_index = index;
-          best = std::move(trial);
-          best_options = trial_options;
-        }
-      }
-      if (best_group < 0) break;
-      ladder.included.push_back(best_group);
-      if (best.fit->start_method != "warm") ladder.start_method = best.fit->start_method;
-      ladder.final = std::move(best);
-      ladder.final_options = best_options;
-      ladder.final_index = best_index;
-      tried[best_index].verdict += ": kept";
-    }
-    return ladder;
-  };
-
-  // The perspective ladder from pose + focal, and the orthographic one (scale, then aspect and
-  // skew); the family whose final model has the lower criterion wins.
-  const std::string base_name =
-      base.projection == Projection::kOrthographic ? "orthographic" : "pose+focal";
-  Ladder chosen = run_ladder(base, base_name, candidates, &base_fit);
-  bool orthographic_chosen = base.projection == Projection::kOrthographic;
   if (orthographic_allowed) {
-    FitOptions ortho_options = base;
-    ortho_options.projection = Projection::kOrthographic;
-    std::vector<int> ortho_groups;
-    for (const int g : candidates) {
-      if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
-    }
-    // No orthographic model fits better than the affine camera (every A), so when even its sum
-    // of squares with the fewest orthographic parameters' penalty cannot beat the best
-    // perspective model, the orthographic ladder cannot win: skip it (one closed-form solve,
-    // not up to four Ceres fits of 2N residuals each).
-    std::optional<double> affine_sum_squares;
-    std::string affine_refusal;
-    try {
-      affine_sum_squares = AffineSumSquaresPx2(points, pixels, ortho_options);
-    } catch (const SceneError& error) {
-      affine_refusal = error.what();
-    }
-    const double ortho_lower_bound =
-        affine_sum_squares ? *affine_sum_squares / (sigma * sigma) + penalty * 6
-                           : std::numeric_limits<double>::infinity();
-    Ladder ortho;
-    if (ortho_lower_bound < criterion_or_inf(chosen.final)) {
-      ortho = run_ladder(ortho_options, "orthographic", ortho_groups, nullptr);
-    } else {
-      ModelCandidate c;
-      c.name = "orthographic";  // with the forced groups, as its ladder would name it
-      if (ortho_options.aspect.IsFree()) c.name += "+aspect";
-      if (ortho_options.skew.IsFree()) c.name += "+skew";
-      c.verdict = affine_sum_squares
-                      ? "not supported: even the affine camera's residual (rms " +
-                            Fixed(std::sqrt(*affine_sum_squares / n)) + " px) puts every "
-                            "orthographic model above the best perspective one"
-                      : "not determined: " + affine_refusal;
-      tried.push_back(c);
-    }
-    if (criterion_or_inf(ortho.final) < criterion_or_inf(chosen.final)) {
-      const std::string against =
-          chosen.final.fit ? Versus(criterion_name,
-                                    criterion_of(ortho.final) - criterion_of(chosen.final),
-                                    "the best perspective model, " + chosen.final.fit->model)
-                           : std::string("no perspective model is determined");
-      for (const int g : candidates) {
-        // (The orthographic fit says itself why it has no principal point.)
-        if (g != kAspect && g != kSkew && g != kPrincipalPoint) {
-          ortho.why_left_out[g] = "left out: not part of an orthographic camera (" + against + ")";
-        }
-      }
-      chosen = std::move(ortho);
-      orthographic_chosen = true;
+    const Evaluation& e = Affine(base);
+    if (e.fit && num_equations_ > e.num_params) {
+      return CombinedNoise(options_, e.sum_squares, num_equations_ - e.num_params);
     }
   }
-  if (!chosen.final.fit) {
-    // The simplest model's refusal says what to fix.
-    throw SceneError(base_fit.fit ? chosen.final.reason : base_fit.reason,
-                     base_fit.fit ? chosen.final.refusal : base_fit.refusal);
-  }
-  if (orthographic_chosen && base.projection == Projection::kPerspective) {
-    // An orthographic image cannot show a mirrored world (its depth order is a choice), but a
-    // perspective camera can: if the mirrored world fits a perspective camera better than any
-    // orthographic one, the world frame is left-handed.
-    FitOptions mirrored = base;
-    mirrored.compute_uncertainty = false;
-    const Evaluation e = Evaluate(MirroredZ(points), pixels, image_size, mirrored, sigma);
-    if (e.fit && criterion_of(e) < criterion_of(chosen.final)) {
-      throw SceneError(SceneError::Reason::kMirroredWorld,
-                       "the points fit a perspective camera only with one world axis flipped "
-                       "(rms " + Fixed(e.fit->rms_px) + " px; the best camera of this world is "
-                       "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): they "
-                       "are seen as through a mirror, i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of every "
-                       "point, and again in anything you render) and refit");
-    }
-  }
+  return CombinedNoise(options_, 0.0, 0.0);  // the prior alone
+}
 
+size_t ModelSelector::Record(const Evaluation& e, const std::string& name,
+                             const std::string& verdict) {
+  ModelCandidate c;
+  c.name = name;
+  c.fitted = e.fit.has_value();
+  c.num_params = e.num_params;
+  if (e.fit) {
+    c.name = e.fit->model;
+    c.sum_squares_px2 = e.sum_squares;
+    c.rms_px = e.fit->rms_px;
+    c.criterion = CriterionOf(e);
+    rivals_.push_back({e.fit->model, e.options, e.fit->camera, c.criterion});
+  }
+  c.verdict = verdict;
+  tried_.push_back(c);
+  return tried_.size() - 1;
+}
+
+// One family's ladder: from `base_options`, free one of `groups` at a time while the criterion
+// improves, the fit with it is not refused and the model keeps min_redundancy equations to
+// spare (whether the chosen camera is determined well enough is the assessment's question:
+// leaving out a group the residuals ask for only hides its uncertainty in a biased camera).
+// A refused base is a model of infinite criterion that any fitted trial improves on (so a
+// perspective camera whose principal point is far from the centre is still found). Records
+// every model tried and why each group was left out.
+Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::string& base_name,
+                                const std::vector<int>& groups, const Evaluation* evaluated_base) {
+  Ladder ladder;
+  ladder.final_options = base_options;
+  // The base fitted before the noise was known has the same camera and residuals (the noise
+  // only scales its sigmas, which the ladder does not read for the base).
+  ladder.final = evaluated_base != nullptr ? *evaluated_base : FitModel(base_options);
+  if (ladder.final.fit) ladder.start_method = ladder.final.fit->start_method;
+  ladder.final_index = Record(ladder.final, base_name,
+                              ladder.final.fit ? "simplest model"
+                                               : "not determined: " + ladder.final.refusal);
+  auto in_groups = [&](int g) { return std::find(groups.begin(), groups.end(), g) != groups.end(); };
+  for (;;) {
+    const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
+    int best_group = -1;
+    size_t best_index = 0;
+    Evaluation best;
+    FitOptions best_options;
+    auto included = [&](int g) {
+      return std::find(ladder.included.begin(), ladder.included.end(), g) != ladder.included.end();
+    };
+    for (const int g : groups) {
+      if (included(g)) continue;
+      if (g == kK2 && !included(kK1) && in_groups(kK1)) {
+        ladder.why_left_out[g] = "left out: not tried, k1 is not in the model";
+        continue;
+      }
+      if (g == kSkew && !included(kPrincipalPoint) && in_groups(kPrincipalPoint)) {
+        // Skew only describes resampled or cropped pixels; before the principal point it
+        // stands in for a lens shift at a few points and bends the camera to match.
+        ladder.why_left_out[g] = "left out: not tried, the principal point is not in the model";
+        continue;
+      }
+      FitOptions trial_options = ladder.final_options;
+      ModeOf(trial_options, g) = ParameterMode::Free();
+      const std::string name = current_name + "+" + kGroupNames[g];
+      const int redundancy = 2 * n_ - NumParameters(trial_options);
+      if (redundancy < options_.min_redundancy) {
+        const std::string why = TooFewRedundant(redundancy, options_.min_redundancy);
+        ladder.why_left_out[g] = "left out: not tried: " + why;
+        ModelCandidate c;
+        c.name = name;
+        c.num_params = NumParameters(trial_options);
+        c.verdict = "not tried: " + why;
+        tried_.push_back(c);
+        continue;
+      }
+      Evaluation trial =
+          FitModel(trial_options, ladder.final.fit ? &ladder.final.fit->camera : nullptr);
+      if (!trial.fit) {
+        ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
+                                 trial.refusal + ")";
+        Record(trial, name, "not determined: refused");
+        continue;
+      }
+      const double delta = CriterionOf(trial) - CriterionOrInf(ladder.final);
+      ladder.why_left_out[g] = "left out: " + Versus(criterion_name_, delta, current_name);
+      const size_t index = Record(trial, name, Versus(criterion_name_, delta, current_name));
+      if (delta < 0.0 && (best_group < 0 || CriterionOf(trial) < CriterionOf(best))) {
+        best_group = g;
+        best_index = index;
+        best = std::move(trial);
+        best_options = trial_options;
+      }
+    }
+    if (best_group < 0) break;
+    ladder.included.push_back(best_group);
+    if (best.fit->start_method != "warm") ladder.start_method = best.fit->start_method;
+    ladder.final = std::move(best);
+    ladder.final_options = best_options;
+    ladder.final_index = best_index;
+    tried_[best_index].verdict += ": kept";
+  }
+  return ladder;
+}
+
+// The orthographic ladder (scale, then aspect and skew) against the perspective one's answer
+// in `chosen`: replaces it, and returns true, if its final model has the lower criterion.
+bool ModelSelector::ChooseOrthographic(const FitOptions& base, const std::vector<int>& candidates,
+                                       Ladder* chosen) {
+  FitOptions ortho_options = base;
+  ortho_options.projection = Projection::kOrthographic;
+  std::vector<int> ortho_groups;
+  for (const int g : candidates) {
+    if (g == kAspect || g == kSkew) ortho_groups.push_back(g);
+  }
+  // No orthographic model fits better than the affine camera (every A), so when even its sum
+  // of squares with the fewest orthographic parameters' penalty cannot beat the best
+  // perspective model, the orthographic ladder cannot win: skip it (one closed-form solve,
+  // not up to four Ceres fits of 2N residuals each).
+  std::optional<double> affine_sum_squares;
+  std::string affine_refusal;
+  try {
+    affine_sum_squares = AffineSumSquaresPx2(points_, pixels_, ortho_options);
+  } catch (const SceneError& error) {
+    affine_refusal = error.what();
+  }
+  const double ortho_lower_bound =
+      affine_sum_squares ? *affine_sum_squares / (sigma_ * sigma_) + penalty_ * 6
+                         : std::numeric_limits<double>::infinity();
+  Ladder ortho;
+  if (ortho_lower_bound < CriterionOrInf(chosen->final)) {
+    ortho = RunLadder(ortho_options, "orthographic", ortho_groups, nullptr);
+  } else {
+    ModelCandidate c;
+    c.name = "orthographic";  // with the forced groups, as its ladder would name it
+    if (ortho_options.aspect.IsFree()) c.name += "+aspect";
+    if (ortho_options.skew.IsFree()) c.name += "+skew";
+    c.verdict = affine_sum_squares
+                    ? "not supported: even the affine camera's residual (rms " +
+                          Fixed(std::sqrt(*affine_sum_squares / n_)) + " px) puts every "
+                          "orthographic model above the best perspective one"
+                    : "not determined: " + affine_refusal;
+    tried_.push_back(c);
+  }
+  if (!(CriterionOrInf(ortho.final) < CriterionOrInf(chosen->final))) return false;
+  const std::string against =
+      chosen->final.fit ? Versus(criterion_name_,
+                                 CriterionOf(ortho.final) - CriterionOf(chosen->final),
+                                 "the best perspective model, " + chosen->final.fit->model)
+                        : std::string("no perspective model is determined");
+  for (const int g : candidates) {
+    // (The orthographic fit says itself why it has no principal point.)
+    if (g != kAspect && g != kSkew && g != kPrincipalPoint) {
+      ortho.why_left_out[g] = "left out: not part of an orthographic camera (" + against + ")";
+    }
+  }
+  *chosen = std::move(ortho);
+  return true;
+}
+
+// An orthographic image cannot show a mirrored world (its depth order is a choice), but a
+// perspective camera can: if the mirrored world fits a perspective camera better than the
+// orthographic one chosen, the world frame is left-handed (kMirroredWorld).
+void ModelSelector::RefuseMirroredIfPerspectiveFits(const FitOptions& base,
+                                                    const Ladder& chosen) const {
+  FitOptions mirrored = base;
+  mirrored.compute_uncertainty = false;
+  const Evaluation e = Evaluate(MirroredZ(points_), pixels_, image_size_, mirrored, sigma_);
+  if (e.fit && CriterionOf(e) < CriterionOf(chosen.final)) {
+    throw SceneError(SceneError::Reason::kMirroredWorld,
+                     "the points fit a perspective camera only with one world axis flipped "
+                     "(rms " + Fixed(e.fit->rms_px) + " px; the best camera of this world is "
+                     "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): they "
+                     "are seen as through a mirror, i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of every "
+                     "point, and again in anything you render) and refit");
+  }
+}
+
+// The chosen model refitted with its covariance and views, and what the selection reports with
+// it.
+Selection ModelSelector::Refit(const Ladder& chosen, const std::vector<int>& candidates) {
   Selection selection;
-  selection.sigma_px = sigma;
+  selection.sigma_px = sigma_;
   selection.options = chosen.final_options;
   // The reported sigmas: the noise given, else the prior combined with the chosen model's own
   // residuals (at 6-12 points its 2N - p alone says little).
   selection.options.pixel_sigma =
-      options.fit.pixel_sigma
-          ? *options.fit.pixel_sigma
-          : CombinedNoise(options, chosen.final.sum_squares, num_equations - chosen.final.num_params);
-  selection.options.compute_uncertainty = options.fit.compute_uncertainty;
+      options_.fit.pixel_sigma
+          ? *options_.fit.pixel_sigma
+          : CombinedNoise(options_, chosen.final.sum_squares,
+                          num_equations_ - chosen.final.num_params);
+  selection.options.compute_uncertainty = options_.fit.compute_uncertainty;
   // From its closed form below kFromScratchBelowPoints, else where the ladder's fit of it ended.
-  if (points.size() < kFromScratchBelowPoints) {
-    selection.fit = FitCamera(points, pixels, image_size, selection.options);
+  if (points_.size() < kFromScratchBelowPoints) {
+    selection.fit = FitCamera(points_, pixels_, image_size_, selection.options);
   } else {
-    selection.fit = FitChosen(points, pixels, image_size, selection.options,
-                              CandidateReuse{&chosen.final.fit->camera, &geometry});
+    selection.fit = FitChosen(points_, pixels_, image_size_, selection.options,
+                              CandidateReuse{&chosen.final.fit->camera, &geometry_});
     if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
   }
-  if (!options.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
-  tried[chosen.final_index].verdict = "chosen";
+  if (!options_.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
+  tried_[chosen.final_index].verdict = "chosen";
   for (const int g : candidates) {
     if (std::find(chosen.included.begin(), chosen.included.end(), g) != chosen.included.end()) {
       continue;
@@ -473,15 +484,73 @@ Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
       if (p.name == kFixedNames[g] && !chosen.why_left_out[g].empty()) p.why = chosen.why_left_out[g];
     }
   }
-  selection.criterion = tried[chosen.final_index].criterion;
-  selection.penalty = penalty;
-  for (Rival& r : rivals) {
+  selection.criterion = tried_[chosen.final_index].criterion;
+  selection.penalty = penalty_;
+  for (Rival& r : rivals_) {
     if (r.model != selection.fit.model) selection.rivals.push_back(std::move(r));
   }
-  selection.fit.candidates = std::move(tried);
-  selection.fit.criterion = criterion_name;
-  selection.fit.selection_sigma_px = sigma;
+  selection.fit.candidates = std::move(tried_);
+  selection.fit.criterion = criterion_name_;
+  selection.fit.selection_sigma_px = sigma_;
   return selection;
+}
+
+// The stages in order: the base model, the noise, the perspective ladder, the orthographic
+// family against it, the refit of the chosen model.
+Selection ModelSelector::Run() {
+  FitOptions base = options_.fit;
+  base.ransac = false;
+  if (base.focal.kind == ParameterMode::Kind::kDefault) base.focal = ParameterMode::Free();
+  std::vector<int> candidates;  // groups the ladder may free
+  if (base.projection == Projection::kPerspective && !base.known_intrinsics) {
+    for (int g = 0; g < kNumGroups; ++g) {
+      if (ModeOf(base, g).kind == ParameterMode::Kind::kDefault) candidates.push_back(g);
+    }
+  }
+  // The perspective base (pose + focal and whatever the caller forced) decides whether an
+  // orthographic camera may answer: only where the perspective is fitted, not determined or
+  // ambiguous (the depth spread too small against the distance to show it, or to tell a
+  // mirrored world from a proper one), never where it was refused as mirrored, behind the
+  // points, or short of points.
+  base.compute_uncertainty = false;
+  const Evaluation base_fit = FitModel(base);
+  const bool orthographic_allowed =
+      options_.allow_orthographic && OrthographicIsPossible(base) &&
+      (base_fit.fit || base_fit.reason == SceneError::Reason::kDegenerate ||
+       base_fit.reason == SceneError::Reason::kAmbiguous);
+  sigma_ = Noise(base, candidates, base_fit, orthographic_allowed);
+
+  // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
+  base.pixel_sigma = sigma_;
+  candidate_sigma_ = sigma_;
+  base.compute_uncertainty = true;
+
+  // The perspective ladder from pose + focal, and the orthographic one (scale, then aspect and
+  // skew); the family whose final model has the lower criterion wins.
+  const std::string base_name =
+      base.projection == Projection::kOrthographic ? "orthographic" : "pose+focal";
+  Ladder chosen = RunLadder(base, base_name, candidates, &base_fit);
+  bool orthographic_chosen = base.projection == Projection::kOrthographic;
+  if (orthographic_allowed && ChooseOrthographic(base, candidates, &chosen)) {
+    orthographic_chosen = true;
+  }
+  if (!chosen.final.fit) {
+    // The simplest model's refusal says what to fix.
+    throw SceneError(base_fit.fit ? chosen.final.reason : base_fit.reason,
+                     base_fit.fit ? chosen.final.refusal : base_fit.refusal);
+  }
+  if (orthographic_chosen && base.projection == Projection::kPerspective) {
+    RefuseMirroredIfPerspectiveFits(base, chosen);
+  }
+  return Refit(chosen, candidates);
+}
+
+}  // namespace
+
+Selection SelectModel(const std::vector<Eigen::Vector3d>& points,
+                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& image_size,
+                      const AutoFitOptions& options, const Prefit* prefit) {
+  return ModelSelector(points, pixels, image_size, options, prefit).Run();
 }
 
 }  // namespace internal
