@@ -31,6 +31,20 @@ constexpr int kIterationsAtTheOptimum = 1;
 // Px per axis at which a candidate may skip its restarts: the scenes' noise.
 constexpr double kNoisePx = 0.5;
 
+// The bench's clean scenes: n points in a cloud seen at 1920x1080, fovy 45 degrees, sigma
+// kNoisePx, by a centred camera (offset_y 0) or a projector with lens shift (0.4).
+SynthScene CloudScene(uint64_t seed, int n, double offset_y) {
+  SynthOptions synth;
+  synth.seed = testing::Seed(seed);
+  synth.num_points = n;
+  synth.object = SynthObject::kCloud;
+  synth.image_size = ImageSize{1920, 1080};
+  synth.fovy_deg = 45.0;
+  synth.principal_point_offset = Eigen::Vector2d(0.0, offset_y);
+  synth.noise_px = kNoisePx;
+  return SynthesizeScene(synth);
+}
+
 // `sigmas`: a full fit's (FitCamera) of the model, for the k1 model's bound; a candidate
 // computes none.
 void ExpectSameOptimum(const FitResult& a, const FitResult& b, bool pinhole,
@@ -74,15 +88,7 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
   for (const int n : {20, 100, 1000}) {
     for (uint64_t seed = 1; seed <= 8; ++seed) {
       for (const double offset_y : {0.0, 0.4}) {
-        SynthOptions synth;
-        synth.seed = testing::Seed(seed);
-        synth.num_points = n;
-        synth.object = SynthObject::kCloud;
-        synth.image_size = ImageSize{1920, 1080};
-        synth.fovy_deg = 45.0;
-        synth.principal_point_offset = Eigen::Vector2d(0.0, offset_y);
-        synth.noise_px = kNoisePx;
-        const SynthScene scene = SynthesizeScene(synth);
+        const SynthScene scene = CloudScene(seed, n, offset_y);
         const auto& points = scene.correspondences.points_in_world;
         const auto& pixels = scene.correspondences.pixels;
         FitOptions focal;  // pose + focal
@@ -105,22 +111,22 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
           SCOPED_TRACE(::testing::Message() << "N " << n << " seed " << seed << " offset "
                                             << offset_y << " free " << step.model->aspect.IsFree()
                                             << step.model->k1.IsFree());
-          const FitResult nested = internal::FitCandidate(points, pixels, synth.image_size,
+          const FitResult nested = internal::FitCandidate(points, pixels, scene.truth.image_size,
                                                           *step.nested, kNoisePx);
           const FitResult cold =
-              internal::FitCandidate(points, pixels, synth.image_size, *step.model, kNoisePx);
-          const FitResult warm = internal::FitCandidate(points, pixels, synth.image_size,
+              internal::FitCandidate(points, pixels, scene.truth.image_size, *step.model, kNoisePx);
+          const FitResult warm = internal::FitCandidate(points, pixels, scene.truth.image_size,
                                                         *step.model, kNoisePx, {&nested.camera});
           EXPECT_EQ(warm.start_method, "warm");
           EXPECT_NE(cold.start_method, "warm");
           std::vector<ParameterSigma> sigmas;
           if (!step.pinhole) {
-            sigmas = FitCamera(points, pixels, synth.image_size, *step.model).sigmas;
+            sigmas = FitCamera(points, pixels, scene.truth.image_size, *step.model).sigmas;
           }
           ExpectSameOptimum(cold, warm, step.pinhole, sigmas);
           // Started at its own optimum, a model stays there: the start is the camera given
           // (pose and intrinsics in the scene's normalized frame), not merely near it.
-          const FitResult again = internal::FitCandidate(points, pixels, synth.image_size,
+          const FitResult again = internal::FitCandidate(points, pixels, scene.truth.image_size,
                                                          *step.model, kNoisePx, {&cold.camera});
           EXPECT_LE(again.iterations, kIterationsAtTheOptimum);
           ExpectSameOptimum(cold, again, step.pinhole, sigmas);
@@ -140,15 +146,7 @@ TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
   for (const int n : {20, 100, 1000}) {
     for (uint64_t seed = 1; seed <= 8; ++seed) {
       for (const double offset_y : {0.0, 0.4}) {
-        SynthOptions synth;
-        synth.seed = testing::Seed(100 + seed);
-        synth.num_points = n;
-        synth.object = SynthObject::kCloud;
-        synth.image_size = ImageSize{1920, 1080};
-        synth.fovy_deg = 45.0;
-        synth.principal_point_offset = Eigen::Vector2d(0.0, offset_y);
-        synth.noise_px = kNoisePx;
-        const SynthScene scene = SynthesizeScene(synth);
+        const SynthScene scene = CloudScene(100 + seed, n, offset_y);
         const auto& points = scene.correspondences.points_in_world;
         const auto& pixels = scene.correspondences.pixels;
         SCOPED_TRACE(::testing::Message() << "N " << n << " seed " << seed << " offset "
@@ -159,18 +157,18 @@ TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
         model.k1 = ParameterMode::Free();
         model.pixel_sigma = kNoisePx;
         const FitResult before =
-            internal::FitCandidate(points, pixels, synth.image_size, nested, kNoisePx);
-        const FitResult ladder = internal::FitCandidate(points, pixels, synth.image_size, model,
+            internal::FitCandidate(points, pixels, scene.truth.image_size, nested, kNoisePx);
+        const FitResult ladder = internal::FitCandidate(points, pixels, scene.truth.image_size, model,
                                                         kNoisePx, {&before.camera});
-        const FitResult scratch = FitCamera(points, pixels, synth.image_size, model);
+        const FitResult scratch = FitCamera(points, pixels, scene.truth.image_size, model);
         const FitResult chosen =
-            internal::FitChosen(points, pixels, synth.image_size, model, {&ladder.camera});
+            internal::FitChosen(points, pixels, scene.truth.image_size, model, {&ladder.camera});
         EXPECT_EQ(chosen.start_method, "warm");
         ExpectSameOptimum(scratch, chosen, false, scratch.sigmas);
         EXPECT_EQ(chosen.sigmas.size(), scratch.sigmas.size());
         EXPECT_TRUE(chosen.views.clip_from_gl_eye.allFinite());
         EXPECT_EQ(chosen.linearity.checked, scratch.linearity.checked);
-        const FitResult automatic = FitCameraAuto(points, pixels, synth.image_size);
+        const FitResult automatic = FitCameraAuto(points, pixels, scene.truth.image_size);
         EXPECT_NE(automatic.start_method, "warm");
         EXPECT_FALSE(automatic.start_method.empty());
         ++compared;
