@@ -309,7 +309,8 @@ struct FitResult {
   double selection_sigma_px = 0.0;
 
   // "dlt", "homography", "pnp", "pnp-focal-sweep" ("affine": orthographic; "ransac+...": the
-  // consensus's). FitCameraAuto from 20 points on: the closed form its model selection began at.
+  // consensus's). FitCameraAuto, where it refits the chosen model from the selection's own fit
+  // of it (from 20 points on, or where it is the screen's model): the closed form that began it.
   std::string start_method;
   bool planar = false;       // the points are (numerically) coplanar
   std::vector<std::string> free_parameters;   // names in the covariance's order

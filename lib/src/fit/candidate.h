@@ -23,7 +23,8 @@
 // to the Gauss-Newton polish (least_squares.h): from the nested minimum the new one is usually a
 // step or two away, and Levenberg-Marquardt runs only where the polish does not settle. The
 // chosen model is refitted with everything computed and its restarts: from scratch below 20
-// points, else from the ladder's camera (FitChosen; selection.cc says why).
+// points unless it is the screen's model (whose fit from scratch the ladder holds), else from
+// the ladder's camera (FitChosen; selection.cc says why).
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
