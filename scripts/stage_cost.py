@@ -102,9 +102,9 @@ STAGES = [
     ("ladder", "model selection: the ladder's fits", False,
      lambda a, b: b == "camproj::internal::SelectModel()"),
     ("refit", "model selection: the chosen model refitted with its covariance (from scratch "
-     "below 20 points, else from the ladder's camera)", False,
+     "below 20 points unless it is the screen's model, else from the ladder's camera)", False,
      lambda a, b: a == "camproj::internal::SelectModel()" and
-     b in ("camproj::FitCamera()", "camproj::internal::FitChosen()")),
+     b == "camproj::internal::FitChosen()"),
     ("gate", "consistency gate on the selection (residuals, chi-square, largest residual)", True,
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::CheckConsistency()",
                                            "camproj::internal::ResidualsAgainst()")),

@@ -56,8 +56,9 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        double consistent_at_px, const CandidateReuse& reuse = {});
 
 // As FitCamera (fit.h), everything computed, restarts included, but started and prepared as
-// `reuse` says: the model selection's chosen model refitted with its covariance from the
-// ladder's fit of it. FitResult::start_method is "warm" where reuse.warm_start is not null.
+// `reuse` says: the model selection's chosen model refitted with its covariance, from the
+// ladder's fit of it or (warm_start null) from its closed form. FitResult::start_method is
+// "warm" where reuse.warm_start is not null.
 FitResult FitChosen(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options,

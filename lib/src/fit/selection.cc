@@ -149,7 +149,7 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
 
 namespace {
 
-// One family's ladder as run_ladder leaves it: the model it ended at, and why each group it did
+// One family's ladder as RunLadder leaves it: the model it ended at, and why each group it did
 // not take was left out.
 struct Ladder {
   Evaluation final;
@@ -474,13 +474,10 @@ Selection ModelSelector::Refit(const Ladder& chosen, const std::vector<int>& can
   // included: the refit starts at that minimum at any count.
   const bool from_scratch = points_.size() < kFromScratchBelowPoints &&
                             !(prefit_ != nullptr && SameModel(prefit_->model, chosen.final_options));
-  if (from_scratch) {
-    selection.fit = FitCamera(points_, pixels_, image_size_, selection.options);
-  } else {
-    selection.fit = FitChosen(points_, pixels_, image_size_, selection.options,
-                              CandidateReuse{&chosen.final.fit->camera, &geometry_});
-    if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
-  }
+  selection.fit = FitChosen(
+      points_, pixels_, image_size_, selection.options,
+      CandidateReuse{from_scratch ? nullptr : &chosen.final.fit->camera, &geometry_});
+  if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
   if (!options_.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
   tried_[chosen.final_index].verdict = "chosen";
   for (const int g : candidates) {
