@@ -311,6 +311,37 @@ void RefuseIfPerspectiveShows(const internal::PerspectiveTest& test, const std::
           "fitted");
 }
 
+// The refusal of a camera whose confidence region has no edge: within the chosen fit's
+// kLinearityLevel region (its linearity check, fit/assess.cc) a point crosses behind the camera,
+// or the sum of squares along some direction never rises to the region's level. Such a camera's
+// sigmas describe nothing, and the determination check, which propagates them to the test
+// points, cannot see how far it may be off beyond the points (kDegenerate).
+void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) {
+  if (!fit.linearity.checked || std::isfinite(fit.linearity.worst_deviation)) return;
+  std::string along = fit.linearity.worst_direction;
+  for (const ParameterSigma& s : fit.sigmas) {
+    if (s.name != along) continue;
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, " = %.4g +- %.2g%s", s.value, s.sigma,
+                  s.unit == "px" ? " px" : s.unit == "deg" ? " deg" : "");
+    along += buffer;
+  }
+  char level[16];
+  std::snprintf(level, sizeof level, "%.4g", 100.0 * fit.linearity.level);
+  throw SceneError(
+      SceneError::Reason::kDegenerate,
+      "the points do not determine the camera: within its " + std::string(level) +
+          " % confidence region, along " +
+          along + ", a camera sees some of them from behind or fits them as well, so how far "
+          "it is off beyond them cannot be told. " +
+          (left_out.empty() ? std::string()
+                            : "Fix or drop " + left_out + " (left out: they disagree with the "
+                              "rest by far more than the noise); ") +
+          (left_out.empty() ? "Add" : "add") +
+          " points where the image has none and spread in depth, or give the intrinsics you "
+          "know (--model, or their values)");
+}
+
 // A selection with every point's residual against its camera, recomputed in world coordinates
 // from the camera as returned (and as the camera file stores it), and the gate on the points
 // kept: computed once per selection, read by the pipeline and by the assessment.
@@ -392,6 +423,7 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
       internal::CheckDetermination(gated.selection, kept_points, options);
   RefuseIfUndetermined(determination, gated.selection.fit.model,
                        LeftOutText(gated.residuals_px, left_out, names), options.fit.pixel_origin);
+  RefuseIfRegionUnbounded(gated.selection.fit, LeftOutText(gated.residuals_px, left_out, names));
 
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);
