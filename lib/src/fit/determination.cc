@@ -44,8 +44,12 @@ constexpr double kAveragedCriterion = 13.8;
 // The chosen model refitted from another start (fit/other_minima.h) that lands within this of
 // the returned camera at every test point has found the same minimum again, not another: LM's
 // runs into one minimum agree to ~1e-12 px (seen: 2.5e-12 px, then named as the rival that
-// "moves a point by 2.5e-12 px"), and no reading of clicked pixels turns on a micro-pixel.
-constexpr double kSameMinimumPx = 1e-6;
+// "moves a point by 2.5e-12 px") near the origin; far from it both cameras are rounded in world
+// coordinates, by up to the 1e-5 px that CheckOffset (fit/scene.h) accepts (seen: 1.4e-6 px at
+// 1.1e6 scene sizes, where a bound of 1e-6 px named the same minimum as another). The bound is
+// the smallest pixel noise the selection believes (kMinNoisePx, 1e-4 px): ten times that
+// rounding, and far below any reading of clicked pixels.
+constexpr double kSameMinimumPx = kMinNoisePx;
 
 // A point whose leverage is within this of 1 in some direction is one the others cannot predict
 // there (their fit moves with it): its leave-one-out error counts as at this leverage, so that

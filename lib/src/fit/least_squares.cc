@@ -360,6 +360,17 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     const double noise_px = std::sqrt(normal->cost / dof);
     return last_step_px <= std::max(kConvergedFraction * noise_px, kRoundingStepPx);
   };
+  // The cost's rounding: each residual (a projection less a pixel) is rounded to about
+  // kResidualUlps units of the pixel's magnitude, so the cost sum_i |r_i|^2 is rounded to
+  // 2 sum_i |r_i| kResidualUlps u |pixel_i| <= 2 kResidualUlps u sqrt(cost) sqrt(sum |pixel_i|^2).
+  // Near a small-residual minimum that is ~1e-11 of the cost (6 points at 0.05 px: 3e-12
+  // measured), above a fixed relative allowance: the step would be refused for its rounding.
+  constexpr double kResidualUlps = 16.0;
+  double pixel_norm2 = 0.0;
+  for (const Eigen::Vector2d& u : pixels) pixel_norm2 += u.squaredNorm();
+  const double cost_rounding_per_root = 2.0 * kResidualUlps *
+                                        std::numeric_limits<double>::epsilon() *
+                                        std::sqrt(pixel_norm2);
   const JacobianColumns columns(*model);
   double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
@@ -401,7 +412,8 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     }
     // Near the optimum the cost is flat to rounding (a 1e-8 relative parameter change moves it by
     // ~1e-16), so accept rounding-level increases and stop on the step's size instead.
-    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) + 1e-300)) {
+    if (!(new_normal.cost <= normal->cost * (1.0 + 1e-12) +
+                                 cost_rounding_per_root * std::sqrt(normal->cost) + 1e-300)) {
       return converged();
     }
     *rotation = new_rotation;
