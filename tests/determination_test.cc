@@ -66,8 +66,9 @@ Eigen::Vector2d PixelOf(const Camera& camera, const Eigen::Matrix<double, 13, 1>
 // the full model's sigmas (focal, aspect, principal point, skew, k1, k2 free) at the box's
 // corners and the fitted points. Steps 1e-5 of each number's scale: truncation ~1e-10, rounding
 // ~1e-16 / 1e-5 = 1e-11 relative per entry, amplified by the normal equations' condition
-// (asserted below 1e6 after Jacobi scaling): 1e-4 relative at worst; measured 2.4e-9 (a 5 %
-// error in the k2 term of the distortion's derivative fails 87 of the 400 comparisons).
+// (asserted below 1e7 after Jacobi scaling; 1.06e6 at seed offset 42): 1e-4
+// relative at worst; measured 2.4e-9 (a 5 % error in the k2 term of the distortion's derivative
+// fails 87 of the 400 comparisons).
 TEST(DeterminationTest, AnalyticJacobianMatchesCentralDifferences) {
   constexpr double kTolerance = 1e-4;
   FitOptions full;
@@ -101,7 +102,7 @@ TEST(DeterminationTest, AnalyticJacobianMatchesCentralDifferences) {
     const Eigen::VectorXd d = normal.diagonal().cwiseSqrt().cwiseInverse();
     const Eigen::MatrixXd scaled = d.asDiagonal() * normal * d.asDiagonal();
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
-    ASSERT_LT(eigen.eigenvalues().maxCoeff() / eigen.eigenvalues().minCoeff(), 1e6) << "seed " << seed;
+    ASSERT_LT(eigen.eigenvalues().maxCoeff() / eigen.eigenvalues().minCoeff(), 1e7) << "seed " << seed;
     const Eigen::MatrixXd inverse = d.asDiagonal() * scaled.inverse() * d.asDiagonal();
     const std::vector<double> sigmas = internal::ReprojectionSigmaPx(camera, full, points, 1.0, test);
     for (size_t i = 0; i < test.size(); ++i) {

@@ -50,8 +50,15 @@ TEST(ModelSelectTest, PerspectiveCameraKeepsTheSimplestModel) {
       fit = Auto(Projector(seed, 30, 1.0, 0.0));
     } catch (const SceneError& e) {
       // The one refusal allowed: a chance extra parameter (BIC keeps one with probability
-      // P(chi2_1 > ln 60) = 4 %) whose camera the simpler model puts elsewhere.
-      EXPECT_EQ(e.reason(), SceneError::Reason::kAmbiguous) << "seed " << seed << ": " << e.what();
+      // P(chi2_1 > ln 60) = 4 %) whose camera the simpler model puts elsewhere (kAmbiguous), or
+      // that leaves the camera undetermined over the points' box (the determination check's
+      // kDegenerate: seen at seed offset 500, k1 + k2 chosen, 5.66 px at 1 sigma).
+      const bool undetermined =
+          e.reason() == SceneError::Reason::kDegenerate &&
+          std::string(e.what()).find("do not determine the camera well enough") !=
+              std::string::npos;
+      EXPECT_TRUE(e.reason() == SceneError::Reason::kAmbiguous || undetermined)
+          << "seed " << seed << ": " << e.what();
       continue;
     }
     if (fit.model == "pose+focal") ++simplest;
