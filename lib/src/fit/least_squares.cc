@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "fit/ceres_minimize.h"
+#include "fit/small_solve.h"
 
 namespace camproj {
 namespace internal {
@@ -255,7 +256,6 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   }
   double damping = 1.0 / kInitialTrustRegionRadius;
   double damping_factor = 2.0;
-  Eigen::LDLT<ParamMatrix> ldlt;
   for (summary.iterations = 1; summary.iterations < max_iterations; ++summary.iterations) {
     ParamMatrix regularized = jtj;
     for (int i = 0; i < regularized.rows(); ++i) {
@@ -263,8 +263,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
           std::sqrt(damping * std::min(std::max(jtj(i, i), kMinDiagonal), kMaxDiagonal));
       regularized(i, i) += lm_diagonal * lm_diagonal;
     }
-    ldlt.compute(regularized);
-    ParamVector lm_step = ldlt.solve(gradient);
+    const SymmetricSolver solver(regularized);
+    ParamVector lm_step = solver.Solve(gradient);
     ParamVector step = scaling.asDiagonal() * lm_step;
     // Adding parameter_tolerance to |u| keeps the test meaningful near u = 0.
     if (step.norm() < options.parameter_tolerance * (u->norm() + options.parameter_tolerance)) {
@@ -275,7 +275,7 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
     if (geodesic) {
       ParamVector second;
       if (problem.JacobianTransposeSecondDerivative(*u, step, kGeodesicStep, &second)) {
-        const ParamVector acceleration = -ldlt.solve(scaling.asDiagonal() * second);
+        const ParamVector acceleration = -solver.Solve(scaling.asDiagonal() * second);
         if (!acceleration.allFinite() ||
             2.0 * acceleration.norm() > kGeodesicAlpha * lm_step.norm()) {
           damping *= damping_factor;
@@ -376,9 +376,9 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   for (int step = 0; step < kMaxSteps; ++step) {
     const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
     const ParamVector delta =
-        -(scale.asDiagonal() * (scale.asDiagonal() * normal->jtj * scale.asDiagonal())
-                                   .ldlt()
-                                   .solve(scale.asDiagonal() * normal->jtr));
+        -(scale.asDiagonal() *
+          SymmetricSolver(ParamMatrix(scale.asDiagonal() * normal->jtj * scale.asDiagonal()))
+              .Solve(scale.asDiagonal() * normal->jtr));
     if (!delta.allFinite()) return false;
     Eigen::Matrix3d new_rotation = *rotation;
     const double angle = delta.head<3>().norm();

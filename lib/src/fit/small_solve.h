@@ -1,0 +1,83 @@
+// Solving the fitters' small symmetric systems (private): normal equations of at most
+// kMaxParams parameters, factored once and solved for one or more right-hand sides. At these
+// sizes Eigen's pivoted LDL^T spends most of its instructions in its general kernels (a
+// matrix-vector product per column); a plain Cholesky on the fixed-capacity storage does the
+// same n^3 / 6 multiply-adds without them (docs/bench/stage_cost.md).
+//
+// A positive definite system (LM's damped normal equations; a determined fit's J^T J) factors
+// by Cholesky. One whose Cholesky meets a pivot that is not positive and finite -- semidefinite
+// or indefinite to rounding: an undetermined direction -- is factored by Eigen's pivoted LDL^T
+// instead, as every such system was before, so that those cases keep their answers.
+#ifndef CAMPROJ_SRC_FIT_SMALL_SOLVE_H_
+#define CAMPROJ_SRC_FIT_SMALL_SOLVE_H_
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "fit/normal_equations.h"
+
+namespace camproj {
+namespace internal {
+
+class SymmetricSolver {
+ public:
+  // Factors `a` (square, symmetric: only its lower triangle is read by the Cholesky).
+  explicit SymmetricSolver(const ParamMatrix& a) : n_(static_cast<int>(a.rows())) {
+    if (!FactorCholesky(a)) {
+      cholesky_ = false;
+      ldlt_.compute(a);
+    }
+  }
+
+  // a^-1 b.
+  ParamVector Solve(const ParamVector& b) const {
+    if (!cholesky_) return ldlt_.solve(b);
+    ParamVector x = b;
+    for (int i = 0; i < n_; ++i) {  // L y = b
+      double sum = x(i);
+      for (int k = 0; k < i; ++k) sum -= l_(i, k) * x(k);
+      x(i) = sum / l_(i, i);
+    }
+    for (int i = n_ - 1; i >= 0; --i) {  // L^T x = y
+      double sum = x(i);
+      for (int k = i + 1; k < n_; ++k) sum -= l_(k, i) * x(k);
+      x(i) = sum / l_(i, i);
+    }
+    return x;
+  }
+
+  // Whether the Cholesky factored it (else the LDL^T fall-back).
+  bool UsedCholesky() const { return cholesky_; }
+
+ private:
+  // Column by column: L(j, j) = sqrt(a(j, j) - sum_k<j L(j, k)^2), L(i, j) for i > j by the
+  // same sums over row i. False at the first pivot that is not positive and finite.
+  bool FactorCholesky(const ParamMatrix& a) {
+    l_.resize(n_, n_);
+    for (int j = 0; j < n_; ++j) {
+      double pivot = a(j, j);
+      for (int k = 0; k < j; ++k) pivot -= l_(j, k) * l_(j, k);
+      if (!(pivot > 0.0 && std::isfinite(pivot))) return false;
+      const double diagonal = std::sqrt(pivot);
+      l_(j, j) = diagonal;
+      for (int i = j + 1; i < n_; ++i) {
+        double sum = a(i, j);
+        for (int k = 0; k < j; ++k) sum -= l_(i, k) * l_(j, k);
+        l_(i, j) = sum / diagonal;
+      }
+    }
+    return true;
+  }
+
+  int n_ = 0;
+  bool cholesky_ = true;
+  ParamMatrix l_;  // lower triangle: the Cholesky factor
+  Eigen::LDLT<ParamMatrix> ldlt_;
+};
+
+}  // namespace internal
+}  // namespace camproj
+
+#endif  // CAMPROJ_SRC_FIT_SMALL_SOLVE_H_
