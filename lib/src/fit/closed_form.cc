@@ -256,20 +256,29 @@ bool PnpStart(const std::vector<Eigen::Vector3d>& points,
   return true;
 }
 
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinFovDeg = 0.5;
+constexpr double kMaxFovDeg = 175.0;
+
+}  // namespace
+
+double SweepMinFocalPx(int image_width) {
+  return 0.5 * image_width / std::tan(0.5 * kMaxFovDeg * kPi / 180.0);
+}
+
 bool FocalSweepStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& guess,
                      double aspect, int image_width, StartCamera* start,
                      std::vector<StartCamera>* other_minima) {
-  constexpr double kPi = 3.14159265358979323846;
   constexpr int kSteps = 48;
-  constexpr double kMinFovDeg = 0.5;
-  constexpr double kMaxFovDeg = 175.0;
   // Each coarse valley is looked at again on a grid this many times finer between its
   // neighbours: two valleys can lie within one coarse step (a factor 1.2 in focal length; seen:
   // 4 noise-free points with valleys at fx 2911 and 3132 px, LM from the coarse minimum ending
   // in the wrong one at RMS 0.04 px).
   constexpr int kFine = 4;
-  const double f_min = 0.5 * image_width / std::tan(0.5 * kMaxFovDeg * kPi / 180.0);
+  const double f_min = SweepMinFocalPx(image_width);
   const double f_max = 0.5 * image_width / std::tan(0.5 * kMinFovDeg * kPi / 180.0);
   const double kNone = std::numeric_limits<double>::infinity();
   // The RMS of the SQPnP pose at focal length f_min (f_max / f_min)^(step / (kSteps - 1)).

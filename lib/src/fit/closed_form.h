@@ -59,6 +59,9 @@ bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
               StartCamera* start);
 
+// The shortest focal length FocalSweepStart tries: a 175-degree view across the image width.
+double SweepMinFocalPx(int image_width);
+
 // Focal length unknown, everything else given: SQPnP over a log-spaced sweep of focal lengths
 // (fields of view from 0.5 to 175 degrees across the image width), keeping the lowest RMS. With
 // `other_minima`, also the sweep's other local minima of the RMS (best first): with few points

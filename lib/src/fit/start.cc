@@ -129,6 +129,18 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
     if (start.mirrored) {
       start = ProperStartOrRefuse(points, pixels, start, start_model, scene.image_size, options,
                                   start_time);
+    } else if (start_model.free[0] &&
+               !(start.intrinsics.fx >= SweepMinFocalPx(scene.image_size.width))) {
+      // A DLT with a view wider than any the sweep tries (at 6-7 nearly coplanar points its K
+      // can be degenerate: a focal length of 6e-10 px seen) is no start: LM from it runs to
+      // the orthographic limit or crawls 190-260 iterations through a flat valley. The focal
+      // sweep (the start at 4-5 points) starts it instead.
+      StartCamera sweep;
+      if (FocalSweepStart(points, pixels, guess, start_model.value[1], scene.image_size.width,
+                          &sweep, other_sweep_minima)) {
+        start = sweep;
+        *method = "pnp-focal-sweep";
+      }
     }
   } else if (start_model.NumFreeLinear() <= 1 && !start_model.free[1] && !start_model.free[2] &&
              !start_model.free[4]) {
