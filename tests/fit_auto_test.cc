@@ -633,10 +633,15 @@ TEST(FitAutoTest, AMisclickOffThePlaneOfTheOthersIsNotKept) {
 // scene is refused, never guessed -- unless the 9-parameter fit absorbs the mis-click within the
 // noise (3 redundant equations can hide a mis-click along the directions the camera's freedom
 // can follow): at least 95 % of 100 seeds refused (measured: 99), and the refusals are never
-// numerical failures.
+// numerical failures. Nor is the world called mirrored, unless its mirrored reading explains
+// the clicks within the noise (the mis-click absorbed there): 1 of the click benchmark's 400
+// held-out mis-click scenes at 6-7 points. (A mirrored reading that merely fit better than the
+// orthographic camera was called a mirror in 6 and 4 of these 100 at seed offsets 0 and 1000.)
 TEST(FitAutoTest, SixPointsWithAMisclickAreRefused) {
+  constexpr double kMirroredMisclickRate = 1.0 / 400.0;
   std::mt19937_64 rng(testing::Seed(6));
   int answered = 0;
+  int mirrored = 0;
   for (uint64_t seed = 1; seed <= 100; ++seed) {
     SynthScene scene = Clicks(seed, 6);
     std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
@@ -646,10 +651,13 @@ TEST(FitAutoTest, SixPointsWithAMisclickAreRefused) {
       ++answered;
     } catch (const SceneError& e) {
       EXPECT_NE(e.reason(), SceneError::Reason::kNumerical) << e.what();
+      if (e.reason() == SceneError::Reason::kMirroredWorld) ++mirrored;
     }
   }
   RecordProperty("answered", answered);
   EXPECT_LE(answered, 5);
+  testing::ExpectRate("right-handed worlds with a mis-click refused as mirrored", mirrored, 100,
+                      kMirroredMisclickRate);
 }
 
 // 10, 30 and 50 % of 100 points replaced by random pixels: without options the outliers are
