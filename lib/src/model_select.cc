@@ -234,6 +234,15 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
   return text;
 }
 
+// The advice that ends a refusal: "Add <what>", or with points left out by the outlier stage
+// "Fix or drop <them> (left out: ...); add <what>".
+std::string LeftOutThenAdd(const std::string& left_out, const std::string& what) {
+  return (left_out.empty() ? std::string("Add ")
+                           : "Fix or drop " + left_out + " (left out: they disagree with the "
+                                                         "rest by far more than the noise); add ") +
+         what;
+}
+
 // The refusals of the determination check: a camera the points do not pin down to the bound
 // (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
 void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
@@ -242,10 +251,7 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
   const std::string add_points =
       "points where the image has none (toward that pixel) and spread in depth, or fix the "
       "intrinsics you know (--model, or their values)";
-  const std::string advice =
-      left_out.empty() ? "Add " + add_points
-                       : "Fix or drop " + left_out + " (left out: they disagree with the rest by "
-                                                     "far more than the noise); add " + add_points;
+  const std::string advice = LeftOutThenAdd(left_out, add_points);
   if (check.rival == internal::kMirroredReadingName && check.rival_shift_px > check.bound_px) {
     throw SceneError(SceneError::Reason::kAmbiguous,
                      "the points fit about as well with one world axis flipped, and the two "
@@ -302,13 +308,10 @@ void RefuseIfPerspectiveShows(const internal::PerspectiveTest& test, const std::
           " times the noise's square (" + Px(test.sigma_px) + " with it free; at most " +
           g3(test.bound) + " where the depth spread is too small against the distance to "
           "show perspective), and no perspective model was determined by them or fitted better. " +
-          (left_out.empty() ? std::string()
-                            : "Fix or drop " + left_out + " (left out: they disagree with the "
-                              "rest by far more than the noise); ") +
-          (left_out.empty() ? "Add" : "add") +
-          " points spread in depth and across the image, or give the intrinsics you know (e.g. "
-          "--principal-point for a projector's lens shift), so that a perspective camera can be "
-          "fitted");
+          LeftOutThenAdd(left_out,
+                         "points spread in depth and across the image, or give the intrinsics "
+                         "you know (e.g. --principal-point for a projector's lens shift), so "
+                         "that a perspective camera can be fitted"));
 }
 
 // The refusal of a camera whose confidence region has no edge: within the chosen fit's
@@ -334,12 +337,9 @@ void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) 
           " % confidence region, along " +
           along + ", a camera sees some of them from behind or fits them as well, so how far "
           "it is off beyond them cannot be told. " +
-          (left_out.empty() ? std::string()
-                            : "Fix or drop " + left_out + " (left out: they disagree with the "
-                              "rest by far more than the noise); ") +
-          (left_out.empty() ? "Add" : "add") +
-          " points where the image has none and spread in depth, or give the intrinsics you "
-          "know (--model, or their values)");
+          LeftOutThenAdd(left_out,
+                         "points where the image has none and spread in depth, or give the "
+                         "intrinsics you know (--model, or their values)"));
 }
 
 // A selection with every point's residual against its camera, recomputed in world coordinates
@@ -423,7 +423,9 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
       internal::CheckDetermination(gated.selection, kept_points, options);
   RefuseIfUndetermined(determination, gated.selection.fit.model,
                        LeftOutText(gated.residuals_px, left_out, names), options.fit.pixel_origin);
-  RefuseIfRegionUnbounded(gated.selection.fit, LeftOutText(gated.residuals_px, left_out, names));
+  if (std::isfinite(options.max_uncertainty_px)) {
+    RefuseIfRegionUnbounded(gated.selection.fit, LeftOutText(gated.residuals_px, left_out, names));
+  }
 
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);

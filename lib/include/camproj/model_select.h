@@ -56,7 +56,10 @@ struct AutoFitOptions {
   // (SceneError kDegenerate, saying where points are missing); so is one that a model fitting
   // about as well (BIC within kEqualFitCriterion) puts more than this much elsewhere
   // (kAmbiguous). At 6-8 clicked points this is what stands between a fit that passes every
-  // residual test and a camera that is tens of pixels off across the rest of the object.
+  // residual test and a camera that is tens of pixels off across the rest of the object. So is
+  // one whose own confidence region has no edge (FitResult::linearity infinite: within the
+  // 99.99 % region a camera sees points from behind, or fits as well; kDegenerate), whose
+  // linearized sigmas therefore say nothing. Infinity: none of these refusals.
   double max_uncertainty_px = 5.0;
   // Points of the object that were not clicked (e.g. the vertices of the model being mapped), in
   // the world of points_in_world: the determination check judges the camera at those in front of
