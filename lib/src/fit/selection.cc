@@ -439,7 +439,8 @@ bool ModelSelector::ChooseOrthographic(const FitOptions& base, const std::vector
 
 // An orthographic image cannot show a mirrored world (its depth order is a choice), but a
 // perspective camera can: if the mirrored world fits a perspective camera better than the
-// orthographic one chosen, the world frame is left-handed (kMirroredWorld).
+// orthographic one chosen, and within the noise (the gate's test), the world frame is
+// left-handed (kMirroredWorld).
 void ModelSelector::RefuseMirroredIfPerspectiveFits(const FitOptions& base,
                                                     const Ladder& chosen) const {
   FitOptions mirrored = base;
