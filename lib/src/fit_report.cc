@@ -27,6 +27,12 @@ std::string WithSigma(double value, double sigma) {
 
 }  // namespace
 
+std::string ParameterSigmaText(const ParameterSigma& parameter) {
+  return parameter.name + " = " + WithSigma(parameter.value, parameter.sigma) +
+         (parameter.unit.empty() ? "" : " ") +
+         (parameter.unit == "world" ? "(world units)" : parameter.unit);
+}
+
 FitRecord FitRecordOf(const FitResult& fit) {
   FitRecord record;
   record.rms_px = fit.rms_px;
@@ -112,8 +118,7 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
         << source << "):\n";
     for (const ParameterSigma& s : fit.sigmas) {
       if (s.name.rfind("rotation", 0) == 0) continue;
-      out << "  " << s.name << " = " << WithSigma(s.value, s.sigma) << (s.unit.empty() ? "" : " ")
-          << (s.unit == "world" ? "(world units)" : s.unit) << "\n";
+      out << "  " << ParameterSigmaText(s) << "\n";
     }
     double rotation_sigma = 0.0;
     for (const ParameterSigma& s : fit.sigmas) {

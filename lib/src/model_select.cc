@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "camproj/fit_report.h"
 #include "check.h"
 #include "fit/common.h"
 #include "fit/determination.h"
@@ -323,11 +324,7 @@ void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) 
   if (!fit.linearity.checked || std::isfinite(fit.linearity.worst_deviation)) return;
   std::string along = fit.linearity.worst_direction;
   for (const ParameterSigma& s : fit.sigmas) {
-    if (s.name != along) continue;
-    char buffer[96];
-    std::snprintf(buffer, sizeof buffer, " = %.4g +- %.2g%s", s.value, s.sigma,
-                  s.unit == "px" ? " px" : s.unit == "deg" ? " deg" : "");
-    along += buffer;
+    if (s.name == along) along = ParameterSigmaText(s);
   }
   char level[16];
   std::snprintf(level, sizeof level, "%.4g", 100.0 * fit.linearity.level);
@@ -413,18 +410,18 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, kept_pixels, size)) {
     gated.selection.rivals.push_back(std::move(rival));
   }
+  const std::string left_out_text = LeftOutText(gated.residuals_px, left_out, names);
   if (options.fit.projection == Projection::kPerspective) {
     // Chosen, not forced: orthographic only where the perspective is not observable.
     RefuseIfPerspectiveShows(
-        internal::TestPerspectiveStrength(gated.selection, kept_points, options),
-        LeftOutText(gated.residuals_px, left_out, names));
+        internal::TestPerspectiveStrength(gated.selection, kept_points, options), left_out_text);
   }
   const DeterminationCheck determination =
       internal::CheckDetermination(gated.selection, kept_points, options);
-  RefuseIfUndetermined(determination, gated.selection.fit.model,
-                       LeftOutText(gated.residuals_px, left_out, names), options.fit.pixel_origin);
+  RefuseIfUndetermined(determination, gated.selection.fit.model, left_out_text,
+                       options.fit.pixel_origin);
   if (std::isfinite(options.max_uncertainty_px)) {
-    RefuseIfRegionUnbounded(gated.selection.fit, LeftOutText(gated.residuals_px, left_out, names));
+    RefuseIfRegionUnbounded(gated.selection.fit, left_out_text);
   }
 
   FitResult result = std::move(gated.selection.fit);

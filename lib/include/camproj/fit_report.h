@@ -17,6 +17,10 @@ FitRecord FitRecordOf(const FitResult& fit);
 // do about it.
 std::string LinearityText(const LinearityCheck& check);
 
+// One parameter with its sigma as the summary writes it: "fx = 2653 +- 628 px", enough digits
+// to show the sigma's second; "eye_x = 13.5 +- 3.1 (world units)".
+std::string ParameterSigmaText(const ParameterSigma& parameter);
+
 // A few lines: the model (free and fixed parameters and why), each parameter +- sigma in its
 // unit, fovy in degrees, eye and look-at, RMS / median / max residual, the linearity check, the
 // `worst` largest residuals by id (ids[i] names point i; numbers from 1 when empty), and the fit

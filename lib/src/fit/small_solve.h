@@ -48,9 +48,6 @@ class SymmetricSolver {
     return x;
   }
 
-  // Whether the Cholesky factored it (else the LDL^T fall-back).
-  bool UsedCholesky() const { return cholesky_; }
-
  private:
   // Column by column: L(j, j) = sqrt(a(j, j) - sum_k<j L(j, k)^2), L(i, j) for i > j by the
   // same sums over row i. False at the first pivot that is not positive and finite.
