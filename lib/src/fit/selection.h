@@ -60,7 +60,7 @@ struct Prefit {
 // Selects and fits the model for these points (the caller's, in options.fit.pixel_origin;
 // options.fit.ransac must be off). `prefit`: a fit of these same points, or nullptr. Throws
 // SceneError when no model fits (the simplest model's refusal), or kMirroredWorld when only a
-// mirrored perspective camera beats an orthographic one.
+// mirrored perspective camera beats an orthographic one, and within the noise.
 Selection SelectModel(const std::vector<Eigen::Vector3d>& points_in_world,
                       const std::vector<Eigen::Vector2d>& observed_pixels,
                       const ImageSize& image_size, const AutoFitOptions& options,
