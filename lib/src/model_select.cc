@@ -521,6 +521,10 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
     // outlier stage looks for the points to leave out. Then the model selection on the rest,
     // and its gate; a clean screen whose selection still fails the gate gets the search too.
     const internal::Screen screen = internal::ScreenPoints(points, pixels, size, options, noise);
+    // A refusal of every point that no choice of points should change is the answer: leaving
+    // points out could only find a subset that escapes it (coordinates whose offset leaves too
+    // few digits pass the check once a point with a far pixel is dropped).
+    if (screen.refusal && Final(screen.refusal->reason())) throw *screen.refusal;
     std::optional<internal::OutlierSearch> search;
     auto run_search = [&] {
       search = internal::FindOutliers(points, pixels, size, options, noise, names);

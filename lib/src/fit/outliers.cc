@@ -64,10 +64,12 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
       subset.fit = Prefit{model, std::move(fit)};
+      subset.refusal.reset();
       return subset;
     } catch (const SceneError& e) {
       // Not determined by this subset: try the next model.
       subset.summary = e.what();
+      subset.refusal = e;
       if (next_only_for_planes && e.reason() != SceneError::Reason::kPlanarUnderdetermined) {
         return subset;
       }

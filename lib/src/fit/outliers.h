@@ -37,6 +37,7 @@ struct Screen {
   bool consistent = false;
   std::string summary;  // the gate's verdict, or the last refusal
   std::optional<Prefit> fit;  // the model fitted and its fit, unless every model was refused
+  std::optional<SceneError> refusal;  // the last model's, when every model was refused
 };
 
 Screen ScreenPoints(const std::vector<Eigen::Vector3d>& points_in_world,
