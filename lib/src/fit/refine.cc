@@ -88,11 +88,29 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
   // With few points the sweep's RMS over the focal length can have several valleys (seen: 4
   // noise-free points fitted at fx 3292 px, RMS 0.19 px, for a true 1220 px; tests/fit_test.cc
   // NoiseFreeTest GluPerspective): refine also from each other valley's start.
-  for (const StartCamera& other : start.other_sweep_minima) {
-    KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, other.rotation, other.center,
-                                    ProjectOntoModel(start.model, other.intrinsics), options,
-                                    start_time),
-                 &best);
+  auto refine_from_sweep_valleys = [&](const std::vector<StartCamera>& valleys) {
+    for (const StartCamera& other : valleys) {
+      KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, other.rotation, other.center,
+                                      ProjectOntoModel(start.model, other.intrinsics), options,
+                                      start_time),
+                   &best);
+    }
+  };
+  refine_from_sweep_valleys(start.other_sweep_minima);
+  if (start.method == "homography" && !scene.planar && scene.model.free[0] &&
+      scene.NumPoints() < kSecondStartBelowPoints && MayBeAboveTheMinimum(best, scene, effort)) {
+    // Points only nearly coplanar (thinner than kPlanarStartRatio, not kPlanarRatio: at 4-5
+    // points always a start from a homography) are not on the homography's plane, and LM from
+    // its camera can stop in a local minimum (seen: 4 noise-free points fitted at RMS 0.35 px, fx
+    // 361 px off, rotated 172 deg; NoiseFreeTest GluPerspective at seed offset 123). Refine also
+    // from every valley of the focal sweep, the start at 4-5 points off a plane.
+    StartCamera sweep;
+    std::vector<StartCamera> valleys;
+    if (FocalSweepStart(scene.points, scene.pixels, scene.model.ToIntrinsics(),
+                        scene.model.value[1], scene.image_size.width, &sweep, &valleys)) {
+      valleys.insert(valleys.begin(), sweep);
+      refine_from_sweep_valleys(valleys);
+    }
   }
   const bool distortion_free = scene.model.free[5] || scene.model.free[6];
   if (distortion_free && scene.model.free[2] && MayBeAboveTheMinimum(best, scene, effort)) {
