@@ -368,8 +368,12 @@ namespace camproj {
 namespace {
 
 // The ladder across views (select_model) over OpenCV's groups, skew not a candidate, on 8 noisy
-// boards (432 points, ln 2N = 6.76), 40 seeds each. What these views determine: aspect (826 / 820)
-// and k1 always (BIC -30 to -1700 measured); the 12 px principal point offset (sigma ~2.3 px) and
+// boards (432 points, ln 2N = 6.76), 40 seeds each. What these views determine: k1 always, and
+// aspect (826 / 820) nearly always (BIC -30 to -1700 measured; left out in 2 of the 4000 sets of
+// seed offsets 0, 40, ..., 1960 with and without p1, p2: chi-square falls of 5.7 and 6.0, below
+// ln 2N, where the views pin the aspect poorly), so at most kAspectMissesAllowed of 40 (at the
+// rate's 99 % upper limit, 2.1e-3, P(3 or more of 40) = 1e-4); the 12 px
+// principal point offset (sigma ~2.3 px) and
 // k2 = 0.07 (its sigma here is of its size: the boards reach r ~0.45) only sometimes, so neither
 // is asserted. A group the truth lacks is freed when its chi-square beats its BIC cost:
 // P(chi2_1 > 6.76) = 0.0093 for k3, P(chi2_2 > 13.5) = 0.0012 for p1, p2, so ~0.4 of 40 sets
@@ -378,6 +382,7 @@ namespace {
 // freed in every seed at those offsets (bound 38 of 40); at p1 = 0.002 in about half.
 TEST(CalibrateTest, ModelLadderFreesWhatTheViewsNeed) {
   constexpr int kSeeds = 40;
+  constexpr int kAspectMissesAllowed = 2;
   CalibrateOptions options = Options();
   options.select_model = true;
   options.num_radial = 3;
@@ -389,7 +394,7 @@ TEST(CalibrateTest, ModelLadderFreesWhatTheViewsNeed) {
       truth.p1 = 0.006;
       truth.p2 = -0.005;
     }
-    int extra = 0, tangential_found = 0;
+    int extra = 0, tangential_found = 0, aspect_missed = 0;
     for (int s = 0; s < kSeeds; ++s) {
       const Calibration c = Calibrate(Views(Seed(5000 + s), 8, true, 0.5, truth), options);
       ASSERT_EQ(c.model_choice.size(), 7u);
@@ -398,8 +403,10 @@ TEST(CalibrateTest, ModelLadderFreesWhatTheViewsNeed) {
         free[m.group] = m.free;
         EXPECT_FALSE(m.reason.empty()) << m.group;
       }
-      for (const char* needed : {"aspect", "k1"}) {
-        EXPECT_TRUE(free[needed]) << needed << ", seed " << s;
+      EXPECT_TRUE(free["k1"]) << "seed " << s;
+      if (!free["aspect"]) {
+        ++aspect_missed;
+        std::cout << "seed " << s << ": " << c.model_choice[1].reason << "\n";
       }
       EXPECT_FALSE(free["skew"]);  // skew_free false: not a candidate
       EXPECT_EQ(c.model_choice[2].reason, "not a candidate (held by the options)");
@@ -409,6 +416,7 @@ TEST(CalibrateTest, ModelLadderFreesWhatTheViewsNeed) {
     std::cout << (tangential ? "with" : "without") << " p1, p2: tangential freed in "
               << tangential_found << ", k3 or tangential beyond the truth in " << extra << " of "
               << kSeeds << "\n";
+    EXPECT_LE(aspect_missed, kAspectMissesAllowed);
     if (tangential) {
       EXPECT_GE(tangential_found, 38);
     } else {
