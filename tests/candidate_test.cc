@@ -168,9 +168,17 @@ TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
         EXPECT_EQ(chosen.sigmas.size(), scratch.sigmas.size());
         EXPECT_TRUE(chosen.views.clip_from_gl_eye.allFinite());
         EXPECT_EQ(chosen.linearity.checked, scratch.linearity.checked);
-        const FitResult automatic = FitCameraAuto(points, pixels, scene.truth.image_size);
-        EXPECT_NE(automatic.start_method, "warm");
-        EXPECT_FALSE(automatic.start_method.empty());
+        // (A clean scene may be refused as not determined: at seed offset 77777, N 20, pose +
+        // focal + k1 + k2 and pose + focal + principal point fit about as well and part by 8 px.)
+        try {
+          const FitResult automatic = FitCameraAuto(points, pixels, scene.truth.image_size);
+          EXPECT_NE(automatic.start_method, "warm");
+          EXPECT_FALSE(automatic.start_method.empty());
+        } catch (const SceneError& e) {
+          EXPECT_TRUE(e.reason() == SceneError::Reason::kAmbiguous ||
+                      e.reason() == SceneError::Reason::kDegenerate)
+              << e.what();
+        }
         ++compared;
       }
     }
