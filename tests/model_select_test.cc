@@ -1,6 +1,7 @@
 #include "camproj/model_select.h"
 
 #include <cmath>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -74,17 +75,49 @@ TEST(ModelSelectTest, PerspectiveCameraKeepsTheSimplestModel) {
   RecordProperty("simplest_of_200", simplest);
 }
 
+// The fit of `scene`, or nullopt where the determination check refuses it (kAmbiguous: a rival
+// that fits about as well puts the scene elsewhere; kDegenerate: too uncertain); any other
+// refusal fails the test.
+std::optional<FitResult> AutoUnlessUndetermined(const SynthScene& scene) {
+  try {
+    return Auto(scene);
+  } catch (const SceneError& e) {
+    EXPECT_TRUE(e.reason() == SceneError::Reason::kAmbiguous ||
+                e.reason() == SceneError::Reason::kDegenerate)
+        << e.what();
+  }
+  return std::nullopt;
+}
+
+// Clean 30-point scenes are refused as not determined now and then: a rival that fits about as
+// well (e.g. + k1 for + principal point, 5.1-5.7 px apart against the 5 px bound). Measured on
+// synth seeds 1-2000 (what the two tests below draw, without a seed offset): the projector 1,
+// the stretched pixels 4, the 40 deg view 2, the 0.03 deg view 6 of 2000 each. Each test allows
+// kUndeterminedAllowed of its fits: at the 99 % upper limit of those rates (2.9e-3 and 3.9e-3
+// per fit) P(3 or more) is 0.4 % over 100 fits and 0.06 % over 40.
+constexpr int kUndeterminedAllowed = 2;
+
 // Effects far above the noise are always kept: a principal point at the bottom edge moves every
 // pixel by ~540 px against 0.5 px noise; an aspect of 1.05 moves the image's top edge by ~27 px.
 TEST(ModelSelectTest, KeepsWhatTheDataNeed) {
+  int undetermined = 0;
   for (uint64_t seed = 1; seed <= 50; ++seed) {
-    const FitResult projector = Auto(Projector(seed, 30, 0.5, 0.5));
-    EXPECT_NE(projector.model.find("principal-point"), std::string::npos)
-        << "seed " << seed << ": " << projector.model;
-    const FitResult stretched = Auto(Projector(seed, 30, 0.5, 0.0, 1.05));
-    EXPECT_NE(stretched.model.find("aspect"), std::string::npos)
-        << "seed " << seed << ": " << stretched.model;
+    if (const std::optional<FitResult> projector =
+            AutoUnlessUndetermined(Projector(seed, 30, 0.5, 0.5))) {
+      EXPECT_NE(projector->model.find("principal-point"), std::string::npos)
+          << "seed " << seed << ": " << projector->model;
+    } else {
+      ++undetermined;
+    }
+    if (const std::optional<FitResult> stretched =
+            AutoUnlessUndetermined(Projector(seed, 30, 0.5, 0.0, 1.05))) {
+      EXPECT_NE(stretched->model.find("aspect"), std::string::npos)
+          << "seed " << seed << ": " << stretched->model;
+    } else {
+      ++undetermined;
+    }
   }
+  EXPECT_LE(undetermined, kUndeterminedAllowed);
 }
 
 // Radial distortion k1 = -0.2 at a 60 degree horizontal field of view in 1280 x 800 (corner at
@@ -172,7 +205,12 @@ TEST(ModelSelectTest, ExactDataGiveTheExactCamera) {
 // 0.5 px noise on 30 points leaves in a 6-parameter fit, sqrt(6 / 30) * 0.5 * sqrt(2) = 0.32 px
 // in expectation; 3x that bounds it. At 40 degrees the perspective is overwhelming (BIC
 // differences of thousands): never orthographic.
+// (The 0.03 deg view's refusals: its perspective camera chosen by chance, fx ~2e5 px, whose
+// confidence region reaches cameras that see points from behind. A perspective fit that ran
+// through the orthographic limit to points behind it was refused as inconsistent correspondences
+// in 3 more of 2000 before the affine camera's test, selection.cc AffineExplains.)
 TEST(ModelSelectTest, OrthographicWhenThePerspectiveIsNotObservable) {
+  int undetermined = 0;
   for (uint64_t seed = 1; seed <= 20; ++seed) {
     SynthOptions synth;
     synth.seed = testing::Seed(seed);
@@ -180,17 +218,57 @@ TEST(ModelSelectTest, OrthographicWhenThePerspectiveIsNotObservable) {
     synth.noise_px = 0.5;
     synth.fovy_deg = 0.03;
     const SynthScene tele = SynthesizeScene(synth);
-    const FitResult fit = Auto(tele);
-    ASSERT_EQ(fit.camera.projection, Projection::kOrthographic) << "seed " << seed << ": " << fit.model;
-    double sum = 0.0;
-    for (const Eigen::Vector3d& x : tele.correspondences.points_in_world) {
-      sum += (*PixelFromWorld(fit.camera, x) - *PixelFromWorld(tele.truth, x)).squaredNorm();
+    if (const std::optional<FitResult> fit = AutoUnlessUndetermined(tele)) {
+      ASSERT_EQ(fit->camera.projection, Projection::kOrthographic)
+          << "seed " << seed << ": " << fit->model;
+      double sum = 0.0;
+      for (const Eigen::Vector3d& x : tele.correspondences.points_in_world) {
+        sum += (*PixelFromWorld(fit->camera, x) - *PixelFromWorld(tele.truth, x)).squaredNorm();
+      }
+      EXPECT_LT(std::sqrt(sum / 30.0), 3.0 * std::sqrt(6.0 / 30.0) * 0.5 * std::sqrt(2.0))
+          << "seed " << seed;
+    } else {
+      ++undetermined;
     }
-    EXPECT_LT(std::sqrt(sum / 30.0), 3.0 * std::sqrt(6.0 / 30.0) * 0.5 * std::sqrt(2.0)) << "seed " << seed;
 
     synth.fovy_deg = 40.0;
-    EXPECT_EQ(Auto(SynthesizeScene(synth)).camera.projection, Projection::kPerspective) << "seed " << seed;
+    if (const std::optional<FitResult> fit = AutoUnlessUndetermined(SynthesizeScene(synth))) {
+      EXPECT_EQ(fit->camera.projection, Projection::kPerspective) << "seed " << seed;
+    } else {
+      ++undetermined;
+    }
   }
+  EXPECT_LE(undetermined, kUndeterminedAllowed);
+}
+
+// Regression (the 0.03 deg view at synth seed 405): the perspective fit runs through the
+// orthographic limit to a camera with points behind it, which refused the clean scene as
+// inconsistent correspondences; the affine camera explains the points, and the orthographic
+// camera is the answer, within the bound above.
+TEST(ModelSelectTest, APerspectiveFitLostBeyondTheOrthographicLimitIsNoContamination) {
+  SynthOptions synth;
+  synth.seed = 405;
+  synth.num_points = 30;
+  synth.noise_px = 0.5;
+  synth.fovy_deg = 0.03;
+  const SynthScene tele = SynthesizeScene(synth);
+  FitOptions perspective;
+  perspective.aspect = ParameterMode::Default();
+  perspective.principal_point = ParameterMode::Default();
+  try {
+    FitCamera(tele.correspondences.points_in_world, tele.correspondences.pixels,
+              tele.truth.image_size, perspective);
+    ADD_FAILURE() << "the perspective fit is no longer refused: this case tests nothing";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.reason(), SceneError::Reason::kPointsBehindCamera) << e.what();
+  }
+  const FitResult fit = Auto(tele);
+  EXPECT_EQ(fit.camera.projection, Projection::kOrthographic) << fit.model;
+  double sum = 0.0;
+  for (const Eigen::Vector3d& x : tele.correspondences.points_in_world) {
+    sum += (*PixelFromWorld(fit.camera, x) - *PixelFromWorld(tele.truth, x)).squaredNorm();
+  }
+  EXPECT_LT(std::sqrt(sum / 30.0), 3.0 * std::sqrt(6.0 / 30.0) * 0.5 * std::sqrt(2.0));
 }
 
 TEST(ModelSelectTest, RobustLossIsRefusedWithTheAlternative) {
