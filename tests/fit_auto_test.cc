@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -666,7 +667,15 @@ TEST(FitAutoTest, SixPointsWithAMisclickAreRefused) {
 // (p = 9 parameters, sigma 0.7 px plus rounding 0.29 px); 3x that bounds it. Random pixels that
 // land within the inlier bound of their true projection by chance may be kept (probability ~1e-4
 // each), so the outlier set is checked to contain every point further than 20 px.
+// Refusals are counted, not failures, per clean scene (a seed; its three fractions share its
+// points and often its fate): on seeds 1-2000 of these scenes (6000 fits) 9 were refused as not
+// determined (a rival such as + k1 fitting about as well, 5-10 px apart over the widened box) and
+// 1 by the gate (a random pixel 4.8 px from its point's projection, not named by the re-read
+// consensus), in 9 scenes; at the 99 % upper limit of that rate (9.5e-3 per scene) 3 or more of
+// these 10 scenes refused has probability 1.4e-4.
 TEST(FitAutoTest, OutliersAreLeftOutWithoutOptions) {
+  constexpr int kScenesRefusedAllowed = 2;
+  std::set<uint64_t> refused;
   for (const double fraction : {0.1, 0.3, 0.5}) {
     for (uint64_t seed = 1; seed <= 10; ++seed) {
       SynthScene scene = Clicks(seed, 100, SynthObject::kCloud);
@@ -681,7 +690,11 @@ TEST(FitAutoTest, OutliersAreLeftOutWithoutOptions) {
       try {
         fit = Auto(points, pixels);
       } catch (const SceneError& e) {
-        ADD_FAILURE() << "fraction " << fraction << " seed " << seed << ": " << e.what();
+        EXPECT_TRUE(e.reason() == SceneError::Reason::kAmbiguous ||
+                    e.reason() == SceneError::Reason::kDegenerate ||
+                    e.reason() == SceneError::Reason::kInconsistent)
+            << "fraction " << fraction << " seed " << seed << ": " << e.what();
+        refused.insert(seed);
         continue;
       }
       double sum = 0.0;
@@ -703,6 +716,7 @@ TEST(FitAutoTest, OutliersAreLeftOutWithoutOptions) {
           << "fraction " << fraction << " seed " << seed << " model " << fit.model;
     }
   }
+  EXPECT_LE(refused.size(), kScenesRefusedAllowed);
 }
 
 // Purely random pixels are refused, never answered.
