@@ -75,6 +75,10 @@ constexpr double kPlanar = 1e-10;
 // that is below this fraction of ||m||^3 the nearest rotation is ill-conditioned and an SVD
 // computes it instead. Above it FOAM loses at most ~1e-10 relative.
 constexpr double kFoamMinDenominator = 1e-6;
+// FOAM's rotation is checked: max |R^T R - I| above this and the SVD computes it instead.
+// Rounding leaves ~1e-15 where FOAM converged; seen above it: 3e-3 to 0.98 at a 0.01 deg view
+// (FitAutoStress, wild-intrinsics), where the Newton iteration stopped short of the root.
+constexpr double kFoamOrthonormal = 1e-12;
 // FOAM's Newton iteration for its quartic's largest root (monotone from the upper bound it
 // starts at): at most this many steps, stopping at a relative change of kFoamRelativeStep.
 constexpr int kFoamMaxSteps = 15;
@@ -173,7 +177,13 @@ Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
   if (!(denominator > kFoamMinDenominator * m_sq * std::sqrt(m_sq))) {
     return NearestRotationSvd(m);
   }
-  return ((l * l + m_sq) * m + 2.0 * l * cof - 2.0 * m * m.transpose() * m) / denominator;
+  const Eigen::Matrix3d r =
+      ((l * l + m_sq) * m + 2.0 * l * cof - 2.0 * m * m.transpose() * m) / denominator;
+  if (!((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <=
+        kFoamOrthonormal)) {
+    return NearestRotationSvd(m);
+  }
+  return r;
 }
 
 // How an SQP step treats the tangent space (SqpStep).
