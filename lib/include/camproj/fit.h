@@ -9,6 +9,13 @@
 // predicted - observed pixels; rotation on a quaternion manifold, translation in a world frame
 // centred and scaled to the points (so units and offsets do not matter); fixed intrinsics are
 // constants, not penalties. Conventions: docs/conventions.md.
+//
+// Below 20 points a fit that may sit in a local minimum is refined from more starts, keeping the
+// lowest cost: a DLT start with the principal point free also from the image centre; a focal
+// sweep start from each other valley of its RMS; and from every valley of the focal sweep (SQPnP
+// over fields of view 0.5-175 deg) a homography start for points only nearly coplanar and a DLT
+// start whose best fit has an intrinsic no lens has (pixels 1.5 times as tall as wide or more,
+// the principal point more than an image size from the centre). Details: fit/refine.cc.
 #ifndef CAMPROJ_FIT_H_
 #define CAMPROJ_FIT_H_
 
