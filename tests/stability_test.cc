@@ -1159,9 +1159,18 @@ std::vector<Case> AllCases() {
   cases.push_back(FittedNoisy(
       "NearPlanar1em2FullModelNoisy", "near-planar, thickness 0.01, full model, 0.5 px noise",
       [] { return NearPlanar(1e-2, true); }, 0.5, 45,
-      // Curved in 1619 of 1620 draws at seed offsets 0-80; the one reported linear sat on a
-      // straight stretch of the valley with the truth beyond the probe (NEES above its bound).
-      NoisyExpectation{kNoisyDraws, kNoisyDraws - 2, 0.0, true, ""}));
+      [] {
+        // Curved in 1619 of 1620 draws at seed offsets 0-80; the one reported linear sat on a
+        // straight stretch of the valley with the truth beyond the probe (NEES above its bound).
+        NoisyExpectation e{kNoisyDraws, kNoisyDraws - 2, 0.0, true, ""};
+        // Refused short of the minimum (LM stops on its cost tolerance in the flat, curved
+        // valley after ~110 iterations) in 2 of 6000 draws at seed offsets 0, 20, ..., 5980,
+        // and at offset 2048: p 1e-3 is above the measured rate's 99 % upper limit (1.4e-3 is
+        // its 99.9 %); ExpectRate allows 3 of 20 at level 1e-6.
+        e.refusal_rate = 1e-3;
+        e.why = "2 of 6000 draws refused short of the minimum at seed offsets 0-5980";
+        return e;
+      }()));
   cases.push_back(FittedNoisy(
       "LensShiftTwoWidthsLeftNoisy10", "pp two widths left, 10 px noise",
       [] { return LensShift(-2560.5, 399.5, 0.0, 22); }, 10.0, 46,
