@@ -1089,6 +1089,16 @@ TEST(FitTest, TheSameMinimumFoundAgainIsNoRival) {
   std::printf("[ INFO ] other minima named as rivals: %d of 40 scenes\n", named);
 }
 
+// Six points of a projector (principal point at the bottom edge) at `noise_px`.
+SynthOptions SixPointProjector(uint64_t seed, double noise_px) {
+  SynthOptions synth;
+  synth.seed = seed;
+  synth.num_points = 6;
+  synth.noise_px = noise_px;
+  synth.principal_point_offset = Eigen::Vector2d(0, 0.5);
+  return synth;
+}
+
 // Under noise a six-point DLT of a right-handed world can flip its determinant's sign; the fitter
 // then refines both readings and believes the mirror only when it fits better. So a right-handed
 // scene is never refused as definitely left-handed (a refusal, if any, must say the data cannot
@@ -1098,20 +1108,12 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
   int flipped_refusals = 0;
   for (uint64_t seed = 1; seed <= 400; ++seed) {
     for (const double noise_px : {2.0, 5.0}) {
-      SynthOptions synth;
-      synth.seed = testing::Seed(seed);
-      synth.num_points = 6;
-      synth.noise_px = noise_px;
-      synth.principal_point_offset = Eigen::Vector2d(0, 0.5);
+      SynthOptions synth = SixPointProjector(testing::Seed(seed), noise_px);
       const SynthScene scene = SynthesizeScene(synth);
       const Correspondences& c = scene.correspondences;
-      double truth_sum = 0.0;
-      for (size_t i = 0; i < c.pixels.size(); ++i) {
-        truth_sum += (*PixelFromWorld(scene.truth, c.points_in_world[i]) - c.pixels[i]).squaredNorm();
-      }
       try {
         const FitResult fit = FitCamera(c.points_in_world, c.pixels, synth.image_size);
-        EXPECT_LE(fit.rms_px, std::sqrt(truth_sum / c.pixels.size()) * (1.0 + 1e-9))
+        EXPECT_LE(fit.rms_px, TruthRmsPx(scene) * (1.0 + 1e-9))
             << "seed " << seed << " noise " << noise_px;
       } catch (const SceneError& e) {
         if (e.reason() != SceneError::Reason::kAmbiguous) continue;
@@ -1145,19 +1147,11 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
 TEST(FitTest, SixNoisyPointsAreNotLeftInAMinimumNoLensHas) {
   const std::pair<uint64_t, double> cases[] = {{1623, 5.0}, {2099, 5.0}, {2232, 2.0}, {3431, 2.0}};
   for (const auto& [seed, noise_px] : cases) {
-    SynthOptions synth;
-    synth.seed = seed;
-    synth.num_points = 6;
-    synth.noise_px = noise_px;
-    synth.principal_point_offset = Eigen::Vector2d(0, 0.5);
+    const SynthOptions synth = SixPointProjector(seed, noise_px);
     const SynthScene scene = SynthesizeScene(synth);
     const Correspondences& c = scene.correspondences;
-    double truth_sum = 0.0;
-    for (size_t i = 0; i < c.pixels.size(); ++i) {
-      truth_sum += (*PixelFromWorld(scene.truth, c.points_in_world[i]) - c.pixels[i]).squaredNorm();
-    }
     const FitResult fit = FitCamera(c.points_in_world, c.pixels, synth.image_size);
-    EXPECT_LE(fit.rms_px, std::sqrt(truth_sum / c.pixels.size()) * (1.0 + 1e-9)) << "seed " << seed;
+    EXPECT_LE(fit.rms_px, TruthRmsPx(scene) * (1.0 + 1e-9)) << "seed " << seed;
   }
 }
 

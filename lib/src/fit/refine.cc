@@ -108,32 +108,23 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
     }
   };
   refine_from_sweep_valleys(start.other_sweep_minima);
-  if (start.method == "dlt" && scene.NumPoints() < kSecondStartBelowPoints &&
-      scene.model.free[0] && best.ok && UnlikeAnyLens(best.model, scene.image_size) &&
-      MayBeAboveTheMinimum(best, scene, effort)) {
-    // A DLT on few noisy points can start LM (and the second start) in a minimum with an
-    // intrinsic no lens has (seen at 6 points, 2-5 px noise, focal + aspect + principal point
-    // free: aspect 0.56-2.3, a principal point 1.9-4.5 image sizes off centre, rms 7.5 px where
-    // the truth's is 3.0; 4 of 8000 scenes fitted worse than the truth, FitTest.
-    // NoisySixPointScenesAreNotCalledMirrored). There, refine also from every valley of the focal
-    // sweep (square pixels, the image centre), and keep the lowest cost. (Not for a candidate
-    // of the model selection already consistent with the noise, as the restarts above: at 6
-    // points that cost the default path 10 % more instructions.)
-    StartCamera sweep;
-    std::vector<StartCamera> valleys;
-    if (FocalSweepStart(scene.points, scene.pixels, scene.model.ToIntrinsics(),
-                        scene.model.value[1], scene.image_size.width, &sweep, &valleys)) {
-      valleys.insert(valleys.begin(), sweep);
-      refine_from_sweep_valleys(valleys);
-    }
-  }
-  if (start.method == "homography" && !scene.planar && scene.model.free[0] &&
+  // Refine also from every valley of the focal sweep (square pixels, the image centre), the start
+  // at 4-5 points off a plane, where another closed form may have started LM in a local minimum:
+  // - a homography for points only nearly coplanar (thinner than kPlanarStartRatio, not
+  //   kPlanarRatio: at 4-5 points always), which are not on its plane (seen: 4 noise-free points
+  //   fitted at RMS 0.35 px, fx 361 px off, rotated 172 deg; NoiseFreeTest GluPerspective at
+  //   seed offset 123);
+  // - a DLT on few noisy points whose fit (and second start) ended with an intrinsic no lens has
+  //   (seen at 6 points, 2-5 px noise, focal + aspect + principal point free: aspect 0.56-2.3,
+  //   a principal point 1.9-4.5 image sizes off centre, rms 7.5 px where the truth's is 3.0; 4 of
+  //   8000 scenes fitted worse than the truth, FitTest.NoisySixPointScenesAreNotCalledMirrored).
+  // Not for a candidate of the model selection already consistent with the noise, as the
+  // restarts above (for the DLT's: 10 % more instructions for the default path at 6 points).
+  const bool nearly_planar = start.method == "homography" && !scene.planar;
+  const bool unlike_any_lens =
+      start.method == "dlt" && best.ok && UnlikeAnyLens(best.model, scene.image_size);
+  if ((nearly_planar || unlike_any_lens) && scene.model.free[0] &&
       scene.NumPoints() < kSecondStartBelowPoints && MayBeAboveTheMinimum(best, scene, effort)) {
-    // Points only nearly coplanar (thinner than kPlanarStartRatio, not kPlanarRatio: at 4-5
-    // points always a start from a homography) are not on the homography's plane, and LM from
-    // its camera can stop in a local minimum (seen: 4 noise-free points fitted at RMS 0.35 px, fx
-    // 361 px off, rotated 172 deg; NoiseFreeTest GluPerspective at seed offset 123). Refine also
-    // from every valley of the focal sweep, the start at 4-5 points off a plane.
     StartCamera sweep;
     std::vector<StartCamera> valleys;
     if (FocalSweepStart(scene.points, scene.pixels, scene.model.ToIntrinsics(),
