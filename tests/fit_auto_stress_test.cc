@@ -727,8 +727,10 @@ TEST(FitAutoStress, TwoThousandAdversarialScenesKeepTheContract) {
 // - 1023 at offset 4096 (wild-intrinsics: N 10, a 0.01 deg view, the principal point 4.49 image
 //   sizes off): SQPnP's nearest rotation by FOAM returned matrices up to 0.98 from orthonormal,
 //   LM kept the error, and the refit's camera was refused as not a rotation (kNumerical).
+// - 1751 at offset 424242 (wild-intrinsics: N 8, a 0.01 deg view, aspect 1.38): SQPnP's search
+//   flipped a planar pose seen from behind, and its flip again, without end (a stack overflow).
 TEST(FitAutoStress, ScenesThatOnceBrokeTheContract) {
-  const std::pair<int, uint64_t> scenes[] = {{1023, 4096}};
+  const std::pair<int, uint64_t> scenes[] = {{1023, 4096}, {1751, 424242}};
   for (const auto& [seed, offset] : scenes) {
     const Outcome outcome = RunScene(MakeStressSceneAt(seed, offset));
     EXPECT_TRUE(outcome.violation.empty())

@@ -311,17 +311,20 @@ class Search {
   // with every point in front is preferred, then by Kind (an r_hat off the rotations, an
   // eigenvector or where SQP stopped unconverged, can cost less than the rotation it stands
   // for), then the lower cost.
-  void Consider(const Vector9& r_hat, bool from_sqp, bool converged) {
+  // `flip`: whether a planar scene seen from behind may be considered flipped (once: the flip of
+  // a flip is not tried again, which rounding could otherwise repeat without end -- seen: a stack
+  // overflow at FitAutoStress seed offset 424242).
+  void Consider(const Vector9& r_hat, bool from_sqp, bool converged, bool flip = true) {
     if (!r_hat.allFinite()) return;
     const Eigen::Vector3d t = problem_.p * r_hat;
-    if (planar_normal_ != nullptr && t.z() < 0.0) {
+    if (flip && planar_normal_ != nullptr && t.z() < 0.0) {
       // A plane's points (centred: n.X = 0) seen behind the camera by (R, t) are seen in front,
       // on the same rays, by (-R (I - 2 n n^T), -t): a proper rotation with r^T Omega r the same
       // (the two differ by a null vector of Omega).
       const Eigen::Vector3d& n = *planar_normal_;
       const Eigen::Matrix3d flipped =
           -AsMatrix(r_hat) * (Eigen::Matrix3d::Identity() - 2.0 * n * n.transpose());
-      Consider(AsVector(flipped), from_sqp, converged);
+      Consider(AsVector(flipped), from_sqp, converged, /*flip=*/false);
     }
     if (!(t.z() > 0.0) && 2 * InFront(r_hat, t) < Count()) return;
     const double cost = r_hat.dot(problem_.omega * r_hat);
