@@ -1102,10 +1102,14 @@ SynthOptions SixPointProjector(uint64_t seed, double noise_px) {
 // Under noise a six-point DLT of a right-handed world can flip its determinant's sign; the fitter
 // then refines both readings and believes the mirror only when it fits better. So a right-handed
 // scene is never refused as definitely left-handed (a refusal, if any, must say the data cannot
-// tell), and any camera it returns is no worse than the truth (the truth is feasible). A
-// left-handed copy of a noise-free scene fits no proper camera and is always refused.
+// tell), and any camera it returns is no worse than the truth (the truth is feasible) -- but
+// for a rate: LM from the closed forms can still end in a higher local minimum, in 7 of 80000 of
+// these fits at synth seeds 1-40000 (rms 3.1-28 px for the truth's 2.6-10), so p 2e-4 per fit,
+// above the 99 % upper limit of that rate (1.8e-4). A left-handed copy of a noise-free scene fits
+// no proper camera and is always refused.
 TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
-  int flipped_refusals = 0;
+  constexpr double kAboveTheTruthRate = 2e-4;
+  int flipped_refusals = 0, fitted = 0, above_the_truth = 0;
   for (uint64_t seed = 1; seed <= 400; ++seed) {
     for (const double noise_px : {2.0, 5.0}) {
       SynthOptions synth = SixPointProjector(testing::Seed(seed), noise_px);
@@ -1113,8 +1117,13 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
       const Correspondences& c = scene.correspondences;
       try {
         const FitResult fit = FitCamera(c.points_in_world, c.pixels, synth.image_size);
-        EXPECT_LE(fit.rms_px, TruthRmsPx(scene) * (1.0 + 1e-9))
-            << "seed " << seed << " noise " << noise_px;
+        ++fitted;
+        if (!(fit.rms_px <= TruthRmsPx(scene) * (1.0 + 1e-9))) {
+          ++above_the_truth;
+          std::printf("seed %llu noise %g: rms %g px above the truth's %g px\n",
+                      static_cast<unsigned long long>(seed), noise_px, fit.rms_px,
+                      TruthRmsPx(scene));
+        }
       } catch (const SceneError& e) {
         if (e.reason() != SceneError::Reason::kAmbiguous) continue;
         ++flipped_refusals;
@@ -1137,6 +1146,7 @@ TEST(FitTest, NoisySixPointScenesAreNotCalledMirrored) {
     }
   }
   RecordProperty("ambiguous_mirror_refusals", flipped_refusals);
+  testing::ExpectRate("fits above the truth's cost", above_the_truth, fitted, kAboveTheTruthRate);
 }
 
 // Regression (NoisySixPointScenesAreNotCalledMirrored at seed offsets 2024 and 77777): the four
