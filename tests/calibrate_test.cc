@@ -303,17 +303,25 @@ TEST(CalibrateTest, CrossValidationMatchesTheCovariances) {
   EXPECT_NEAR(ratio_sum / kSeeds, 1.0, 0.5);
 }
 
+// `good` with a board view of seed `seed` named "swapped" inserted fifth, its first two rows of
+// pixels swapped (wrong correspondences, ~34 px RMS).
+std::vector<CalibrationView> WithSwappedView(const std::vector<CalibrationView>& good,
+                                             uint64_t seed) {
+  std::vector<CalibrationView> views = good;
+  CalibrationView swapped = Views(seed, 1, true, 0.3)[0];
+  swapped.name = "swapped";
+  for (int x = 0; x < 9; ++x) std::swap(swapped.pixels[x], swapped.pixels[9 + x]);
+  views.insert(views.begin() + 4, swapped);
+  return views;
+}
+
 // A view whose pixels belong to other corners (two rows of the board swapped: wrong
 // correspondences, ~34 px RMS) among 10 good ones, in each of 20 seeds: refused by name, and the
 // rest calibrated as the good views alone are.
 TEST(CalibrateTest, ViewsThatDoNotFitAreRefusedByName) {
   for (int s = 0; s < 20; ++s) {
     const std::vector<CalibrationView> good = Views(Seed(40 + 2 * s), 10, true, 0.3);
-    std::vector<CalibrationView> views = good;
-    CalibrationView swapped = Views(Seed(41 + 2 * s), 1, true, 0.3)[0];
-    swapped.name = "swapped";
-    for (int x = 0; x < 9; ++x) std::swap(swapped.pixels[x], swapped.pixels[9 + x]);
-    views.insert(views.begin() + 4, swapped);
+    const std::vector<CalibrationView> views = WithSwappedView(good, Seed(41 + 2 * s));
     CalibrateOptions options = Options();
     options.cross_validate = false;
     const Calibration c = Calibrate(views, options);
@@ -331,11 +339,7 @@ TEST(CalibrateTest, ViewsThatDoNotFitAreRefusedByName) {
 // points are judged again without it: the good views' own calibration, no outlier.
 TEST(CalibrateTest, AViewRefusedAfterThePointStageCostsNoGoodPoint) {
   const std::vector<CalibrationView> good = Views(6048, 10, true, 0.3);
-  std::vector<CalibrationView> views = good;
-  CalibrationView swapped = Views(6049, 1, true, 0.3)[0];
-  swapped.name = "swapped";
-  for (int x = 0; x < 9; ++x) std::swap(swapped.pixels[x], swapped.pixels[9 + x]);
-  views.insert(views.begin() + 4, swapped);
+  const std::vector<CalibrationView> views = WithSwappedView(good, 6049);
   CalibrateOptions options = Options();
   options.cross_validate = false;
   const Calibration c = Calibrate(views, options);

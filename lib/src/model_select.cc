@@ -563,7 +563,6 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
         return;
       }
       if (!gated->check.passed) {
-        failed_gate = gated;
         problem = "the best camera for " +
                   (left_out.empty() ? "all " + std::to_string(points.size()) + " points"
                                     : "the " + std::to_string(points.size() - left_out.size()) +
@@ -571,6 +570,7 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
                   " (" + gated->selection.fit.model + ", rms " + Px(gated->check.rms_px) +
                   ") does not explain them: " + gated->check.summary + "; largest residuals " +
                   WorstPoints(gated->residuals_px, left_out, names);
+        failed_gate = std::move(gated);
         gated.reset();
       }
     };

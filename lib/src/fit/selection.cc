@@ -387,10 +387,10 @@ Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::strin
 // Whether the affine camera (the orthographic family's best) explains every point within the
 // noise as the gate's first test asks it: its sum of squares within the chi-square quantile of
 // 2N - 8 degrees of freedom at the gate's significance, in units of noise_tolerance times the
-// noise given or the prior. A perspective fit refused with points
-// behind it is contamination (a mis-click, a mirrored world: no orthographic answer then) -- or a
-// perspective the points cannot show, whose fit ran through the orthographic limit (seen: 30
-// clean points at a 0.03 deg view, 3 of 2000 seeds), where the affine camera fits them.
+// noise given or the prior. A perspective fit refused with points behind it is contamination (a
+// mis-click, a mirrored world: no orthographic answer then) -- or a perspective the points cannot
+// show, whose fit ran through the orthographic limit (seen: 30 clean points at a 0.03 deg view, 3
+// of 2000 seeds), where the affine camera fits them.
 bool ModelSelector::AffineExplains(const FitOptions& base) const {
   FitOptions affine = base;
   affine.projection = Projection::kOrthographic;
