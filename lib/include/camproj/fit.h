@@ -246,9 +246,15 @@ struct DeterminationCheck {
   double bound_px = 0.0;      // AutoFitOptions::max_uncertainty_px
   std::string rival;          // the model that fits about as well and moves a test point most
   double rival_shift_px = 0.0;  // by how much (0: no such model)
+  Eigen::Vector2d rival_worst_pixel = Eigen::Vector2d::Zero();  // where it moves it (kCenter)
   // The rival predicts each kept point from the others better than the returned model
   // (leave-one-out, at up to 12 points): its shift counts even within its own 3 sigma.
   bool rival_predicts_better = false;
+  // The returned camera has its principal point at the image centre and the rival frees it (at
+  // up to 12 points): the clicks cannot tell a lens shift from a longer focal length, so its
+  // shift counts even within its own 3 sigma, over the box the points span doubled
+  // (fit/determination.cc, kLensShiftBoxScale).
+  bool rival_frees_lens_shift = false;
   // The camera averaged over the models fitted (the returned one and every unmirrored rival,
   // each weighted by exp(-(its BIC - the returned model's) / 2), as posterior model
   // probabilities: Raftery 1995): its largest 1-sigma spread sqrt(sum_m w_m (sigma_m^2 +

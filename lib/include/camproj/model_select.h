@@ -62,12 +62,11 @@ struct AutoFitOptions {
   // linearized sigmas therefore say nothing. Infinity: none of these refusals.
   double max_uncertainty_px = 5.0;
   // Points of the object that were not clicked (e.g. the vertices of the model being mapped), in
-  // the world of points_in_world: the determination check judges the camera at those in front of
-  // it and in its image too, and there a rival that fits about as well but is itself
-  // undetermined (sigma above the bound) counts its shift even within its own 3 sigma. The box
-  // the clicks span can miss parts of the object where a camera that explains every click is
-  // still more than the bound off; only the user knows where the rest of the object is
-  // (docs/model-selection.md, "Rules tried").
+  // the world of points_in_world: the determination check judges the camera, its rivals and
+  // their average at those in front of it and in its image too. The box the clicks span can miss
+  // parts of the object where a camera that explains every click is still more than the bound
+  // off; only the user knows where the rest of the object is (docs/model-selection.md, "Rules
+  // tried").
   std::vector<Eigen::Vector3d> object_points_in_world;
   // Also consider an orthographic camera (scale, then aspect and skew): chosen when the
   // criterion prefers it to pose + focal (the perspective is not observable: a telephoto or
