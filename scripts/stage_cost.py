@@ -112,6 +112,9 @@ STAGES = [
      "depth reversal (every perspective answer)", True,
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::FitMirroredReading()",
                                            "camproj::internal::FitMirroredWorld()")),
+    ("other_minima", "other minima: at six kept points, the chosen model refitted from each "
+     "edge midpoint's principal point (rivals for the determination check)", True,
+     lambda a, b: b == "camproj::internal::FitFromEdgePrincipalPoints()"),
     ("determination", "determination check: sigmas at the test points, rivals' shifts", True,
      lambda a, b: b == "camproj::internal::CheckDetermination()"),
 ]
