@@ -334,8 +334,17 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
 
   // Uncertainty, in u = [omega, center, free slots] (ComputeNormalEquations). Fixed-capacity
   // types (ParamMatrix): no allocation, and Eigen's small-matrix products.
-  const JacobiScaledNormal<ParamMatrix> scaled_normal(refined.normal.jtj);
-  if (!(scaled_normal.rcond > kSingularRcond)) RefuseUndetermined(scaled_normal, names);
+  // The eigenvectors only where they are read: the covariance and linearity check of a described
+  // fit; a refusal's null direction recomputes them. (A candidate of the model selection, a
+  // screen's or a mirror test's fit reads the reciprocal condition alone.)
+  const bool needs_vectors = options.compute_uncertainty && effort.describe;
+  const JacobiScaledNormal<ParamMatrix> scaled_normal(
+      refined.normal.jtj, needs_vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
+  if (!(scaled_normal.rcond > kSingularRcond)) {
+    RefuseUndetermined(needs_vectors ? scaled_normal
+                                     : JacobiScaledNormal<ParamMatrix>(refined.normal.jtj),
+                       names);
+  }
   result.jacobian_condition = scaled_normal.JacobianCondition();
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
   if (options.compute_uncertainty && have_sigma && effort.describe) {

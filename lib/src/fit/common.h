@@ -87,14 +87,17 @@ struct FitEffort {
 
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest
 // eigenvalue is the reciprocal condition the fitters refuse on (kDegenerate), and its inverse
-// gives the covariance. `Matrix` is Eigen::MatrixXd or a fixed-capacity type.
+// gives the covariance. `Matrix` is Eigen::MatrixXd or a fixed-capacity type. With
+// Eigen::EigenvaluesOnly the eigenvectors (and Inverse) are not available; the eigenvalues, and
+// so rcond, are the same bit for bit (Eigen's tridiagonal QR steps update the vectors alongside,
+// never reading them), at about half the instructions.
 template <typename Matrix>
 struct JacobiScaledNormal {
   using Vector = Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1, 0, Matrix::MaxRowsAtCompileTime, 1>;
 
-  explicit JacobiScaledNormal(const Matrix& jtj)
+  explicit JacobiScaledNormal(const Matrix& jtj, int eigen_options = Eigen::ComputeEigenvectors)
       : column_scale(jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse()),
-        eigen(Matrix(column_scale.asDiagonal() * jtj * column_scale.asDiagonal())),
+        eigen(Matrix(column_scale.asDiagonal() * jtj * column_scale.asDiagonal()), eigen_options),
         rcond(eigen.eigenvalues()(0) / eigen.eigenvalues()(jtj.rows() - 1)) {}
 
   // sqrt(largest / smallest eigenvalue): the scaled Jacobian's condition number.
