@@ -280,30 +280,29 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
         " near pixel " + internal::PixelText(check.averaged_worst_pixel, pixel_origin) +
         " (bound " + Px(check.bound_px) + ", --max-uncertainty). " + advice);
   }
-  const std::string predicts_better =
-      check.rival_predicts_better
-          ? " (and the latter predicts each point from the others better)"
-          : "";
-  const std::string where = " near pixel " +
-                            internal::PixelText(check.rival_worst_pixel, pixel_origin) +
-                            " (bound " + Px(check.bound_px) + ", --max-uncertainty). ";
+  // "both fit about as well, but they put the scene up to 8.88 px apart near pixel (445, 673)
+  // (bound 5 px, --max-uncertainty). "
+  const std::string parted =
+      std::string("both fit about as well") +
+      (check.rival_predicts_better
+           ? " (and the latter predicts each point from the others better)"
+           : "") +
+      ", but they put the scene up to " + Px(check.rival_shift_px) + " apart near pixel " +
+      internal::PixelText(check.rival_worst_pixel, pixel_origin) + " (bound " +
+      Px(check.bound_px) + ", --max-uncertainty). ";
   if (check.rival_frees_lens_shift) {
     throw SceneError(
         SceneError::Reason::kAmbiguous,
         "the points cannot tell where the principal point is: " + model +
-            " leaves it at the image centre and " + check.rival + " frees it; both fit about "
-            "as well" + predicts_better + ", but they put the scene up to " +
-            Px(check.rival_shift_px) + " apart" + where +
+            " leaves it at the image centre and " + check.rival + " frees it; " + parted +
             "A few points cannot tell a projector's lens shift from a longer focal length and a "
             "tilt. If the principal point is at the image centre (a camera, or a projector "
             "without lens shift), give --fix principal-point; if you know where it is, "
             "--principal-point CX,CY. " + advice);
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
-                   "the points cannot tell " + model + " from " + check.rival +
-                       ": both fit about as well" +
-                       predicts_better + ", but they put the scene up to " +
-                       Px(check.rival_shift_px) + " apart" + where + advice);
+                   "the points cannot tell " + model + " from " + check.rival + ": " + parted +
+                       advice);
 }
 
 // The refusal of an orthographic camera chosen where the points show perspective

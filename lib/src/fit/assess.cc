@@ -341,9 +341,8 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const JacobiScaledNormal<ParamMatrix> scaled_normal(
       refined.normal.jtj, needs_vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
   if (!(scaled_normal.rcond > kSingularRcond)) {
-    RefuseUndetermined(needs_vectors ? scaled_normal
-                                     : JacobiScaledNormal<ParamMatrix>(refined.normal.jtj),
-                       names);
+    if (needs_vectors) RefuseUndetermined(scaled_normal, names);
+    RefuseUndetermined(JacobiScaledNormal<ParamMatrix>(refined.normal.jtj), names);
   }
   result.jacobian_condition = scaled_normal.JacobianCondition();
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
