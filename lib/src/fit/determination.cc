@@ -519,6 +519,71 @@ const FittedRival* LensShiftRival(const Selection& selection,
   return best;
 }
 
+// At a handful of points, the unmirrored rival that predicts each kept point from the others
+// better than the chosen model and every other such rival (PRESS), or null: as good a reading
+// of the data, so its shift counts even within its own 3 sigma.
+const FittedRival* RivalPredictingBetter(const Selection& selection, const Camera& camera,
+                                         const PixelUncertainty& uncertainty,
+                                         const std::vector<Eigen::Vector3d>& points,
+                                         const std::vector<const FittedRival*>& counted) {
+  if (points.size() > kCrossValidationMaxPoints ||
+      selection.fit.residuals_px.size() != points.size()) {
+    return nullptr;
+  }
+  std::vector<Eigen::Vector2d> observed(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    observed[i] = *PixelFromWorld(camera, points[i]) - selection.fit.residuals_px[i];
+  }
+  const FittedRival* predicts_better = nullptr;
+  double best = PredictionSumOfSquares(uncertainty, camera, points, observed);
+  for (const FittedRival* c : counted) {
+    if (c->rival->mirrored_world) continue;
+    const double press = PredictionSumOfSquares(c->uncertainty, c->camera, points, observed);
+    if (press < best) {
+      best = press;
+      predicts_better = c;
+    }
+  }
+  return predicts_better;
+}
+
+// `around` with the corners and face centres of the box the rivals are judged over
+// (kRivalBoxThickness) scaled by `scale` about its centre, where the image shows them.
+TestPoints WithScaledBox(TestPoints around, const Camera& camera,
+                         const std::vector<Eigen::Vector3d>& points, double scale) {
+  const TestPoints scaled = TestPointsOf(camera, points, kRivalBoxThickness, {}, scale);
+  for (size_t i = 0; i < scaled.points.size(); ++i) {
+    if (scaled.fitted[i] >= 0) continue;  // the fitted points are in `around` already
+    around.points.push_back(scaled.points[i]);
+    around.fitted.push_back(-1);
+  }
+  return around;
+}
+
+// The largest distance between where `camera` and a rival put a test point (infinite where the
+// rival has it behind), and where; within the rival's kRivalSigmas only if not `exempt`.
+struct RivalShift {
+  double px = 0.0;
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // the returned camera's
+};
+RivalShift ShiftOf(const Camera& camera, const FittedRival& rival, const Eigen::Vector3d& flip,
+                   const TestPoints& test, bool exempt) {
+  TestPoints their_test = test;  // as the rival sees them (a mirrored reading: z negated)
+  for (Eigen::Vector3d& x : their_test.points) x = flip.asDiagonal() * x;
+  const std::vector<double> rival_sigmas = SigmasAt(rival.uncertainty, their_test);
+  RivalShift shift;
+  for (size_t i = 0; i < test.points.size(); ++i) {
+    const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, test.points[i]);
+    const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival.camera, their_test.points[i]);
+    const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
+    if ((!exempt || d > kRivalSigmas * rival_sigmas[i]) && d > shift.px) {
+      shift.px = d;
+      shift.pixel = *ours;
+    }
+  }
+  return shift;
+}
+
 // True if `other` puts every point of `test` within kSameMinimumPx of where `camera` does.
 bool SameMinimum(const Camera& camera, const Camera& other, const std::vector<Eigen::Vector3d>& test) {
   for (const Eigen::Vector3d& x : test) {
@@ -527,6 +592,40 @@ bool SameMinimum(const Camera& camera, const Camera& other, const std::vector<Ei
     if (!ours || !theirs || !((*theirs - *ours).norm() <= kSameMinimumPx)) return false;
   }
   return true;
+}
+
+// The rivals that fit about as well (the rival check's) or are unmirrored within
+// kAveragedCriterion (the model average's), each with its uncertainty at the kept points (a
+// mirrored reading sees them with z negated); one with a kept point behind it is no reading of
+// them, nor a refit into the returned minimum (the same at every point of `test`). In
+// `unit_world`, which must outlive them (their uncertainties read its points).
+std::vector<FittedRival> FittedRivals(const Selection& selection, const UnitWorld& unit_world,
+                                      double sigma, const std::vector<Eigen::Vector3d>& test) {
+  std::vector<FittedRival> fitted;
+  fitted.reserve(selection.rivals.size());  // moved in once, never copied
+  for (const Rival& rival : selection.rivals) {
+    const double excess = rival.criterion - selection.criterion;
+    const bool about_as_well = rival.mirrored_world || rival.same_model
+                                   ? excess <= kEqualFitCriterion
+                                   : std::abs(excess) <= kEqualFitCriterion;
+    const bool averaged = !rival.mirrored_world && excess >= -kEqualFitCriterion &&
+                          excess <= kAveragedCriterion;
+    if (!about_as_well && !averaged) continue;
+    // A mirrored reading sees every point, test points included, with z negated: in the unit
+    // world about the centroid, whose mirror image is the mirrored points' centroid.
+    const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
+    const Camera rival_camera =
+        InUnitWorld(rival.camera, flip.asDiagonal() * unit_world.origin, unit_world.unit);
+    if (rival.same_model && SameMinimum(unit_world.camera, rival_camera, test)) continue;
+    try {
+      fitted.push_back({&rival, rival_camera,
+                        PixelUncertainty(rival_camera, rival.options, unit_world.points, sigma,
+                                         rival.mirrored_world),
+                        about_as_well, averaged ? std::exp(-0.5 * excess) : 0.0});
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  return fitted;
 }
 
 // The model average (DeterminationCheck::averaged_sigma_px): at each point of `around` that is
@@ -675,57 +774,13 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.worst_pixel = *PixelFromWorld(camera, test[i]);
     }
   }
-  // The rivals that fit about as well (the rival check's) or are unmirrored within
-  // kAveragedCriterion (the model average's), each with its uncertainty at the kept points (a
-  // mirrored reading sees them with z negated); one with a kept point behind it is no reading of
-  // them.
-  std::vector<FittedRival> fitted;
-  fitted.reserve(selection.rivals.size());  // moved in once, never copied
-  for (const Rival& rival : selection.rivals) {
-    const double excess = rival.criterion - selection.criterion;
-    const bool about_as_well = rival.mirrored_world || rival.same_model
-                                   ? excess <= kEqualFitCriterion
-                                   : std::abs(excess) <= kEqualFitCriterion;
-    const bool averaged = !rival.mirrored_world && excess >= -kEqualFitCriterion &&
-                          excess <= kAveragedCriterion;
-    if (!about_as_well && !averaged) continue;
-    // A mirrored reading sees every point, test points included, with z negated: in the unit
-    // world about the centroid, whose mirror image is the mirrored points' centroid.
-    const Eigen::Vector3d flip(1.0, 1.0, rival.mirrored_world ? -1.0 : 1.0);
-    const Camera rival_camera = InUnitWorld(rival.camera, flip.asDiagonal() * origin, unit);
-    if (rival.same_model && SameMinimum(camera, rival_camera, test)) continue;
-    try {
-      fitted.push_back({&rival, rival_camera,
-                        PixelUncertainty(rival_camera, rival.options, points, sigma,
-                                         rival.mirrored_world),
-                        about_as_well, averaged ? std::exp(-0.5 * excess) : 0.0});
-    } catch (const std::invalid_argument&) {
-    }
-  }
+  const std::vector<FittedRival> fitted = FittedRivals(selection, unit_world, sigma, test);
   std::vector<const FittedRival*> counted;
   for (const FittedRival& c : fitted) {
     if (c.about_as_well) counted.push_back(&c);
   }
-  // At a handful of points, the unmirrored rival that predicts each kept point from the others
-  // better than the chosen model and every other such rival (PRESS) is as good a reading of the
-  // data: its shift counts even within its own 3 sigma.
-  const FittedRival* predicts_better = nullptr;
-  if (points.size() <= kCrossValidationMaxPoints &&
-      selection.fit.residuals_px.size() == points.size()) {
-    std::vector<Eigen::Vector2d> observed(points.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-      observed[i] = *PixelFromWorld(camera, points[i]) - selection.fit.residuals_px[i];
-    }
-    double best = PredictionSumOfSquares(uncertainty, camera, points, observed);
-    for (const FittedRival* c : counted) {
-      if (c->rival->mirrored_world) continue;
-      const double press = PredictionSumOfSquares(c->uncertainty, c->camera, points, observed);
-      if (press < best) {
-        best = press;
-        predicts_better = c;
-      }
-    }
-  }
+  const FittedRival* predicts_better =
+      RivalPredictingBetter(selection, camera, uncertainty, points, counted);
   // The unmirrored rivals are judged over the box widened to kRivalBoxThickness.
   std::optional<TestPoints> rival_test;
   if (std::any_of(fitted.begin(), fitted.end(),
@@ -741,16 +796,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
           ? LensShiftRival(selection, counted)
           : nullptr;
   std::optional<TestPoints> lens_shift_test;
-  if (lens_shift) {
-    lens_shift_test = *rival_test;
-    const TestPoints scaled = TestPointsOf(camera, points, kRivalBoxThickness, {},
-                                           kLensShiftBoxScale);
-    for (size_t i = 0; i < scaled.points.size(); ++i) {
-      if (scaled.fitted[i] >= 0) continue;  // the fitted points are in rival_test already
-      lens_shift_test->points.push_back(scaled.points[i]);
-      lens_shift_test->fitted.push_back(-1);
-    }
-  }
+  if (lens_shift) lens_shift_test = WithScaledBox(*rival_test, camera, points, kLensShiftBoxScale);
   for (const FittedRival* counted_rival : counted) {
     const FittedRival& c = *counted_rival;
     const Rival& rival = *c.rival;
@@ -760,29 +806,14 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     const TestPoints& our_test = rival.mirrored_world ? test_points
                                  : &c == lens_shift    ? *lens_shift_test
                                                        : *rival_test;
-    TestPoints their_test = our_test;
-    for (Eigen::Vector3d& x : their_test.points) x = flip.asDiagonal() * x;
     // A richer rival scatters by its own uncertainty: only a shift beyond kRivalSigmas of it
     // is a different reading of the data rather than the rival's noise -- except for the rival
     // that predicts the points better and the lens-shift rival (above).
-    const std::vector<double> rival_sigmas = SigmasAt(c.uncertainty, their_test);
     const bool exempt = &c != predicts_better && &c != lens_shift;
-    double shift = 0.0;
-    Eigen::Vector2d shift_pixel = Eigen::Vector2d::Zero();
-    for (size_t i = 0; i < our_test.points.size(); ++i) {
-      const Eigen::Vector3d& x = our_test.points[i];
-      const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, x);
-      const std::optional<Eigen::Vector2d> theirs =
-          PixelFromWorld(c.camera, their_test.points[i]);
-      const double d = theirs ? (*theirs - *ours).norm() : std::numeric_limits<double>::infinity();
-      if ((!exempt || d > kRivalSigmas * rival_sigmas[i]) && d > shift) {
-        shift = d;
-        shift_pixel = *ours;
-      }
-    }
-    if (!(shift <= check.rival_shift_px)) {
-      check.rival_shift_px = shift;
-      check.rival_worst_pixel = shift_pixel;
+    const RivalShift shift = ShiftOf(camera, c, flip, our_test, exempt);
+    if (!(shift.px <= check.rival_shift_px)) {
+      check.rival_shift_px = shift.px;
+      check.rival_worst_pixel = shift.pixel;
       check.rival = rival.model;
       check.rival_predicts_better = &c == predicts_better;
       check.rival_frees_lens_shift = &c == lens_shift;
