@@ -104,14 +104,15 @@ STAGES = [
     ("refit", "model selection: the chosen model refitted with its covariance (from scratch "
      "below 20 points unless it is the screen's model, else from the ladder's camera)", False,
      lambda a, b: a == "camproj::internal::SelectModel()" and
-     b == "camproj::internal::FitChosen()"),
+     b == "camproj::internal::FitReusing()"),
     ("gate", "consistency gate on the selection (residuals, chi-square, largest residual)", True,
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::CheckConsistency()",
                                            "camproj::internal::ResidualsAgainst()")),
     ("mirror", "mirror test: the chosen model refined on the mirrored world from the camera's "
      "depth reversal (every perspective answer)", True,
      lambda a, b: is_pipeline(a) and b in ("camproj::internal::FitMirroredReading()",
-                                           "camproj::internal::FitMirroredWorld()")),
+                                           "camproj::internal::FitMirroredWorld()",
+                                           "camproj::internal::PrepareScene()")),
     ("other_minima", "other minima: at six kept points, the chosen model refitted from each "
      "edge midpoint's principal point (rivals for the determination check)", True,
      lambda a, b: b == "camproj::internal::FitFromEdgePrincipalPoints()"),

@@ -14,6 +14,8 @@
 #include "camproj/model_select.h"
 #include "camproj/pose.h"
 #include "camproj/synth.h"
+#include "fit/selection.h"
+#include "fit/start.h"
 #include "seeds.h"
 
 namespace camproj {
@@ -138,7 +140,7 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
   EXPECT_EQ(compared, 3 * 8 * 2 * 3);
 }
 
-// The chosen model refitted from the ladder's camera (FitChosen, what FitCameraAuto does from 20
+// The chosen model refitted from the ladder's camera (FitReusing, what FitCameraAuto does from 20
 // points on) is FitCamera's fit from scratch: the same optimum, sigmas, views and linearity
 // check; and FitCameraAuto names the closed form its selection began at, never "warm".
 TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
@@ -162,7 +164,7 @@ TEST(CandidateTest, ChosenModelRefittedFromTheLadderIsTheFitFromScratch) {
                                                         kNoisePx, {&before.camera});
         const FitResult scratch = FitCamera(points, pixels, scene.truth.image_size, model);
         const FitResult chosen =
-            internal::FitChosen(points, pixels, scene.truth.image_size, model, {&ladder.camera});
+            internal::FitReusing(points, pixels, scene.truth.image_size, model, {&ladder.camera});
         EXPECT_EQ(chosen.start_method, "warm");
         ExpectSameOptimum(scratch, chosen, false, scratch.sigmas);
         EXPECT_EQ(chosen.sigmas.size(), scratch.sigmas.size());
@@ -279,6 +281,83 @@ TEST(CandidateTest, PreparedPointsRefuseAsTheirOwnScene) {
       }
     }
   }
+}
+
+// The DLT is read once for the prepared points (fit/start.h, DltStartOf) and every model fitted
+// to them starts from it: each model's fit from the shared preparation is bit for bit the fit
+// from its own (the same arithmetic on the same numbers), its DLT read only once, at 6-12
+// points of both kinds of scene; and a DLT that refuses (no camera with every point in front)
+// refuses every model with the message the model's own DLT gives.
+TEST(CandidateTest, ModelsFittedToPreparedPointsShareOneDlt) {
+  constexpr int kSeeds = 20;
+  FitOptions focal;
+  focal.aspect = ParameterMode::Default();
+  focal.principal_point = ParameterMode::Default();
+  FitOptions off_axis = focal;
+  off_axis.principal_point = ParameterMode::Free();
+  FitOptions full = off_axis;
+  full.aspect = ParameterMode::Free();
+  full.skew = ParameterMode::Free();
+  int fitted = 0;
+  for (const int n : {6, 8, 12}) {
+    for (const double offset_y : {0.0, 0.4}) {
+      for (int seed = 1; seed <= kSeeds; ++seed) {
+        const SynthScene scene = CloudScene(seed, n, offset_y);
+        const auto& points = scene.correspondences.points_in_world;
+        const auto& pixels = scene.correspondences.pixels;
+        const ImageSize size = scene.truth.image_size;
+        const internal::SceneGeometry geometry =
+            internal::PrepareScene(points, pixels, size, focal.pixel_origin);
+        ASSERT_NE(geometry.scene.dlt, nullptr);
+        for (const FitOptions* model : {&focal, &off_axis, &full}) {
+          SCOPED_TRACE(::testing::Message() << "n " << n << ", offset " << offset_y << ", seed "
+                                            << seed << ", " << internal::NumParameters(*model)
+                                            << " parameters");
+          if (2 * n - internal::NumParameters(*model) < 1) continue;
+          FitResult own, shared;
+          const std::string own_refusal = Refusal([&] {
+            own = internal::FitReusing(points, pixels, size, *model, {});
+          });
+          const std::string shared_refusal = Refusal([&] {
+            shared = internal::FitReusing(points, pixels, size, *model, {nullptr, &geometry});
+          });
+          ASSERT_EQ(shared_refusal, own_refusal);
+          if (own_refusal != "answered") continue;
+          ++fitted;
+          EXPECT_TRUE(geometry.scene.dlt->camera.has_value());
+          EXPECT_EQ(shared.camera.intrinsics.fx, own.camera.intrinsics.fx);
+          EXPECT_EQ(shared.camera.intrinsics.cy, own.camera.intrinsics.cy);
+          EXPECT_EQ(shared.camera.cam_from_world.rotation, own.camera.cam_from_world.rotation);
+          EXPECT_EQ(shared.camera.cam_from_world.translation,
+                    own.camera.cam_from_world.translation);
+          EXPECT_EQ(shared.rms_px, own.rms_px);
+        }
+      }
+    }
+  }
+  EXPECT_GE(fitted, 3 * 2 * kSeeds * 2);  // most scenes determine the models
+
+  // Every pixel reflected through the image centre but two: the DLT's linear camera has points
+  // on both sides of it.
+  const SynthScene scene = CloudScene(1, 8, 0.0);
+  const auto& points = scene.correspondences.points_in_world;
+  std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
+  const ImageSize size = scene.truth.image_size;
+  const Eigen::Vector2d centre(0.5 * (size.width - 1), 0.5 * (size.height - 1));
+  for (size_t i = 2; i < pixels.size(); ++i) pixels[i] = 2.0 * centre - pixels[i];
+  const internal::SceneGeometry geometry =
+      internal::PrepareScene(points, pixels, size, focal.pixel_origin);
+  for (const FitOptions* model : {&focal, &off_axis}) {
+    const std::string own = Refusal([&] { internal::FitReusing(points, pixels, size, *model, {}); });
+    const std::string shared = Refusal(
+        [&] { internal::FitReusing(points, pixels, size, *model, {nullptr, &geometry}); });
+    EXPECT_EQ(shared, own);
+    EXPECT_EQ(own.rfind(std::to_string(
+                            static_cast<int>(SceneError::Reason::kPointsBehindCamera)) + ":", 0),
+              0u)
+        << own;
+  }
+  EXPECT_TRUE(geometry.scene.dlt->refusal.has_value());
 }
 
 }  // namespace

@@ -150,7 +150,7 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
   return Fit(points_in_world, observed_pixels, image_size, options, effort);
 }
 
-FitResult FitChosen(const std::vector<Eigen::Vector3d>& points_in_world,
+FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options,
                     const CandidateReuse& reuse) {

@@ -161,8 +161,11 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
     rival = internal::Rival{internal::kMirroredReadingName, model, camera, criterion,
                             /*mirrored_world=*/true};
   };
+  // The mirrored world prepared once for every reading of it below.
+  const internal::SceneGeometry mirrored_world = internal::PrepareScene(
+      internal::MirroredZ(kept_points), kept_pixels, size, selection.options.pixel_origin);
   const std::optional<internal::MirroredReading> reversed = internal::FitMirroredReading(
-      selection.fit.camera, selection.options, kept_points, kept_pixels);
+      selection.fit.camera, selection.options, kept_points, kept_pixels, &mirrored_world);
   if (reversed) {
     const double gain = n * (rms_px * rms_px - reversed->rms_px * reversed->rms_px);
     if (gain / (noise.sigma_px * noise.sigma_px) > kSignificantChi2) {
@@ -189,7 +192,7 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
     for (const FitOptions& model : models) {
       const std::optional<internal::MirroredReading> reading =
           internal::FitMirroredWorld(kept_points, kept_pixels, size, model,
-                                     selection.fit.camera.intrinsics);
+                                     selection.fit.camera.intrinsics, &mirrored_world);
       if (reading) consider(reading->camera, model, reading->rms_px);
     }
   }

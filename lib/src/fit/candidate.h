@@ -24,7 +24,7 @@
 // step or two away, and Levenberg-Marquardt runs only where the polish does not settle. The
 // chosen model is refitted with everything computed and its restarts: from scratch below 20
 // points unless it is the screen's model (whose fit from scratch the ladder holds), else from
-// the ladder's camera (FitChosen; selection.cc says why).
+// the ladder's camera (FitReusing; selection.cc says why).
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
@@ -57,9 +57,10 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
 
 // As FitCamera (fit.h), everything computed, restarts included, but started and prepared as
 // `reuse` says: the model selection's chosen model refitted with its covariance, from the
-// ladder's fit of it or (warm_start null) from its closed form. FitResult::start_method is
-// "warm" where reuse.warm_start is not null.
-FitResult FitChosen(const std::vector<Eigen::Vector3d>& points_in_world,
+// ladder's fit of it or (warm_start null) from its closed form; the screen's fit (fit/outliers.h)
+// on the points it prepares for the selection. FitResult::start_method is "warm" where
+// reuse.warm_start is not null.
+FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options,
                     const CandidateReuse& reuse);

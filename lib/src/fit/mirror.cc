@@ -37,18 +37,28 @@ namespace {
 constexpr int kReversalIterations = 10;
 constexpr int kFreshStartIterations = 20;
 
+// The mirrored world's scene for `options`: from `mirrored_world` where the caller prepared it.
+Scene MirroredScene(const std::vector<Eigen::Vector3d>& points_in_world,
+                    const std::vector<Eigen::Vector2d>& observed_pixels,
+                    const ImageSize& image_size, const FitOptions& options,
+                    const SceneGeometry* mirrored_world) {
+  return mirrored_world != nullptr
+             ? ValidateScene(*mirrored_world, options)
+             : ValidateScene(MirroredZ(points_in_world), observed_pixels, image_size, options);
+}
+
 }  // namespace
 
 std::optional<MirroredReading> FitMirroredReading(
     const Camera& camera, const FitOptions& model,
     const std::vector<Eigen::Vector3d>& points_in_world,
-    const std::vector<Eigen::Vector2d>& observed_pixels) {
+    const std::vector<Eigen::Vector2d>& observed_pixels, const SceneGeometry* mirrored_world) {
   const Camera reversed = NeckerReversal(camera, points_in_world);
   FitOptions options = model;
   options.max_iterations = kReversalIterations;
   try {
-    const Scene scene =
-        ValidateScene(MirroredZ(points_in_world), observed_pixels, camera.image_size, options);
+    const Scene scene = MirroredScene(points_in_world, observed_pixels, camera.image_size,
+                                      options, mirrored_world);
     StartCamera start;
     start.rotation = reversed.cam_from_world.rotation;
     start.center = (CameraCenterInWorld(reversed.cam_from_world) - scene.centroid) / scene.scale;
@@ -61,18 +71,18 @@ std::optional<MirroredReading> FitMirroredReading(
 std::optional<MirroredReading> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
-    const FitOptions& model, const Intrinsics& intrinsics) {
+    const FitOptions& model, const Intrinsics& intrinsics, const SceneGeometry* mirrored_world) {
   FitOptions options = model;
   options.max_iterations = kFreshStartIterations;
   try {
     const Scene scene =
-        ValidateScene(MirroredZ(points_in_world), observed_pixels, image_size, options);
+        MirroredScene(points_in_world, observed_pixels, image_size, options, mirrored_world);
     StartCamera start;
     Model start_model;
     // The DLT reads the mirrored world as mirrored where it reads the given one as proper:
     // SQPnP then, from the intrinsics the given world was fitted with.
     if (model.known_intrinsics || scene.planar_start || scene.num_distinct_points < 6 ||
-        !DltStart(scene.points, scene.pixels).mirrored) {
+        !DltStartOf(scene).mirrored) {
       const Start closed_form = ClosedFormStart(scene, options, Clock::now());
       start = closed_form.camera;
       start_model = closed_form.model;

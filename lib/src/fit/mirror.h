@@ -15,6 +15,7 @@
 #include "camproj/camera.h"
 #include "camproj/fit.h"
 #include "fit/reading.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
@@ -35,11 +36,14 @@ using MirroredReading = Reading;
 // `model` fitted by least squares (at most 10 LM iterations) to the points with z negated, from
 // NeckerReversal(camera, points): a proper camera of the mirrored world whose RMS is at or above
 // the best one near the reversal. Nothing when that refinement ends with a point behind the
-// camera or a non-positive focal length or aspect.
+// camera or a non-positive focal length or aspect. `mirrored_world`: MirroredZ(points_in_world)
+// and the pixels as PrepareScene prepares them for model.pixel_origin (shared with
+// FitMirroredWorld), or null (prepared here).
 std::optional<MirroredReading> FitMirroredReading(
     const Camera& camera, const FitOptions& model,
     const std::vector<Eigen::Vector3d>& points_in_world,
-    const std::vector<Eigen::Vector2d>& observed_pixels);
+    const std::vector<Eigen::Vector2d>& observed_pixels,
+    const SceneGeometry* mirrored_world = nullptr);
 
 // `model` fitted to the points with z negated from a start of that world's own, by LM (one round
 // of at most 20 iterations): at few points a mirrored world can fit a proper camera within the
@@ -47,10 +51,13 @@ std::optional<MirroredReading> FitMirroredReading(
 // reads it as proper (the DLT's det > 0, or a plane's homography), else SQPnP with `intrinsics`
 // (the fitted camera's: the closed form would refine both readings and refuse, start.cc).
 // Nothing where no start or no proper camera with every point in front is found.
+// `mirrored_world` as for FitMirroredReading: prepared once, the mirrored world's DLT is read
+// once for every model fitted to it.
 std::optional<MirroredReading> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
-    const FitOptions& model, const Intrinsics& intrinsics);
+    const FitOptions& model, const Intrinsics& intrinsics,
+    const SceneGeometry* mirrored_world = nullptr);
 
 }  // namespace internal
 }  // namespace camproj

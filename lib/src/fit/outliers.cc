@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "fit/candidate.h"
+#include "fit/scene.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
 
@@ -53,17 +55,19 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
     u.push_back(pixels[i]);
   }
   Screen subset;
+  // Prepared once for the models tried here and the selection that reads the fit (Prefit).
+  const SceneGeometry geometry = PrepareScene(x, u, size, options.fit.pixel_origin);
   for (const FitOptions& model : models) {
     const int p = NumParameters(model);
     if (2 * static_cast<int>(x.size()) - p < options.min_redundancy) continue;
     try {
-      FitResult fit = FitCamera(x, u, size, model);
+      FitResult fit = FitReusing(x, u, size, model, CandidateReuse{nullptr, &geometry});
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
       const ConsistencyCheck check = CheckConsistency(lengths, Repeats(x, u), p, noise, options);
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
-      subset.fit = Prefit{model, std::move(fit)};
+      subset.fit = Prefit{model, std::move(fit), geometry};
       subset.refusal.reset();
       return subset;
     } catch (const SceneError& e) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <memory>
 #include <limits>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "camproj/model_select.h"
 #include "check.h"
 #include "fit/common.h"
+#include "fit/start.h"
 
 namespace camproj {
 namespace internal {
@@ -179,6 +181,7 @@ SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
       shape.matrixV().determinant() > 0
           ? Eigen::Matrix3d(shape.matrixV())
           : Eigen::Matrix3d(shape.matrixV() * Eigen::Vector3d(1, 1, -1).asDiagonal());
+  scene.dlt = std::make_shared<DltReading>();
   return geometry;
 }
 

@@ -8,6 +8,7 @@
 #ifndef CAMPROJ_SRC_FIT_SCENE_H_
 #define CAMPROJ_SRC_FIT_SCENE_H_
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -19,6 +20,8 @@
 
 namespace camproj {
 namespace internal {
+
+struct DltReading;  // fit/start.h
 
 struct Scene {
   // The points in the normalized world (point_in_world = centroid + scale * point) and their
@@ -40,6 +43,10 @@ struct Scene {
   // The model the options ask for, before the closed-form start sets its free values.
   Model model;
   ImageSize image_size;
+  // The DLT of `points` and `pixels`, read at most once for this scene and its copies (fit/start.h,
+  // DltStartOf): every model fitted to the same points starts from the same linear camera. Set by
+  // PrepareScene.
+  std::shared_ptr<DltReading> dlt;
 
   int NumPoints() const { return static_cast<int>(points.size()); }
 };

@@ -26,7 +26,7 @@ const char* const kGroupNames[kNumGroups] = {"principal-point", "aspect", "skew"
 const char* const kFixedNames[kNumGroups] = {"principal point", "aspect", "skew", "k1", "k2"};
 
 // Below this many points the chosen model is refitted with its covariance from its own closed
-// form, restarts included; from there on from the ladder's camera (fit/candidate.h, FitChosen).
+// form, restarts included; from there on from the ladder's camera (fit/candidate.h, FitReusing).
 // Measured on the click benchmark (bench --clicks): at 6-12 clicks the refit from scratch is
 // what refuses two mirrored 6-point scenes as mirrored (the DLT's two readings, fit/start.h)
 // rather than as undetermined, and the second start from the image centre runs only below 20
@@ -176,7 +176,9 @@ class ModelSelector {
         // The noise at which a candidate's fit is consistent enough to skip its restarts: the
         // given one, else the prior until the selection's own noise is known.
         candidate_sigma_(options.fit.pixel_sigma.value_or(options.prior_sigma_px)),
-        geometry_(PrepareScene(points, pixels, image_size, options.fit.pixel_origin)),
+        geometry_(prefit != nullptr
+                      ? prefit->geometry
+                      : PrepareScene(points, pixels, image_size, options.fit.pixel_origin)),
         n_(static_cast<int>(points.size())),
         num_equations_(2.0 * n_),
         aic_(options.criterion == ModelCriterion::kAic),
@@ -509,7 +511,7 @@ Selection ModelSelector::Refit(const Ladder& chosen, const std::vector<int>& can
   // included: the refit starts at that minimum at any count.
   const bool from_scratch = points_.size() < kFromScratchBelowPoints &&
                             !(prefit_ != nullptr && SameModel(prefit_->model, chosen.final_options));
-  selection.fit = FitChosen(
+  selection.fit = FitReusing(
       points_, pixels_, image_size_, selection.options,
       CandidateReuse{from_scratch ? nullptr : &chosen.final.fit->camera, &geometry_});
   if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;

@@ -10,6 +10,7 @@
 
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
@@ -50,11 +51,13 @@ double CombinedNoise(const AutoFitOptions& options, double sum_squares, double d
 int NumParameters(const FitOptions& options);
 
 // A model already fitted to the same points (the screen's, ScreenPoints): the selection reads
-// its fit where the ladder reaches that model instead of fitting it again. Its noise and
-// covariance settings may differ from the selection's (they do not change the camera).
+// its fit where the ladder reaches that model instead of fitting it again, and the points as it
+// prepared them (their DLT included) instead of preparing them again. Its noise and covariance
+// settings may differ from the selection's (they do not change the camera).
 struct Prefit {
   FitOptions model;
   FitResult fit;
+  SceneGeometry geometry;  // for model.pixel_origin
 };
 
 // Selects and fits the model for these points (the caller's, in options.fit.pixel_origin;

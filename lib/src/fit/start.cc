@@ -124,7 +124,7 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
                        "length (--focal / --fovy) or add points off the plane");
     }
   } else if (n >= 6) {
-    start = DltStart(points, pixels);
+    start = DltStartOf(scene);
     *method = "dlt";
     if (start.mirrored) {
       start = ProperStartOrRefuse(points, pixels, start, start_model, scene.image_size, options,
@@ -163,6 +163,20 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
 }
 
 }  // namespace
+
+StartCamera DltStartOf(const Scene& scene) {
+  if (scene.dlt == nullptr) return DltStart(scene.points, scene.pixels);
+  DltReading& reading = *scene.dlt;
+  if (!reading.camera && !reading.refusal) {
+    try {
+      reading.camera = DltStart(scene.points, scene.pixels);
+    } catch (const SceneError& refusal) {
+      reading.refusal = refusal;
+    }
+  }
+  if (reading.refusal) throw *reading.refusal;
+  return *reading.camera;
+}
 
 Start ClosedFormStart(const Scene& scene, const FitOptions& options,
                       Clock::time_point start_time) {

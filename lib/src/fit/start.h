@@ -9,6 +9,7 @@
 #ifndef CAMPROJ_SRC_FIT_START_H_
 #define CAMPROJ_SRC_FIT_START_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,19 @@ struct Start {
   // "pnp-focal-sweep" only: the sweep's other local minima, best first (FocalSweepStart).
   std::vector<StartCamera> other_sweep_minima;
 };
+
+// The DLT of one scene's points (Scene::dlt): DltStart's camera or its refusal, once read.
+struct DltReading {
+  std::optional<StartCamera> camera;
+  std::optional<SceneError> refusal;
+};
+
+// DltStart(scene.points, scene.pixels) (fit/closed_form.h), read once for the scene and every
+// copy of it: the model selection fits several models to the same prepared points
+// (SceneGeometry), and the mirror test reads the mirrored world's DLT before its start does.
+// Throws DltStart's SceneError each time it is asked. Not for concurrent use of one scene's
+// copies (a fit's stages run in one thread).
+StartCamera DltStartOf(const Scene& scene);
 
 // Throws SceneError where no start exists: kDegenerate (no pose, focal length or camera found),
 // kTooFewPoints (fewer than 6 points with more than the focal length free), kMirroredWorld (a
