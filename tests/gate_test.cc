@@ -1,11 +1,14 @@
 // The consistency gate (lib/src/fit/gate.h): a correspondence written twice is one observation.
 #include "fit/gate.h"
 
+#include <cmath>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "camproj/model_select.h"
+#include "fit/statistics.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -61,6 +64,30 @@ TEST(GateTest, RepeatedCorrespondencesAddNoRedundancy) {
   EXPECT_EQ(ten.max_residual_px, single.max_residual_px);
   // The RMS sums 80 squares instead of 8: equal to rounding.
   EXPECT_NEAR(ten.rms_px, single.rms_px, testing::kExactRelative * single.rms_px);
+}
+
+// The gates' chi-square quantile (fit/statistics.h): the bisection to 1e-12 relative meets the
+// closed forms and tabulated values to that (1e-10 allowed: the CDF's own rounding near the
+// root), and the remembered quantiles are the bisection's, bit for bit, over more keys than are
+// remembered, asked in turn and again.
+TEST(GateTest, ChiSquareQuantileIsTheBisectionsRemembered) {
+  constexpr double kRelative = 1e-10;
+  // 2 degrees of freedom: an exponential of mean 2, quantile -2 ln(1 - p).
+  for (const double p : {0.5, 0.9, 0.999}) {
+    EXPECT_NEAR(internal::ChiSquareQuantile(2.0, p), -2.0 * std::log1p(-p), kRelative * 10.0);
+  }
+  // 1 degree of freedom: a squared standard normal, 6.634896601021214 at p = 0.99.
+  EXPECT_NEAR(internal::ChiSquareQuantile(1.0, 0.99), 6.634896601021214, kRelative * 10.0);
+  std::vector<std::pair<double, double>> keys;
+  for (int nu = 1; nu <= 10; ++nu) {
+    for (const double p : {0.99, 0.999}) keys.emplace_back(nu, p);
+  }
+  for (int round = 0; round < 3; ++round) {
+    for (const auto& [nu, p] : keys) {
+      EXPECT_EQ(internal::ChiSquareQuantile(nu, p), internal::BisectChiSquareQuantile(nu, p))
+          << "nu " << nu << ", p " << p << ", round " << round;
+    }
+  }
 }
 
 }  // namespace

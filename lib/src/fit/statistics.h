@@ -50,7 +50,7 @@ inline double RegularizedLowerGamma(double a, double x) {
 
 // The p-quantile of the chi-square distribution with nu > 0 degrees of freedom, 0 < p < 1, by
 // bisection on its CDF P(nu / 2, x / 2) to 1e-12 relative.
-inline double ChiSquareQuantile(double nu, double p) {
+inline double BisectChiSquareQuantile(double nu, double p) {
   double lo = 0.0;
   double hi = std::max(1.0, nu);
   while (RegularizedLowerGamma(0.5 * nu, 0.5 * hi) < p) hi *= 2.0;
@@ -59,6 +59,28 @@ inline double ChiSquareQuantile(double nu, double p) {
     (RegularizedLowerGamma(0.5 * nu, 0.5 * mid) < p ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+// BisectChiSquareQuantile, remembered: one fit of the default path asks for the same few
+// quantiles (the gates' at 2N - p degrees of freedom, the linearity level's at p) several times,
+// and each bisection costs about 40 evaluations of the CDF (~30 thousand instructions at 8
+// points). The last kRemembered (nu, p) of each thread are kept.
+inline double ChiSquareQuantile(double nu, double p) {
+  struct Remembered {
+    double nu = 0.0;
+    double p = 0.0;
+    double quantile = 0.0;  // 0: empty (every quantile for p > 0 is positive)
+  };
+  constexpr size_t kRemembered = 8;
+  thread_local Remembered remembered[kRemembered];
+  thread_local size_t next = 0;
+  for (const Remembered& r : remembered) {
+    if (r.quantile > 0.0 && r.nu == nu && r.p == p) return r.quantile;
+  }
+  const double quantile = BisectChiSquareQuantile(nu, p);
+  remembered[next] = {nu, p, quantile};
+  next = (next + 1) % kRemembered;
+  return quantile;
 }
 
 // The largest of N residual lengths |r| of a 2D Gaussian with sigma 1 per axis exceeds
