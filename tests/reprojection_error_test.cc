@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fit/normal_equations.h"
 #include "seeds.h"
 #include "test_scenes.h"
 
@@ -103,6 +104,47 @@ TEST(ReprojectionErrorTest, PointBehindTheCameraIsAnInvalidEvaluation) {
   const double* parameters[3] = {q.coeffs().data(), center, intrinsics};
   double residual[2];
   EXPECT_FALSE(cost.Evaluate(parameters, residual, nullptr));
+}
+
+// ToChart (fit/normal_equations.h) is the change of variables J -> J T, T = diag(A, R, I): the
+// normal equations T^T J^T J T and T^T J^T r, here formed densely, for 6-13 parameters. Both are
+// sums of at most 6 products of entries of size 1: they agree to rounding (1e-13 of the largest
+// entry).
+TEST(ReprojectionErrorTest, ToChartIsTheChangeOfVariables) {
+  constexpr double kRounding = 1e-13;
+  std::mt19937_64 rng(testing::Seed(23));
+  for (int i = 0; i < 200; ++i) {
+    const int p = 6 + i % (internal::kFitIntrinsicsSize + 1);
+    Eigen::MatrixXd j(2 * p, p);
+    for (int r = 0; r < j.rows(); ++r) {
+      for (int c = 0; c < p; ++c) j(r, c) = testing::Uniform(rng, -1, 1);
+    }
+    Eigen::VectorXd residual(2 * p);
+    for (int r = 0; r < residual.size(); ++r) residual(r) = testing::Uniform(rng, -1, 1);
+    Eigen::Matrix3d a;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) a(r, c) = (r == c) + testing::Uniform(rng, -0.3, 0.3);
+    }
+    const Eigen::Matrix3d rotation = testing::RandomRotation(rng);
+    internal::NormalEquations normal;
+    normal.jtj = j.transpose() * j;
+    normal.jtr = j.transpose() * residual;
+    Eigen::MatrixXd t = Eigen::MatrixXd::Identity(p, p);
+    t.topLeftCorner<3, 3>() = a;
+    t.block<3, 3>(3, 3) = rotation;
+    const Eigen::MatrixXd expected_jtj = t.transpose() * normal.jtj * t;
+    const Eigen::VectorXd expected_jtr = t.transpose() * normal.jtr;
+    internal::ToChart(a, rotation, &normal);
+    const double scale = expected_jtj.cwiseAbs().maxCoeff();
+    for (int r = 0; r < p; ++r) {
+      for (int c = 0; c < p; ++c) {
+        EXPECT_NEAR(normal.jtj(r, c), expected_jtj(r, c), kRounding * scale)
+            << "(" << r << ", " << c << ") case " << i;
+      }
+      EXPECT_NEAR(normal.jtr(r), expected_jtr(r), kRounding * expected_jtr.cwiseAbs().maxCoeff())
+          << r << " case " << i;
+    }
+  }
 }
 
 }  // namespace

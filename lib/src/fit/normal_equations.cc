@@ -147,18 +147,29 @@ bool LocalNormalEquations(const std::vector<Eigen::Vector3d>& points,
 
 void ToChart(const Eigen::Matrix3d& d_theta_d_omega, const Eigen::Matrix3d& rotation,
              NormalEquations* normal) {
+  // T = diag(A, R) is block diagonal: T^T P T by its 3 x 3 blocks, a third of the dense 6 x 6
+  // products' multiplications (it runs once per pass over the points).
+  const Eigen::Matrix3d& a = d_theta_d_omega;
+  const Eigen::Matrix3d& r = rotation;
+  ParamMatrix& jtj = normal->jtj;
   const int num_intrinsics = static_cast<int>(normal->jtr.size()) - 6;
-  Eigen::Matrix<double, 6, 6> t = Eigen::Matrix<double, 6, 6>::Zero();
-  t.topLeftCorner<3, 3>() = d_theta_d_omega;
-  t.bottomRightCorner<3, 3>() = rotation;
-  const Eigen::Matrix<double, 6, 6> pose_block = normal->jtj.topLeftCorner<6, 6>();
-  normal->jtj.topLeftCorner<6, 6>() = t.transpose() * pose_block * t;
-  const Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kFitIntrinsicsSize> cross_block =
-      t.transpose() * normal->jtj.topRightCorner(6, num_intrinsics);
-  normal->jtj.topRightCorner(6, num_intrinsics) = cross_block;
-  normal->jtj.bottomLeftCorner(num_intrinsics, 6) = cross_block.transpose();
-  const Eigen::Matrix<double, 6, 1> pose_gradient = normal->jtr.head<6>();
-  normal->jtr.head<6>() = t.transpose() * pose_gradient;
+  const Eigen::Matrix3d rotation_block = a.transpose() * jtj.block<3, 3>(0, 0) * a;
+  const Eigen::Matrix3d mixed_block = a.transpose() * jtj.block<3, 3>(0, 3) * r;
+  const Eigen::Matrix3d center_block = r.transpose() * jtj.block<3, 3>(3, 3) * r;
+  jtj.block<3, 3>(0, 0) = rotation_block;
+  jtj.block<3, 3>(0, 3) = mixed_block;
+  jtj.block<3, 3>(3, 0) = mixed_block.transpose();
+  jtj.block<3, 3>(3, 3) = center_block;
+  for (int j = 6; j < 6 + num_intrinsics; ++j) {
+    const Eigen::Vector3d rotation_column = a.transpose() * jtj.block<3, 1>(0, j);
+    const Eigen::Vector3d center_column = r.transpose() * jtj.block<3, 1>(3, j);
+    jtj.block<3, 1>(0, j) = rotation_column;
+    jtj.block<3, 1>(3, j) = center_column;
+    jtj.block<1, 3>(j, 0) = rotation_column.transpose();
+    jtj.block<1, 3>(j, 3) = center_column.transpose();
+  }
+  normal->jtr.head<3>() = (a.transpose() * normal->jtr.head<3>()).eval();
+  normal->jtr.segment<3>(3) = (r.transpose() * normal->jtr.segment<3>(3)).eval();
 }
 
 bool ComputeNormalEquations(const std::vector<Eigen::Vector3d>& points,
