@@ -189,11 +189,11 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
         2 * static_cast<int>(n) - internal::NumParameters(off_axis) >= options.min_redundancy) {
       models.push_back(off_axis);
     }
-    for (const FitOptions& model : models) {
-      const std::optional<internal::MirroredReading> reading =
-          internal::FitMirroredWorld(kept_points, kept_pixels, size, model,
-                                     selection.fit.camera.intrinsics, &mirrored_world);
-      if (reading) consider(reading->camera, model, reading->rms_px);
+    const std::vector<std::optional<internal::MirroredReading>> readings =
+        internal::FitMirroredWorld(kept_points, kept_pixels, size, models,
+                                   selection.fit.camera.intrinsics, &mirrored_world);
+    for (size_t i = 0; i < models.size(); ++i) {
+      if (readings[i]) consider(readings[i]->camera, models[i], readings[i]->rms_px);
     }
   }
   return rival;

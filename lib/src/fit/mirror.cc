@@ -1,6 +1,8 @@
 #include "fit/mirror.h"
 
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "camproj/pose.h"
 #include "fit/closed_form.h"
@@ -68,34 +70,49 @@ std::optional<MirroredReading> FitMirroredReading(
   }
 }
 
-std::optional<MirroredReading> FitMirroredWorld(
+std::vector<std::optional<MirroredReading>> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
-    const FitOptions& model, const Intrinsics& intrinsics, const SceneGeometry* mirrored_world) {
-  FitOptions options = model;
-  options.max_iterations = kFreshStartIterations;
-  try {
-    const Scene scene =
-        MirroredScene(points_in_world, observed_pixels, image_size, options, mirrored_world);
-    StartCamera start;
-    Model start_model;
-    // The DLT reads the mirrored world as mirrored where it reads the given one as proper:
-    // SQPnP then, from the intrinsics the given world was fitted with.
-    if (model.known_intrinsics || scene.planar_start || scene.num_distinct_points < 6 ||
-        !DltStartOf(scene).mirrored) {
-      const Start closed_form = ClosedFormStart(scene, options, Clock::now());
-      start = closed_form.camera;
-      start_model = closed_form.model;
-    } else {
-      if (!PnpStart(scene.points, scene.pixels, intrinsics, &start)) return std::nullopt;
-      start_model = ModelAt(scene.model, intrinsics);
+    const std::vector<FitOptions>& models, const Intrinsics& intrinsics,
+    const SceneGeometry* mirrored_world) {
+  // The SQPnP pose at `intrinsics` does not depend on the model: solved at most once.
+  bool pnp_solved = false;
+  std::optional<StartCamera> pnp;
+  auto fit = [&](const FitOptions& model) -> std::optional<MirroredReading> {
+    FitOptions options = model;
+    options.max_iterations = kFreshStartIterations;
+    try {
+      const Scene scene =
+          MirroredScene(points_in_world, observed_pixels, image_size, options, mirrored_world);
+      StartCamera start;
+      Model start_model;
+      // The DLT reads the mirrored world as mirrored where it reads the given one as proper:
+      // SQPnP then, from the intrinsics the given world was fitted with.
+      if (model.known_intrinsics || scene.planar_start || scene.num_distinct_points < 6 ||
+          !DltStartOf(scene).mirrored) {
+        const Start closed_form = ClosedFormStart(scene, options, Clock::now());
+        start = closed_form.camera;
+        start_model = closed_form.model;
+      } else {
+        if (!pnp_solved) {
+          pnp_solved = true;
+          StartCamera solved;
+          if (PnpStart(scene.points, scene.pixels, intrinsics, &solved)) pnp = solved;
+        }
+        if (!pnp) return std::nullopt;
+        start = *pnp;
+        start_model = ModelAt(scene.model, intrinsics);
+      }
+      Camera like;
+      like.image_size = image_size;
+      return RefineReading(scene, start, start_model, options, like);
+    } catch (const SceneError&) {
+      return std::nullopt;  // no start, or no valid scene
     }
-    Camera like;
-    like.image_size = image_size;
-    return RefineReading(scene, start, start_model, options, like);
-  } catch (const SceneError&) {
-    return std::nullopt;  // no start, or no valid scene
-  }
+  };
+  std::vector<std::optional<MirroredReading>> readings;
+  for (const FitOptions& model : models) readings.push_back(fit(model));
+  return readings;
 }
 
 }  // namespace internal

@@ -45,18 +45,18 @@ std::optional<MirroredReading> FitMirroredReading(
     const std::vector<Eigen::Vector2d>& observed_pixels,
     const SceneGeometry* mirrored_world = nullptr);
 
-// `model` fitted to the points with z negated from a start of that world's own, by LM (one round
-// of at most 20 iterations): at few points a mirrored world can fit a proper camera within the
-// noise far from any depth reversal. The start is the mirrored world's closed form where that
-// reads it as proper (the DLT's det > 0, or a plane's homography), else SQPnP with `intrinsics`
-// (the fitted camera's: the closed form would refine both readings and refuse, start.cc).
-// Nothing where no start or no proper camera with every point in front is found.
-// `mirrored_world` as for FitMirroredReading: prepared once, the mirrored world's DLT is read
-// once for every model fitted to it.
-std::optional<MirroredReading> FitMirroredWorld(
+// Each of `models` fitted to the points with z negated from a start of that world's own, by LM
+// (one round of at most 20 iterations): at few points a mirrored world can fit a proper camera
+// within the noise far from any depth reversal. The start is the mirrored world's closed form
+// where that reads it as proper (the DLT's det > 0, or a plane's homography), else SQPnP with
+// `intrinsics` (the fitted camera's: the closed form would refine both readings and refuse,
+// start.cc), solved once for every model. Per model, in order: nothing where no start or no
+// proper camera with every point in front is found. `mirrored_world` as for FitMirroredReading:
+// prepared once, the mirrored world's DLT is read once for every model.
+std::vector<std::optional<MirroredReading>> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
-    const FitOptions& model, const Intrinsics& intrinsics,
+    const std::vector<FitOptions>& models, const Intrinsics& intrinsics,
     const SceneGeometry* mirrored_world = nullptr);
 
 }  // namespace internal
