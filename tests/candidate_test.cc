@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +15,8 @@
 #include "camproj/model_select.h"
 #include "camproj/pose.h"
 #include "camproj/synth.h"
+#include "fit/common.h"
+#include "fit/normal_equations.h"
 #include "fit/selection.h"
 #include "fit/start.h"
 #include "seeds.h"
@@ -337,14 +340,24 @@ TEST(CandidateTest, ModelsFittedToPreparedPointsShareOneDlt) {
   }
   EXPECT_GE(fitted, 3 * 2 * kSeeds * 2);  // most scenes determine the models
 
-  // Every pixel reflected through the image centre but two: the DLT's linear camera has points
-  // on both sides of it.
-  const SynthScene scene = CloudScene(1, 8, 0.0);
-  const auto& points = scene.correspondences.points_in_world;
-  std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
-  const ImageSize size = scene.truth.image_size;
-  const Eigen::Vector2d centre(0.5 * (size.width - 1), 0.5 * (size.height - 1));
-  for (size_t i = 2; i < pixels.size(); ++i) pixels[i] = 2.0 * centre - pixels[i];
+  // Four points and their reflections through the camera centre, each pixel the camera matrix's
+  // (the reflection has the same ray, at negative depth): the DLT recovers that camera exactly,
+  // with four points behind it.
+  const SynthScene scene = CloudScene(1, 4, 0.0);
+  const Camera& truth = scene.truth;
+  const Eigen::Vector3d eye = CameraCenterInWorld(truth.cam_from_world);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  for (const Eigen::Vector3d& x : scene.correspondences.points_in_world) {
+    for (const Eigen::Vector3d& point : {x, Eigen::Vector3d(2.0 * eye - x)}) {
+      const Eigen::Vector3d p = truth.cam_from_world * point;
+      const Intrinsics& k = truth.intrinsics;
+      points.push_back(point);
+      pixels.emplace_back(k.fx * p.x() / p.z() + k.skew * p.y() / p.z() + k.cx,
+                          k.fy * p.y() / p.z() + k.cy);
+    }
+  }
+  const ImageSize size = truth.image_size;
   const internal::SceneGeometry geometry =
       internal::PrepareScene(points, pixels, size, focal.pixel_origin);
   for (const FitOptions* model : {&focal, &off_axis}) {
@@ -358,6 +371,49 @@ TEST(CandidateTest, ModelsFittedToPreparedPointsShareOneDlt) {
         << own;
   }
   EXPECT_TRUE(geometry.scene.dlt->refusal.has_value());
+}
+
+// A candidate's fit refuses on the reciprocal condition of its Jacobi-scaled J^T J, and where a
+// Cholesky bound clears the refusal it computes no eigenvalues (fit/common.h,
+// ReciprocalConditionLowerBound): the bound is below the eigenvalues' rcond, by at most p^2
+// (trace S = p against the largest eigenvalue, trace S^-1 against the smallest's reciprocal), on
+// random normal equations of 6-13 parameters, rcond down to ~1e-11; and a singular one (a
+// column repeated, a column of zeros) bounds to 0 or to rounding (1e-16 times p^2).
+TEST(CandidateTest, ReciprocalConditionBoundIsBelowTheEigenvalues) {
+  constexpr double kRounding = 1e-9;  // relative, the eigenvalues' own at rcond 1e-13 and above
+  std::mt19937_64 rng(testing::Seed(31));
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int checked = 0;
+  for (int i = 0; i < 300; ++i) {
+    const int p = 6 + i % 8;
+    Eigen::MatrixXd j(2 * p + 4, p);
+    for (int r = 0; r < j.rows(); ++r) {
+      for (int c = 0; c < p; ++c) j(r, c) = uniform(rng);
+    }
+    // Columns of very different units, and one nearly a combination of the others.
+    const double near = std::pow(10.0, -2.5 * (i % 3));  // 1, 3e-3, 1e-5: rcond to ~1e-11
+    j.col(p - 1) = j.col(0) + j.col(1) + near * j.col(p - 1);
+    for (int c = 0; c < p; ++c) j.col(c) *= std::pow(10.0, 3.0 * uniform(rng));
+    const internal::ParamMatrix jtj = j.transpose() * j;
+    const double bound = internal::ReciprocalConditionLowerBound(jtj);
+    const double rcond = internal::JacobiScaledNormal<internal::ParamMatrix>(jtj).rcond;
+    SCOPED_TRACE(::testing::Message() << "case " << i << ", p " << p << ", rcond " << rcond);
+    if (rcond < 1e-13) continue;  // below the eigenvalues' own rounding
+    ++checked;
+    EXPECT_LE(bound, rcond * (1.0 + kRounding));
+    EXPECT_GE(bound, rcond / (p * p) * (1.0 - kRounding));
+  }
+  EXPECT_GE(checked, 290);  // all but a rare draw beyond the eigenvalues' rounding
+  Eigen::MatrixXd j(20, 8);
+  for (int r = 0; r < j.rows(); ++r) {
+    for (int c = 0; c < j.cols(); ++c) j(r, c) = uniform(rng);
+  }
+  j.col(7) = j.col(2);
+  EXPECT_LE(internal::ReciprocalConditionLowerBound(internal::ParamMatrix(j.transpose() * j)),
+            64 * 1e-16);
+  j.col(7).setZero();
+  EXPECT_EQ(internal::ReciprocalConditionLowerBound(internal::ParamMatrix(j.transpose() * j)),
+            0.0);
 }
 
 }  // namespace

@@ -337,20 +337,30 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   // The eigenvectors only where they are read: the covariance and linearity check of a described
   // fit; a refusal's null direction recomputes them. (A candidate of the model selection, a
   // screen's or a mirror test's fit reads the reciprocal condition alone.)
+  // A fit not described reads the condition only to refuse: where the Cholesky bound already
+  // clears the refusal by kBoundMargin, its eigenvalues are not computed (jacobian_condition is
+  // then NaN: no report shows it).
+  constexpr double kBoundMargin = 1e3;
   const bool needs_vectors = options.compute_uncertainty && effort.describe;
-  const JacobiScaledNormal<ParamMatrix> scaled_normal(
-      refined.normal.jtj, needs_vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
-  if (!(scaled_normal.rcond > kSingularRcond)) {
-    if (needs_vectors) RefuseUndetermined(scaled_normal, names);
-    RefuseUndetermined(JacobiScaledNormal<ParamMatrix>(refined.normal.jtj), names);
+  std::optional<JacobiScaledNormal<ParamMatrix>> scaled_normal;
+  if (effort.describe ||
+      !(ReciprocalConditionLowerBound(refined.normal.jtj) > kBoundMargin * kSingularRcond)) {
+    scaled_normal.emplace(refined.normal.jtj, needs_vectors ? Eigen::ComputeEigenvectors
+                                                            : Eigen::EigenvaluesOnly);
+    if (!(scaled_normal->rcond > kSingularRcond)) {
+      if (needs_vectors) RefuseUndetermined(*scaled_normal, names);
+      RefuseUndetermined(JacobiScaledNormal<ParamMatrix>(refined.normal.jtj), names);
+    }
+    result.jacobian_condition = scaled_normal->JacobianCondition();
+  } else {
+    result.jacobian_condition = std::numeric_limits<double>::quiet_NaN();
   }
-  result.jacobian_condition = scaled_normal.JacobianCondition();
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
   if (options.compute_uncertainty && have_sigma && effort.describe) {
-    SetCovariance(scaled_normal, names, model, scene.scale, options, &result);
+    SetCovariance(*scaled_normal, names, model, scene.scale, options, &result);
     if (effort.check_linearity && refined.normal.jtr.size() == refined.normal.jtj.rows()) {
       result.linearity =
-          CheckLinearity(scene, refined, scaled_normal, names, result.pixel_sigma);
+          CheckLinearity(scene, refined, *scaled_normal, names, result.pixel_sigma);
     }
   }
   return result;
