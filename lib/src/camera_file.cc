@@ -453,6 +453,7 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     }
     if (!fit->consistency.empty()) record["consistency"] = fit->consistency;
     if (!fit->determination.empty()) record["determination"] = fit->determination;
+    if (!fit->reliability.empty()) record["reliability"] = fit->reliability;
     record["start"] = fit->start;
     record["model"] = fit->model;
     if (!fit->candidates.empty()) {

@@ -61,6 +61,7 @@ FitRecord FitRecordOf(const FitResult& fit) {
   }
   if (fit.consistency.checked) record.consistency = fit.consistency.summary;
   if (fit.determination.checked) record.determination = fit.determination.summary;
+  if (fit.reliability.checked) record.reliability = fit.reliability.summary;
   record.pixel_sigma = fit.pixel_sigma;
   record.pixel_sigma_estimated = fit.pixel_sigma_estimated;
   record.iterations = fit.iterations;
@@ -204,6 +205,7 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   }
   if (fit.consistency.checked) out << "check: " << fit.consistency.summary << "\n";
   if (fit.determination.checked) out << "determination: " << fit.determination.summary << "\n";
+  if (fit.reliability.checked) out << "reliability: " << fit.reliability.summary << "\n";
   if (fit.linearity.checked) out << "linearity: " << LinearityText(fit.linearity) << "\n";
   out << "worst points:";
   for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {

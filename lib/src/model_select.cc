@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -398,6 +399,42 @@ Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
               left_out, points, pixels, options, noise);
 }
 
+// The least checked kept point (CheckDetermination's, index among the kept points) in the
+// caller's indices and words (PointReliability).
+PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
+                                 const std::vector<std::string>& names) {
+  // Below this a point's residual keeps under 1 % of a mis-click: say what would check it.
+  constexpr double kWeakRedundancy = 0.01;
+  // Redundancy at the hat matrix's rounding (its eigenvalues to ~1e-12 of 1): none.
+  constexpr double kNoRedundancy = 1e-9;
+  if (!least.checked || least.point < 0) return least;
+  int kept = -1;
+  for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+    if (std::binary_search(left_out.begin(), left_out.end(), i)) continue;
+    if (++kept == least.point) {
+      least.point = i;
+      break;
+    }
+  }
+  char direction[48];
+  std::snprintf(direction, sizeof direction, "(%.2f, %.2f)", least.direction.x(),
+                least.direction.y());
+  char kept_percent[32];
+  std::snprintf(kept_percent, sizeof kept_percent, "%.2g %%", 100.0 * least.redundancy);
+  const std::string& name = names[least.point];
+  least.summary = "least checked: " + name +
+                  (least.redundancy < kNoRedundancy
+                       ? std::string(", which alone fixes the camera along ") + direction +
+                             ": a mis-click of it that way would not show in any residual"
+                       : ", whose residual keeps " + std::string(kept_percent) +
+                             " of a mis-click along " + direction);
+  if (least.redundancy < kWeakRedundancy) {
+    least.summary += "; the other points barely check it: add points (near it), or fix "
+                     "intrinsics you know (e.g. --fix principal-point)";
+  }
+  return least;
+}
+
 // The assessment of the gated selection: the statistics over the kept points, the mirror test,
 // the gate's verdict (kInconsistent when it failed: only the forced-RANSAC path gets here with a
 // failed gate), and the left-out points' report.
@@ -433,8 +470,9 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
     RefuseIfPerspectiveShows(
         internal::TestPerspectiveStrength(gated.selection, kept_points, options), left_out_text);
   }
+  PointReliability least_checked;
   const DeterminationCheck determination =
-      internal::CheckDetermination(gated.selection, kept_points, options);
+      internal::CheckDetermination(gated.selection, kept_points, options, &least_checked);
   RefuseIfUndetermined(determination, gated.selection.fit.model, left_out_text,
                        options.fit.pixel_origin);
   if (std::isfinite(options.max_uncertainty_px)) {
@@ -450,6 +488,7 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   result.max_px = gated.check.max_residual_px;
   result.consistency = gated.check;
   result.determination = determination;
+  result.reliability = WordReliability(least_checked, left_out, names);
   constexpr size_t kMaxRefits = 10;  // beyond, rms_with_px is not computed (0)
   FitOptions refit = gated.selection.options;
   refit.compute_uncertainty = false;

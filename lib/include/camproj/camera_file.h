@@ -38,6 +38,7 @@ struct FitRecord {
   std::vector<OutlierPoint> outlier_points;
   std::string consistency;  // the consistency gate's verdict in words (automatic fit only)
   std::string determination;  // the determination check's verdict in words (automatic fit only)
+  std::string reliability;  // the least checked point in words (automatic fit only)
   std::string start;        // closed-form start: dlt | homography | pnp | pnp-focal-sweep
   std::string model;        // "pose+focal+principal-point": the free intrinsics
   // Automatic model selection (empty otherwise): criterion, the noise it used, every model tried.

@@ -332,6 +332,17 @@ class PixelUncertainty {
     return SigmaOf(FittedRows(i));
   }
 
+  // SigmaAtFitted(i) and HatAt(i) from one evaluation of its rows (the same numbers).
+  double SigmaAndHatAtFitted(size_t i, Eigen::Matrix2d* hat) const {
+    if (singular_) {
+      *hat = Eigen::Matrix2d::Identity();
+      return std::numeric_limits<double>::infinity();
+    }
+    const PointRows whitened = FittedRows(i).lazyProduct(whitening_);
+    *hat = whitened * whitened.transpose();
+    return sigma_px_ * std::sqrt(whitened.squaredNorm());
+  }
+
  private:
   Eigen::Vector3d Fitted(size_t i) const {
     Eigen::Vector3d x = (*fitted_)[i];
@@ -359,6 +370,33 @@ class PixelUncertainty {
   ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
   bool singular_ = false;
 };
+
+// The fitted point whose own pixel the fit follows most: the largest eigenvalue of its hat block
+// over the points, with its eigenvector (PointReliability; `point` its index among the fitted
+// points). `hats`: the blocks already computed (SigmasAt), one slot per fitted point.
+PointReliability LeastChecked(const PixelUncertainty& uncertainty,
+                              const std::vector<std::optional<Eigen::Matrix2d>>& hats) {
+  PointReliability least;
+  least.checked = true;
+  for (size_t i = 0; i < hats.size(); ++i) {
+    const Eigen::Matrix2d h = hats[i] ? *hats[i] : uncertainty.HatAt(i);
+    // The symmetric 2 x 2 block's larger eigenvalue in closed form: mean + radius.
+    const double mean = 0.5 * (h(0, 0) + h(1, 1));
+    const double half_difference = 0.5 * (h(0, 0) - h(1, 1));
+    const double radius = std::hypot(half_difference, h(0, 1));
+    const double redundancy = std::max(0.0, 1.0 - (mean + radius));
+    if (least.point >= 0 && !(redundancy < least.redundancy)) continue;
+    least.point = static_cast<int>(i);
+    least.redundancy = redundancy;
+    // Its eigenvector: (h01, lambda - h00) or, where that vanishes (a diagonal block with
+    // h00 >= h11), (lambda - h11, h01) = (2 radius, 0).
+    const Eigen::Vector2d a(h(0, 1), radius - half_difference);
+    const Eigen::Vector2d b(radius + half_difference, h(0, 1));
+    const Eigen::Vector2d v = a.squaredNorm() > b.squaredNorm() ? a : b;
+    least.direction = v.norm() > 0.0 ? Eigen::Vector2d(v.normalized()) : Eigen::Vector2d(1.0, 0.0);
+  }
+  return least;
+}
 
 // SceneTestPoints with, for each, the index of the fitted point it is (-1: a corner or face
 // centre of the box), whose Jacobian the uncertainty already has.
@@ -457,13 +495,22 @@ TestPoints TestPointsOrFitted(const Camera& camera, const std::vector<Eigen::Vec
   return test;
 }
 
-// The sigmas at the test points.
-std::vector<double> SigmasAt(const PixelUncertainty& uncertainty, const TestPoints& test) {
+// The sigmas at the test points; with `fitted_hats` not null, also the hat block of every
+// fitted point among them, at its index (the others left as they are).
+std::vector<double> SigmasAt(const PixelUncertainty& uncertainty, const TestPoints& test,
+                             std::vector<std::optional<Eigen::Matrix2d>>* fitted_hats = nullptr) {
   std::vector<double> sigmas;
   sigmas.reserve(test.points.size());
   for (size_t i = 0; i < test.points.size(); ++i) {
-    sigmas.push_back(test.fitted[i] >= 0 ? uncertainty.SigmaAtFitted(test.fitted[i])
-                                         : uncertainty.SigmaAt(test.points[i]));
+    const int fitted = test.fitted[i];
+    if (fitted >= 0 && fitted_hats != nullptr) {
+      Eigen::Matrix2d hat;
+      sigmas.push_back(uncertainty.SigmaAndHatAtFitted(fitted, &hat));
+      (*fitted_hats)[fitted] = hat;
+    } else {
+      sigmas.push_back(fitted >= 0 ? uncertainty.SigmaAtFitted(fitted)
+                                   : uncertainty.SigmaAt(test.points[i]));
+    }
   }
   return sigmas;
 }
@@ -747,7 +794,8 @@ PerspectiveTest TestPerspectiveStrength(const Selection& selection,
 
 DeterminationCheck CheckDetermination(const Selection& selection,
                                       const std::vector<Eigen::Vector3d>& kept_points,
-                                      const AutoFitOptions& options) {
+                                      const AutoFitOptions& options,
+                                      PointReliability* reliability) {
   DeterminationCheck check;
   check.checked = true;
   check.bound_px = options.max_uncertainty_px;
@@ -767,7 +815,10 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
   const PixelUncertainty uncertainty(camera, selection.options, points, sigma);
-  const std::vector<double> sigmas = SigmasAt(uncertainty, test_points);
+  std::vector<std::optional<Eigen::Matrix2d>> hats(reliability != nullptr ? points.size() : 0);
+  const std::vector<double> sigmas =
+      SigmasAt(uncertainty, test_points, reliability != nullptr ? &hats : nullptr);
+  if (reliability != nullptr) *reliability = LeastChecked(uncertainty, hats);
   for (size_t i = 0; i < test.size(); ++i) {
     if (!(sigmas[i] <= check.max_sigma_px)) {
       check.max_sigma_px = sigmas[i];

@@ -41,9 +41,12 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
 // sigmas use, and the largest shift of a test point by a rival that fits about as well, over the
 // box widened to kRivalBoxThickness (a rival that agrees on the clicked points can still put the
 // object behind them elsewhere). Pixels in messages are in options.fit.pixel_origin.
+// With `reliability` not null, also the least checked kept point (PointReliability: its index
+// among kept_points, redundancy and direction; the caller words it).
 DeterminationCheck CheckDetermination(const Selection& selection,
                                       const std::vector<Eigen::Vector3d>& kept_points,
-                                      const AutoFitOptions& options);
+                                      const AutoFitOptions& options,
+                                      PointReliability* reliability = nullptr);
 
 // Whether an orthographic answer's perspective is observable: the test of "the depth spread is
 // small against the distance". The orthographic camera is the limit e = 0 of the perspective
