@@ -124,6 +124,11 @@ class FitReport:
     @property
     def determination(self) -> str: ...
     @property
+    def reliability(self) -> Optional[dict[str, Any]]:
+        """The least checked point (fit.h PointReliability): point (0-based index), redundancy
+        (the fraction of a mis-click of it along direction that its residual keeps), direction
+        (unit, image axes), summary; None for a fit without the automatic pipeline."""
+    @property
     def linearity(self) -> Optional[dict[str, Any]]:
         """Whether the covariance's linearization holds out to the 99.99 % region (fit.h
         LinearityCheck): linear, level, worst_deviation, bound, worst_direction, summary; None

@@ -345,6 +345,15 @@ PYBIND11_MODULE(camproj, m) {
       .def_property_readonly("fixed_parameters", [](const FitResult& f) { return FitRecordOf(f).fixed; })
       .def_property_readonly("consistency", [](const FitResult& f) { return f.consistency.summary; })
       .def_property_readonly("determination", [](const FitResult& f) { return f.determination.summary; })
+      .def_property_readonly("reliability", [](const FitResult& f) -> py::object {
+        if (!f.reliability.checked) return py::none();
+        py::dict d;
+        d["point"] = f.reliability.point;
+        d["redundancy"] = f.reliability.redundancy;
+        d["direction"] = py::make_tuple(f.reliability.direction.x(), f.reliability.direction.y());
+        d["summary"] = f.reliability.summary;
+        return d;
+      })
       .def_property_readonly("linearity", [](const FitResult& f) -> py::object {
         if (!f.linearity.checked) return py::none();
         py::dict d;

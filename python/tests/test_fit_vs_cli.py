@@ -106,6 +106,11 @@ def test_report_fields(data_dir):
     assert value == camera.intrinsics.fx and sigma > 0 and unit == "px"
     assert report.covariance.shape == (len(report.free_parameters),) * 2
     assert "consistent" in report.consistency
+    # The least checked point, as the camera file says it.
+    reliability = report.reliability
+    assert 0 <= reliability["point"] < 20 and 0 <= reliability["redundancy"] <= 1
+    assert abs(reliability["direction"][0] ** 2 + reliability["direction"][1] ** 2 - 1) < 1e-12
+    assert reliability["summary"] == json.loads(camera.to_json())["fit"]["reliability"]
     # The linearity check, as the camera file has it (fit.h LinearityCheck).
     linearity = report.linearity
     fit_record = json.loads(camera.to_json())["fit"]["linearity"]
