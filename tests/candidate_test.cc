@@ -50,6 +50,14 @@ SynthScene CloudScene(uint64_t seed, int n, double offset_y) {
   return SynthesizeScene(synth);
 }
 
+// Pose + focal: FitOptions' default frees the aspect and the principal point too.
+FitOptions PoseAndFocal() {
+  FitOptions focal;
+  focal.aspect = ParameterMode::Default();
+  focal.principal_point = ParameterMode::Default();
+  return focal;
+}
+
 // `sigmas`: a full fit's (FitCamera) of the model, for the k1 model's bound; a candidate
 // computes none.
 void ExpectSameOptimum(const FitResult& a, const FitResult& b, bool pinhole,
@@ -96,9 +104,7 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
         const SynthScene scene = CloudScene(seed, n, offset_y);
         const auto& points = scene.correspondences.points_in_world;
         const auto& pixels = scene.correspondences.pixels;
-        FitOptions focal;  // pose + focal
-        focal.aspect = ParameterMode::Default();
-        focal.principal_point = ParameterMode::Default();
+        const FitOptions focal = PoseAndFocal();
         FitOptions principal_point = focal;
         principal_point.principal_point = ParameterMode::Free();
         FitOptions aspect = principal_point;
@@ -256,9 +262,7 @@ TEST(CandidateTest, PreparedPointsRefuseAsTheirOwnScene) {
     for (int i = 0; i < 4; ++i) c.points[i].x() = i % 2 ? 1.7e308 : -1.7e308;  // spread: inf
     cases.push_back(c);
   }
-  FitOptions focal;
-  focal.aspect = ParameterMode::Default();
-  focal.principal_point = ParameterMode::Default();
+  FitOptions focal = PoseAndFocal();
   FitOptions full = focal;  // focal, aspect, principal point, skew: 4 linear intrinsics
   full.aspect = ParameterMode::Free();
   full.principal_point = ParameterMode::Free();
@@ -293,9 +297,7 @@ TEST(CandidateTest, PreparedPointsRefuseAsTheirOwnScene) {
 // refuses every model with the message the model's own DLT gives.
 TEST(CandidateTest, ModelsFittedToPreparedPointsShareOneDlt) {
   constexpr int kSeeds = 20;
-  FitOptions focal;
-  focal.aspect = ParameterMode::Default();
-  focal.principal_point = ParameterMode::Default();
+  FitOptions focal = PoseAndFocal();
   FitOptions off_axis = focal;
   off_axis.principal_point = ParameterMode::Free();
   FitOptions full = off_axis;
