@@ -4,7 +4,9 @@
 #include "fit/candidate.h"
 
 #include <cmath>
+#include <limits>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <utility>
@@ -380,7 +382,9 @@ TEST(CandidateTest, ModelsFittedToPreparedPointsShareOneDlt) {
 // ReciprocalConditionLowerBound): the bound is below the eigenvalues' rcond, by at most p^2
 // (trace S = p against the largest eigenvalue, trace S^-1 against the smallest's reciprocal), on
 // random normal equations of 6-13 parameters, rcond down to ~1e-11; and a singular one (a
-// column repeated, a column of zeros) bounds to 0 or to rounding (1e-16 times p^2).
+// column repeated, a column of zeros) bounds to 0 or to rounding (1e-16 times p^2). The inverse
+// Cholesky factor it reads (InverseCholeskyOfScaled), which the determination check whitens
+// with, inverts the scaled J^T J.
 TEST(CandidateTest, ReciprocalConditionBoundIsBelowTheEigenvalues) {
   constexpr double kRounding = 1e-9;  // relative, the eigenvalues' own at rcond 1e-13 and above
   std::mt19937_64 rng(testing::Seed(31));
@@ -404,6 +408,15 @@ TEST(CandidateTest, ReciprocalConditionBoundIsBelowTheEigenvalues) {
     ++checked;
     EXPECT_LE(bound, rcond * (1.0 + kRounding));
     EXPECT_GE(bound, rcond / (p * p) * (1.0 - kRounding));
+    // Its X = L^-1 inverts the scaled S = D J^T J D as X^T X (so J^T J as W W^T, W = D X^T) to
+    // the Cholesky's rounding: p eps times S's condition 1 / rcond (16 p eps / rcond allowed).
+    const std::optional<internal::ParamMatrix> x = internal::InverseCholeskyOfScaled(jtj);
+    ASSERT_TRUE(x.has_value());
+    const Eigen::VectorXd d = jtj.diagonal().cwiseSqrt().cwiseInverse();
+    const Eigen::MatrixXd scaled = d.asDiagonal() * Eigen::MatrixXd(jtj) * d.asDiagonal();
+    const Eigen::MatrixXd identity = x->transpose() * *x * scaled;
+    EXPECT_LE((identity - Eigen::MatrixXd::Identity(p, p)).cwiseAbs().maxCoeff(),
+              16.0 * p * std::numeric_limits<double>::epsilon() / rcond);
   }
   EXPECT_GE(checked, 290);  // all but a rare draw beyond the eigenvalues' rounding
   Eigen::MatrixXd j(20, 8);

@@ -15,6 +15,7 @@
 
 #include "camproj/camera.h"
 #include "camproj/fit.h"
+#include "fit/small_solve.h"
 
 namespace camproj {
 namespace internal {
@@ -116,43 +117,55 @@ struct JacobiScaledNormal {
   double rcond;
 };
 
-// A lower bound on JacobiScaledNormal(jtj).rcond from a Cholesky factor alone, without the
-// eigenvalues: the scaled S = D J^T J D has a unit diagonal, so its largest eigenvalue is at most
-// trace S = p and its smallest at least 1 / trace(S^-1) = 1 / |L^-1|_F^2 (S = L L^T): rcond >=
-// 1 / (p |L^-1|_F^2), at most p^2 below it. 0 where S is not positive definite to rounding.
-// Plain loops on the fixed-capacity storage (as fit/small_solve.h): about a tenth of the
-// eigenvalues' instructions at 9 parameters.
+// X = L^-1 for the Jacobi-scaled S = D J^T J D = L L^T (D = diag(J^T J)^-1/2, so S has a unit
+// diagonal): S^-1 = X^T X, and (J^T J)^-1 = W W^T with W = D X^T. Lower triangular, column by
+// column (L x = e_j), by plain loops on the fixed-capacity storage (as fit/small_solve.h, whose
+// Cholesky factors S). Nothing where a column has no effect (a zero diagonal) or S is not
+// positive definite to rounding.
 template <typename Matrix>
-double ReciprocalConditionLowerBound(const Matrix& jtj) {
+std::optional<Matrix> InverseCholeskyOfScaled(const Matrix& jtj) {
   const int p = static_cast<int>(jtj.rows());
   for (int j = 0; j < p; ++j) {
-    if (!(jtj(j, j) > 0.0 && std::isfinite(jtj(j, j)))) return 0.0;  // a column without effect
+    if (!(jtj(j, j) > 0.0 && std::isfinite(jtj(j, j)))) return std::nullopt;
   }
-  Matrix l(p, p);  // lower triangle: the Cholesky factor of S
+  Matrix scaled(p, p);  // its lower triangle
   for (int j = 0; j < p; ++j) {
-    double pivot = 1.0;  // S(j, j)
-    for (int k = 0; k < j; ++k) pivot -= l(j, k) * l(j, k);
-    if (!(pivot > 0.0 && std::isfinite(pivot))) return 0.0;
-    l(j, j) = std::sqrt(pivot);
-    for (int i = j + 1; i < p; ++i) {
-      double sum = jtj(i, j) / std::sqrt(jtj(i, i) * jtj(j, j));  // S(i, j)
-      for (int k = 0; k < j; ++k) sum -= l(i, k) * l(j, k);
-      l(i, j) = sum / l(j, j);
-    }
+    scaled(j, j) = 1.0;
+    for (int i = j + 1; i < p; ++i) scaled(i, j) = jtj(i, j) / std::sqrt(jtj(i, i) * jtj(j, j));
   }
-  // |L^-1|_F^2, column by column of X = L^-1 (lower triangular): L x = e_j.
-  double trace_of_inverse = 0.0;
-  double x[Matrix::MaxRowsAtCompileTime > 0 ? Matrix::MaxRowsAtCompileTime : 64];
+  Matrix l;
+  if (!FactorCholesky(scaled, &l)) return std::nullopt;
+  Matrix x = Matrix::Zero(p, p);
   for (int j = 0; j < p; ++j) {
     for (int i = j; i < p; ++i) {
       double sum = i == j ? 1.0 : 0.0;
-      for (int k = j; k < i; ++k) sum -= l(i, k) * x[k];
-      x[i] = sum / l(i, i);
-      trace_of_inverse += x[i] * x[i];
+      for (int k = j; k < i; ++k) sum -= l(i, k) * x(k, j);
+      x(i, j) = sum / l(i, i);
     }
+  }
+  return x;
+}
+
+// A lower bound on JacobiScaledNormal's rcond from InverseCholeskyOfScaled's X, without the
+// eigenvalues: S's largest eigenvalue is at most trace S = p and its smallest at least
+// 1 / trace(S^-1) = 1 / |X|_F^2, so rcond >= 1 / (p |X|_F^2), at most p^2 below it.
+template <typename Matrix>
+double ReciprocalConditionLowerBoundOf(const Matrix& inverse_cholesky) {
+  const int p = static_cast<int>(inverse_cholesky.rows());
+  double trace_of_inverse = 0.0;
+  for (int j = 0; j < p; ++j) {
+    for (int i = j; i < p; ++i) trace_of_inverse += inverse_cholesky(i, j) * inverse_cholesky(i, j);
   }
   if (!(trace_of_inverse > 0.0 && std::isfinite(trace_of_inverse))) return 0.0;
   return 1.0 / (static_cast<double>(p) * trace_of_inverse);
+}
+
+// The same from J^T J; 0 where S is not positive definite to rounding. About a tenth of the
+// eigenvalues' instructions at 9 parameters.
+template <typename Matrix>
+double ReciprocalConditionLowerBound(const Matrix& jtj) {
+  const std::optional<Matrix> x = InverseCholeskyOfScaled(jtj);
+  return x ? ReciprocalConditionLowerBoundOf(*x) : 0.0;
 }
 
 // The pixel noise the covariance is scaled by: given, or sqrt(sum_squares / dof) (none when

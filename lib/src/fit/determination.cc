@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
@@ -279,20 +278,18 @@ class PixelUncertainty {
     }
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
-    // (fit/common.h: (J^T J)^-1 = W W^T with W = D^-1 L^-T, scaled = L L^T), else through the
-    // eigen-decomposition, refusing near-singular directions.
+    // (fit/common.h, InverseCholeskyOfScaled: W = D X^T), else through the eigen-decomposition,
+    // refusing near-singular directions.
     constexpr double kBoundMargin = 1e3;
     const Eigen::VectorXd d_inverse = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-    const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
-    if (ReciprocalConditionLowerBound(ParameterMatrix(normal)) > kBoundMargin * kSingularRcond) {
-      const Eigen::LLT<ParameterMatrix> cholesky{ParameterMatrix(scaled)};
-      if (cholesky.info() == Eigen::Success) {
-        whitening_ = d_inverse.asDiagonal() *
-                     ParameterMatrix(cholesky.matrixU().solve(
-                         ParameterMatrix::Identity(scaled.rows(), scaled.cols())));
-        return;
-      }
+    const std::optional<ParameterMatrix> inverse_cholesky =
+        InverseCholeskyOfScaled(ParameterMatrix(normal));
+    if (inverse_cholesky && ReciprocalConditionLowerBoundOf(*inverse_cholesky) >
+                                kBoundMargin * kSingularRcond) {
+      whitening_ = d_inverse.asDiagonal() * inverse_cholesky->transpose();
+      return;
     }
+    const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
     const Eigen::VectorXd values = eigen.eigenvalues();
     singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));

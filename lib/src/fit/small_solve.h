@@ -21,11 +21,33 @@
 namespace camproj {
 namespace internal {
 
+// a = L L^T for a symmetric `a` (only its lower triangle is read), column by column: L(j, j) =
+// sqrt(a(j, j) - sum_k<j L(j, k)^2), L(i, j) for i > j by the same sums over row i; only L's
+// lower triangle is written. False at the first pivot that is not positive and finite.
+template <typename Matrix>
+bool FactorCholesky(const Matrix& a, Matrix* l) {
+  const int n = static_cast<int>(a.rows());
+  l->resize(n, n);
+  for (int j = 0; j < n; ++j) {
+    double pivot = a(j, j);
+    for (int k = 0; k < j; ++k) pivot -= (*l)(j, k) * (*l)(j, k);
+    if (!(pivot > 0.0 && std::isfinite(pivot))) return false;
+    const double diagonal = std::sqrt(pivot);
+    (*l)(j, j) = diagonal;
+    for (int i = j + 1; i < n; ++i) {
+      double sum = a(i, j);
+      for (int k = 0; k < j; ++k) sum -= (*l)(i, k) * (*l)(j, k);
+      (*l)(i, j) = sum / diagonal;
+    }
+  }
+  return true;
+}
+
 class SymmetricSolver {
  public:
   // Factors `a` (square, symmetric: only its lower triangle is read by the Cholesky).
   explicit SymmetricSolver(const ParamMatrix& a) : n_(static_cast<int>(a.rows())) {
-    if (!FactorCholesky(a)) {
+    if (!FactorCholesky(a, &l_)) {
       cholesky_ = false;
       ldlt_.compute(a);
     }
@@ -49,25 +71,6 @@ class SymmetricSolver {
   }
 
  private:
-  // Column by column: L(j, j) = sqrt(a(j, j) - sum_k<j L(j, k)^2), L(i, j) for i > j by the
-  // same sums over row i. False at the first pivot that is not positive and finite.
-  bool FactorCholesky(const ParamMatrix& a) {
-    l_.resize(n_, n_);
-    for (int j = 0; j < n_; ++j) {
-      double pivot = a(j, j);
-      for (int k = 0; k < j; ++k) pivot -= l_(j, k) * l_(j, k);
-      if (!(pivot > 0.0 && std::isfinite(pivot))) return false;
-      const double diagonal = std::sqrt(pivot);
-      l_(j, j) = diagonal;
-      for (int i = j + 1; i < n_; ++i) {
-        double sum = a(i, j);
-        for (int k = 0; k < j; ++k) sum -= l_(i, k) * l_(j, k);
-        l_(i, j) = sum / diagonal;
-      }
-    }
-    return true;
-  }
-
   int n_ = 0;
   bool cholesky_ = true;
   ParamMatrix l_;  // lower triangle: the Cholesky factor
