@@ -702,6 +702,9 @@ void AutoFitOptions::Check() const {
           significance);
   Require(std::isfinite(noise_tolerance) && noise_tolerance >= 1.0,
           "noise_tolerance must be >= 1, got ", noise_tolerance);
+  Require(screen_noise_tolerance >= 1.0 && screen_noise_tolerance <= noise_tolerance,
+          "screen_noise_tolerance must be in [1, noise_tolerance = ", noise_tolerance, "], got ",
+          screen_noise_tolerance);
   Require(min_redundancy >= 0, "min_redundancy must be >= 0, got ", min_redundancy);
 }
 

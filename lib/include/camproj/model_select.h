@@ -96,6 +96,13 @@ struct AutoFitOptions {
   // residual, corrected for the fit's leverage). Failing either is SceneError kInconsistent.
   double significance = 1e-3;
   double noise_tolerance = 1.5;
+  // The screen (every point fitted before the model selection) runs the same tests with this
+  // tolerance in place of noise_tolerance: failing it only sends the points to the outlier
+  // stage, which names a point only where leaving it out (and no other) passes the gate. So the
+  // screen looks for mis-clicks wherever the residuals exceed what the noise explains, while a
+  // camera is refused only for residuals beyond noise_tolerance times it. In [1,
+  // noise_tolerance].
+  double screen_noise_tolerance = 1.0;
 
   // A model is only freed beyond pose + focal when it leaves at least this many redundant
   // equations (2N - p): with fewer, its residuals cannot show that it is wrong. When the screen

@@ -204,7 +204,10 @@ OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
 Screen ScreenPoints(const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
                     const AutoFitOptions& options, const NoiseReference& noise) {
-  return FitSubset(points, pixels, {}, size, DetectionModels(options), options, noise);
+  // Tested at the screen's tolerance (AutoFitOptions::screen_noise_tolerance).
+  AutoFitOptions screen_options = options;
+  screen_options.noise_tolerance = options.screen_noise_tolerance;
+  return FitSubset(points, pixels, {}, size, DetectionModels(options), screen_options, noise);
 }
 
 OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points,

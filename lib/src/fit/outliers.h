@@ -30,9 +30,9 @@ struct OutlierSearch {
 
 // The screen: every point fitted with the simplest model that can show a mis-click -- pose +
 // focal + principal point where the scene determines it with min_redundancy equations to spare,
-// else pose + focal (the caller's forced or given intrinsics as they are) -- and gated. Run
-// before the model selection, whose richer models (skew, k1, k2 at 8 points) can absorb a
-// mis-click.
+// else pose + focal (the caller's forced or given intrinsics as they are) -- and gated at
+// AutoFitOptions::screen_noise_tolerance. Run before the model selection, whose richer models
+// (skew, k1, k2 at 8 points) can absorb a mis-click.
 struct Screen {
   bool consistent = false;
   std::string summary;  // the gate's verdict, or the last refusal
