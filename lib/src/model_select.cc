@@ -594,6 +594,16 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
     // (or find a subset that one does).
     if (!screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
     if (!screen.consistent && options.find_outliers) run_search();
+    if (screen.consistent && options.find_outliers) {
+      // A screen that passes may still hold a mis-click its fit absorbed (fit/outliers.h).
+      internal::OutlierSearch absorbed =
+          internal::FindAbsorbedOutlier(points, pixels, size, options, noise, screen);
+      if (absorbed.found) {
+        left_out = absorbed.outliers;
+        method = absorbed.method;
+        search = std::move(absorbed);
+      }
+    }
     std::optional<SceneError> refusal;
     std::string problem;
     // The options as the selection reads them, without the names (which `names` holds): each

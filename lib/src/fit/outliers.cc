@@ -37,6 +37,11 @@ std::vector<FitOptions> DetectionModels(const AutoFitOptions& options) {
   return models;
 }
 
+// How a subset is fitted: described (FitReusing: everything a returned fit has, as the screen's
+// fit, which the selection reads) or scored (FitCandidate: the residuals only, the restarts
+// skipped where the fit is already consistent with the noise).
+enum class SubsetFit { kDescribed, kScored };
+
 // A subset fitted with the first of `models` it determines, and gated. With
 // `next_only_for_planes`, a refusal moves on to the next model only where the subset is a plane
 // that cannot determine the model (kPlanarUnderdetermined); any other refusal ends the subset.
@@ -44,7 +49,7 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Eigen::Vector2d>& pixels, const std::vector<int>& left_out,
                  const ImageSize& size, const std::vector<FitOptions>& models,
                  const AutoFitOptions& options, const NoiseReference& noise,
-                 bool next_only_for_planes = false) {
+                 bool next_only_for_planes = false, SubsetFit effort = SubsetFit::kDescribed) {
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Vector2d> u;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -61,7 +66,10 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
     const int p = NumParameters(model);
     if (2 * static_cast<int>(x.size()) - p < options.min_redundancy) continue;
     try {
-      FitResult fit = FitReusing(x, u, size, model, CandidateReuse{nullptr, &geometry});
+      FitResult fit =
+          effort == SubsetFit::kScored
+              ? FitCandidate(x, u, size, model, noise.sigma_px, CandidateReuse{nullptr, &geometry})
+              : FitReusing(x, u, size, model, CandidateReuse{nullptr, &geometry});
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
       const ConsistencyCheck check = CheckConsistency(lengths, Repeats(x, u), p, noise, options);
@@ -208,6 +216,43 @@ Screen ScreenPoints(const std::vector<Eigen::Vector3d>& points,
   AutoFitOptions screen_options = options;
   screen_options.noise_tolerance = options.screen_noise_tolerance;
   return FitSubset(points, pixels, {}, size, DetectionModels(options), screen_options, noise);
+}
+
+OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points,
+                                  const std::vector<Eigen::Vector2d>& pixels,
+                                  const ImageSize& size, const AutoFitOptions& options,
+                                  const NoiseReference& noise, const Screen& screen) {
+  OutlierSearch search;
+  const int n = static_cast<int>(points.size());
+  if (n > options.exhaustive_max_points || !screen.consistent || !screen.fit) return search;
+  const FitOptions& model = screen.fit->model;
+  // As in the exhaustive search: the rest must keep the redundancy that convicts the point.
+  if (2 * (n - 1) - NumParameters(model) < options.min_redundancy + 2) return search;
+  double all_px2 = 0.0;
+  for (const Eigen::Vector2d& r : screen.fit->fit.residuals_px) all_px2 += r.squaredNorm();
+  const double bound_px2 =
+      noise.sigma_px * noise.sigma_px * ChiSquareQuantile(2.0, 1.0 - options.significance / n);
+  // No drop exceeds the whole sum: below the bound no point can be found (clean clicks at about
+  // the assumed noise almost never reach it, so the search costs nothing there).
+  if (!(all_px2 > bound_px2)) return search;
+  std::vector<int> found;
+  for (int i = 0; i < n; ++i) {
+    // Scored fits: skipping a restart can only leave a higher sum for the rest, a smaller drop.
+    const Screen rest = FitSubset(points, pixels, {i}, size, {model}, options, noise,
+                                  /*next_only_for_planes=*/false, SubsetFit::kScored);
+    if (!rest.fit || !rest.consistent) continue;
+    double rest_px2 = 0.0;
+    for (const Eigen::Vector2d& r : rest.fit->fit.residuals_px) rest_px2 += r.squaredNorm();
+    if (all_px2 - rest_px2 > bound_px2) found.push_back(i);
+  }
+  // Two or more: each explains the drop alone, and the points cannot say which; the caller keeps
+  // every point (the gates and the determination check judge them as before).
+  if (found.size() == 1) {
+    search.found = true;
+    search.outliers = found;
+    search.method = "leave-one-out";
+  }
+  return search;
 }
 
 OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points,
