@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "camproj/fit.h"
+#include "fit/small_solve.h"
 #include "fit/sqpnp.h"
 
 namespace camproj {
@@ -65,6 +66,37 @@ bool SqPnp(const std::vector<Eigen::Vector3d>& points,
 
 }  // namespace
 
+Eigen::Matrix<double, 12, 1> SmallestEigenvector(const Eigen::Matrix<double, 12, 12>& m) {
+  // Inverse iteration: each step multiplies the error by lambda_1 / lambda_2, which noisy
+  // points in general position keep far below 1 (two or three steps). It stops where the unit
+  // vector moves by less than kSettled, and hands over to Eigen's tridiagonal QR where it does
+  // not within kMaxSteps (two eigenvalues close together) or where the matrix is singular to
+  // rounding (v^T M v below kSingular of its trace: noise-free points, or a null space of two or
+  // more dimensions -- six coplanar points of a RANSAC sample -- whose vectors are all minima and
+  // Eigen's is the one the fitters were tuned with).
+  constexpr int kMaxSteps = 8;
+  constexpr double kSettled = 1e-13;
+  constexpr double kSingular = 1e-12;
+  Eigen::Matrix<double, 12, 12> l;
+  if (FactorCholesky(m, &l)) {
+    Eigen::Matrix<double, 12, 1> v = Eigen::Matrix<double, 12, 1>::Constant(1.0 / std::sqrt(12.0));
+    for (int step = 0; step < kMaxSteps; ++step) {
+      Eigen::Matrix<double, 12, 1> next = l.triangularView<Eigen::Lower>().solve(v);
+      l.triangularView<Eigen::Lower>().transpose().solveInPlace(next);
+      next.normalize();
+      if (next.dot(v) < 0.0) next = -next;
+      const double change = (next - v).norm();
+      v = next;
+      if (change < kSettled) {
+        if (v.dot(m * v) > kSingular * m.trace()) return v;
+        break;
+      }
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(m);
+  return eigen.eigenvectors().col(0);
+}
+
 Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
                                           const std::vector<Eigen::Vector2d>& pixels) {
   // The 3D points arrive centred and unit-scaled (scene.h); the pixels are normalized here. With
@@ -105,8 +137,7 @@ Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& po
   normal.block<4, 4>(0, 8) = normal.block<4, 4>(8, 0) = -symmetric(1);
   normal.block<4, 4>(4, 8) = normal.block<4, 4>(8, 4) = -symmetric(2);
   normal.block<4, 4>(8, 8) = symmetric(3);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(normal);
-  const Eigen::Matrix<double, 12, 1> p = eigen.eigenvectors().col(0);
+  const Eigen::Matrix<double, 12, 1> p = SmallestEigenvector(normal);
   Eigen::Matrix<double, 3, 4> pn;
   pn << p.segment<4>(0).transpose(), p.segment<4>(4).transpose(), p.segment<4>(8).transpose();
   return t_pixel.inverse() * pn;

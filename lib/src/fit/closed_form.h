@@ -29,6 +29,11 @@ struct StartCamera {
 StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels);
 
+// The unit eigenvector of the smallest eigenvalue of a symmetric positive semidefinite `m` (the
+// DLT's normal matrix), sign arbitrary: by inverse iteration where that settles and `m` is not
+// singular to rounding, else Eigen's SelfAdjointEigenSolver's (closed_form.cc says when).
+Eigen::Matrix<double, 12, 1> SmallestEigenvector(const Eigen::Matrix<double, 12, 12>& m);
+
 // The 3x4 camera matrix fitted by the normalized DLT (scale arbitrary).
 Eigen::Matrix<double, 3, 4> NormalizedDlt(const std::vector<Eigen::Vector3d>& points,
                                           const std::vector<Eigen::Vector2d>& pixels);
