@@ -13,8 +13,10 @@ void Camera::Check() const {
   cam_from_world.Check();
   Frustum{-1.0, 1.0, -1.0, 1.0, z_near, z_far}.Check();
   if (projection == Projection::kOrthographic) {
-    internal::Require(!intrinsics.HasDistortion(), "an orthographic camera has no distortion, got ",
-                      DistortionText(intrinsics));
+    if (intrinsics.HasDistortion()) {
+      internal::ThrowInvalidArgument("an orthographic camera has no distortion, got ",
+                                     DistortionText(intrinsics));
+    }
     internal::Require(std::isfinite(z_far), "an orthographic camera needs a finite far plane");
   }
   if (world_origin) internal::RequireFiniteAll(*world_origin, "world origin");

@@ -7,6 +7,7 @@
 namespace camproj {
 
 using internal::Require;
+using internal::ThrowInvalidArgument;
 using internal::RequireFinite;
 
 namespace {
@@ -24,8 +25,11 @@ void RequireNoSkewNoDistortion(const Intrinsics& intrinsics) {
   Require(intrinsics.skew == 0.0, "skew = ", intrinsics.skew,
           " has no glFrustum form (a frustum is an axis-aligned window): use the projection "
           "matrix, which carries skew");
-  Require(!intrinsics.HasDistortion(), "distortion (", DistortionText(intrinsics),
-          ") has no frustum form: use Intrinsics::Pinhole() to drop it knowingly");
+  // The message's text only when it is thrown: DistortionText formats every coefficient.
+  if (intrinsics.HasDistortion()) {
+    ThrowInvalidArgument("distortion (", DistortionText(intrinsics),
+                         ") has no frustum form: use Intrinsics::Pinhole() to drop it knowingly");
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 namespace camproj {
 
 using internal::Require;
+using internal::ThrowInvalidArgument;
 using internal::RequireFiniteAll;
 
 namespace {
@@ -90,9 +91,12 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
   size.Check();
   // Validates near and far with the frustum's messages; the frustum itself ignores skew.
   Frustum{-1.0, 1.0, -1.0, 1.0, z_near, z_far}.Check();
-  Require(!intrinsics.HasDistortion(), "distortion (", DistortionText(intrinsics),
-          ") cannot be represented by a projection matrix: pass "
-          "intrinsics.Pinhole() to drop it knowingly");
+  // The message's text only when it is thrown: DistortionText formats every coefficient.
+  if (intrinsics.HasDistortion()) {
+    ThrowInvalidArgument("distortion (", DistortionText(intrinsics),
+                         ") cannot be represented by a projection matrix: pass "
+                         "intrinsics.Pinhole() to drop it knowingly");
+  }
   // Corner convention: x_win = u_corner, y_win = H - v_corner (docs/conventions.md).
   const Intrinsics k = ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCorner);
   const double w = size.width;
@@ -127,8 +131,10 @@ Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const Im
                                           PixelOrigin origin) {
   intrinsics.Check();
   size.Check();
-  Require(!intrinsics.HasDistortion(), "an orthographic camera has no distortion, got ",
-          DistortionText(intrinsics));
+  if (intrinsics.HasDistortion()) {
+    ThrowInvalidArgument("an orthographic camera has no distortion, got ",
+                         DistortionText(intrinsics));
+  }
   Require(std::isfinite(z_near) && std::isfinite(z_far) && z_far > z_near,
           "an orthographic projection needs finite near < far, got near ", z_near, ", far ", z_far);
   // Corner convention, x_eye = x_cam, y_eye = -y_cam, z_eye = -z_cam:
