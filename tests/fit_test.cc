@@ -780,8 +780,12 @@ TEST(FitTest, NamesItsRefiner) {
 //   at most 1e-3 of their sigma, which puts each answer within 1e-3 of the covariance's sigma of
 //   the minimum in the joint (Mahalanobis) sense, hence each parameter within 1e-3 of its own
 //   sigma, and the two answers within 2e-3 sigma of each other.
+// From 20 points on the own LM's path starts with Gauss-Newton steps from the DLT (refine.cc,
+// PolishFirst::kFromClosedForm), Ceres' path does not: the bound holds for that start too, and
+// the bench's model settles there without LM in most of those fits (counted).
 TEST(FitTest, CeresRefinerFindsTheSameOptimum) {
   int compared = 0;
+  int gauss_newton_from_dlt = 0;
   for (const int n : {6, 10, 20, 100, 1000}) {
     for (int seed = 1; seed <= 6; ++seed) {
       for (const double offset_y : {0.0, 0.5}) {
@@ -820,6 +824,8 @@ TEST(FitTest, CeresRefinerFindsTheSameOptimum) {
           ++compared;
           EXPECT_EQ(b->refiner, "ceres");
           if (!with_k1) {
+            gauss_newton_from_dlt +=
+                a->termination.find("Gauss-Newton from the closed form") != std::string::npos;
             const Intrinsics& ka = a->camera.intrinsics;
             const Intrinsics& kb = b->camera.intrinsics;
             constexpr double kSameOptimum = 1e-9;
@@ -849,6 +855,8 @@ TEST(FitTest, CeresRefinerFindsTheSameOptimum) {
     }
   }
   EXPECT_GT(compared, 100);
+  // Measured: 34-36 at seed offsets 0, 7, 42, 1000; the rest settle only after LM.
+  EXPECT_GE(gauss_newton_from_dlt, 30) << "of the 36 fits of the bench's model at 20-1000 points";
 }
 
 // Regression (found at seed offset 7, literal seed 12): six points, a projector, 0.5 px noise,

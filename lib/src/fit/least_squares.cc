@@ -341,7 +341,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
-                       NormalEquations* normal) {
+                       NormalEquations* normal, bool* settled = nullptr) {
+  if (settled != nullptr) *settled = false;
   constexpr int kMaxSteps = 6;
   // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
   // their pixel-noise sigma per px of noise).
@@ -403,6 +404,7 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       *rotation = new_rotation;
       *center = new_center;
       model->value = new_intrinsics;
+      if (settled != nullptr) *settled = true;
       return true;
     }
     NormalEquations new_normal;
@@ -434,24 +436,30 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
-                                       int max_rounds, bool polish_first) {
+                                       int max_rounds, PolishFirst polish_first) {
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
   outcome.center = start_center;
   outcome.model = model;
   bool have_normal = false;
-  if (polish_first && options.refiner != Refiner::kCeres &&
+  if (polish_first != PolishFirst::kNo && options.refiner != Refiner::kCeres &&
       ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center, outcome.model,
                              &outcome.normal)) {
-    // From a start at a nested model's minimum the new minimum is usually a Gauss-Newton step
-    // or two away; where the polish does not settle (it never raises the cost), LM goes on from
-    // where it stopped.
+    // From a start at a nested model's minimum, or a closed form on many points, the minimum
+    // is usually a few Gauss-Newton steps away; where the polish does not end there (it never
+    // raises the cost), LM goes on from where it stopped.
     outcome.trace.push_back({0, MicrosecondsSince(start_time),
                              std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
-    outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                          &outcome.model, &outcome.normal);
+    bool settled = false;
+    const bool polished = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
+                                            &outcome.model, &outcome.normal, &settled);
+    outcome.converged = polish_first == PolishFirst::kFromNestedMinimum ? polished : settled;
     have_normal = true;
-    if (outcome.converged) outcome.termination = "CONVERGENCE: Gauss-Newton from a nested minimum";
+    if (outcome.converged) {
+      outcome.termination = polish_first == PolishFirst::kFromNestedMinimum
+                                ? "CONVERGENCE: Gauss-Newton from a nested minimum"
+                                : "CONVERGENCE: Gauss-Newton from the closed form";
+    }
   }
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
     have_normal = false;

@@ -48,16 +48,27 @@ struct LeastSquaresOutcome {
 // ends behind the camera or the focal length or aspect is not positive (normal is then empty if
 // the normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one
 // settling step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
-// With `polish_first` (a start at a nested model's minimum, fit/start.h WarmStart), the polish
-// runs first and LM only if it does not settle (not with Refiner::kCeres); the termination then
-// says "Gauss-Newton from a nested minimum" and no LM iteration is counted.
+// Where the Gauss-Newton polish may run before LM (not with Refiner::kCeres): LM then runs only
+// if the polish does not end at the minimum, and the termination says where it started
+// ("Gauss-Newton from a nested minimum" / "... from the closed form") when it does.
+enum class PolishFirst {
+  kNo,
+  // A start at a nested model's minimum (fit/start.h WarmStart): the new minimum is usually a
+  // step or two away; the polish's own convergence test decides.
+  kFromNestedMinimum,
+  // A closed form on many points (the DLT's start is then close): the polish must settle (a
+  // step under 1e-9 px), not only converge to the test's 1e-3 sigma, so that the answer is the
+  // one LM would reach to rounding; else LM goes on from where it stopped.
+  kFromClosedForm,
+};
+
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
                                        int max_rounds = kMaxLeastSquaresRounds,
-                                       bool polish_first = false);
+                                       PolishFirst polish_first = PolishFirst::kNo);
 
 }  // namespace internal
 }  // namespace camproj
