@@ -335,9 +335,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
 // holds the normal equations (ComputeNormalEquations) at the start on entry; on return, those
 // at the final parameters, or one settling step (under kSettledStepPx) before them. Returns
-// whether it settled: a step under kSettledStepPx, or steps that stopped shrinking at the
-// rounding floor (under kRoundingFloorPx). It does not settle where LM stopped short of the
-// minimum on a curved valley: there Gauss-Newton steps overshoot and raise the cost.
+// whether it converged: a step under kSettledStepPx (then also *settled, if given), or a last
+// step within the convergence test below (steps that stopped shrinking at the rounding floor, or
+// that raised the cost by rounding). It does not converge where LM stopped short of the minimum
+// on a curved valley: there Gauss-Newton steps overshoot and raise the cost.
 bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
