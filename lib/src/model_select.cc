@@ -593,8 +593,9 @@ FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
     // before the outlier search, which would crawl through samples that no proper camera fits
     // (or find a subset that one does).
     if (!screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
-    if (!screen.consistent && options.find_outliers) run_search();
-    if (screen.consistent && options.find_outliers) {
+    if (!screen.consistent && options.find_outliers) {
+      run_search();
+    } else if (options.find_outliers) {
       // A screen that passes may still hold a mis-click its fit absorbed (fit/outliers.h).
       internal::OutlierSearch absorbed =
           internal::FindAbsorbedOutlier(points, pixels, size, options, noise, screen);

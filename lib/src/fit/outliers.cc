@@ -228,8 +228,12 @@ OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points,
   const FitOptions& model = screen.fit->model;
   // As in the exhaustive search: the rest must keep the redundancy that convicts the point.
   if (2 * (n - 1) - NumParameters(model) < options.min_redundancy + 2) return search;
-  double all_px2 = 0.0;
-  for (const Eigen::Vector2d& r : screen.fit->fit.residuals_px) all_px2 += r.squaredNorm();
+  auto sum_of_squares_px2 = [](const FitResult& fit) {
+    double sum = 0.0;
+    for (const Eigen::Vector2d& r : fit.residuals_px) sum += r.squaredNorm();
+    return sum;
+  };
+  const double all_px2 = sum_of_squares_px2(screen.fit->fit);
   const double bound_px2 =
       noise.sigma_px * noise.sigma_px * ChiSquareQuantile(2.0, 1.0 - options.significance / n);
   // No drop exceeds the whole sum: below the bound no point can be found (clean clicks at about
@@ -240,10 +244,9 @@ OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points,
     // Scored fits: skipping a restart can only leave a higher sum for the rest, a smaller drop.
     const Screen rest = FitSubset(points, pixels, {i}, size, {model}, options, noise,
                                   /*next_only_for_planes=*/false, SubsetFit::kScored);
-    if (!rest.fit || !rest.consistent) continue;
-    double rest_px2 = 0.0;
-    for (const Eigen::Vector2d& r : rest.fit->fit.residuals_px) rest_px2 += r.squaredNorm();
-    if (all_px2 - rest_px2 > bound_px2) found.push_back(i);
+    if (rest.fit && rest.consistent && all_px2 - sum_of_squares_px2(rest.fit->fit) > bound_px2) {
+      found.push_back(i);
+    }
   }
   // Two or more: each explains the drop alone, and the points cannot say which; the caller keeps
   // every point (the gates and the determination check judge them as before).
