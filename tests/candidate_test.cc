@@ -1,6 +1,7 @@
 // The model selection's candidate fit (lib/src/fit/candidate.h) warm-started from the nested
 // model's camera (fit/start.h, WarmStart): where the scene has one minimum, the same optimum as
-// the closed-form start reaches.
+// the closed-form start reaches (to the polish's convergence test, which a scored candidate
+// stops at).
 #include "fit/candidate.h"
 
 #include <cmath>
@@ -33,6 +34,12 @@ constexpr double kSameOptimum = 1e-9;
 // With k1 free the minimum is flat along the focal-distance-k1 direction; both runs stop within
 // a small fraction of that direction's sigma (the Ceres comparison's bound, for the same reason).
 constexpr double kSameOptimumSigmas = 2e-3;
+// A warm-started candidate is only scored: its polish stops at the convergence test
+// (least_squares.h, PolishFirst::kFromNestedMinimumScored), the last step moving the residual
+// vector by at most 1e-3 of the noise, |J d| <= 1e-3 sigma. Each parameter is then within 1e-3
+// of its own sigma of the minimum (|d_i| <= sqrt((J^T J)^-1_ii) |J d|), and closer still once
+// the step is taken.
+constexpr double kScoredSigmas = 1e-3;
 // LM started at the minimum: its first step is rejected or negligible and it stops.
 constexpr int kIterationsAtTheOptimum = 1;
 // Px per axis at which a candidate may skip its restarts: the scenes' noise.
@@ -60,10 +67,11 @@ FitOptions PoseAndFocal() {
   return focal;
 }
 
-// `sigmas`: a full fit's (FitCamera) of the model, for the k1 model's bound; a candidate
-// computes none.
+// `sigmas`: a full fit's (FitCamera) of the model, for the bound in sigmas (`bound_sigmas`:
+// always with k1, and for a pinhole model where `pinhole` is false); a candidate computes none.
 void ExpectSameOptimum(const FitResult& a, const FitResult& b, bool pinhole,
-                       const std::vector<ParameterSigma>& sigmas) {
+                       const std::vector<ParameterSigma>& sigmas,
+                       double bound_sigmas = kSameOptimumSigmas) {
   const Intrinsics& ka = a.camera.intrinsics;
   const Intrinsics& kb = b.camera.intrinsics;
   const Eigen::Vector3d eye_a = CameraCenterInWorld(a.camera.cam_from_world);
@@ -80,19 +88,20 @@ void ExpectSameOptimum(const FitResult& a, const FitResult& b, bool pinhole,
               kSameOptimum);
     return;
   }
+  // Every free parameter these models have (fy only with the aspect free, k1 only with itself).
   const std::map<std::string, std::pair<double, double>> values = {
-      {"fx", {ka.fx, kb.fx}},       {"cx", {ka.cx, kb.cx}},       {"cy", {ka.cy, kb.cy}},
-      {"k1", {ka.k1, kb.k1}},       {"eye_x", {eye_a.x(), eye_b.x()}},
+      {"fx", {ka.fx, kb.fx}},       {"fy", {ka.fy, kb.fy}},       {"cx", {ka.cx, kb.cx}},
+      {"cy", {ka.cy, kb.cy}},       {"k1", {ka.k1, kb.k1}},       {"eye_x", {eye_a.x(), eye_b.x()}},
       {"eye_y", {eye_a.y(), eye_b.y()}}, {"eye_z", {eye_a.z(), eye_b.z()}}};
   int checked = 0;
   for (const ParameterSigma& s : sigmas) {
     const auto it = values.find(s.name);
     if (it == values.end()) continue;
-    EXPECT_LE(std::abs(it->second.second - it->second.first), kSameOptimumSigmas * s.sigma)
-        << s.name;
+    EXPECT_LE(std::abs(it->second.second - it->second.first), bound_sigmas * s.sigma) << s.name;
     ++checked;
   }
-  EXPECT_EQ(checked, static_cast<int>(values.size()));
+  // The focal length, the principal point and the eye at least.
+  EXPECT_GE(checked, 6);
 }
 
 // Each step of the ladder (pose + focal -> + principal point -> + aspect, and -> + k1) fitted
@@ -132,11 +141,10 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
                                                         *step.model, kNoisePx, {&nested.camera});
           EXPECT_EQ(warm.start_method, "warm");
           EXPECT_NE(cold.start_method, "warm");
-          std::vector<ParameterSigma> sigmas;
-          if (!step.pinhole) {
-            sigmas = FitCamera(points, pixels, scene.truth.image_size, *step.model).sigmas;
-          }
-          ExpectSameOptimum(cold, warm, step.pinhole, sigmas);
+          const std::vector<ParameterSigma> sigmas =
+              FitCamera(points, pixels, scene.truth.image_size, *step.model).sigmas;
+          ExpectSameOptimum(cold, warm, /*pinhole=*/false, sigmas,
+                            step.pinhole ? kScoredSigmas : kSameOptimumSigmas);
           // Started at its own optimum, a model stays there: the start is the camera given
           // (pose and intrinsics in the scene's normalized frame), not merely near it.
           const FitResult again = internal::FitCandidate(points, pixels, scene.truth.image_size,

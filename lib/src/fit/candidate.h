@@ -21,7 +21,12 @@
 // (tests/candidate_test.cc); where it has several, the nested model's minimum is the one the
 // ladder asks about: whether freeing the group pays at this camera. A warm start goes straight
 // to the Gauss-Newton polish (least_squares.h): from the nested minimum the new one is usually a
-// step or two away, and Levenberg-Marquardt runs only where the polish does not settle. The
+// step or two away, and Levenberg-Marquardt runs only where the polish does not converge. The
+// polish stops at its convergence test (PolishFirst::kFromNestedMinimumScored: the last step
+// under 1e-3 of the noise), not when a step settles under 1e-9 px: the sum of squares is then
+// within ~1e-6 sigma^2 of the minimum's, and the pass over the points that would confirm it is
+// saved (the default path 1 / 3 / 4 / 6 / 7 / 8 % cheaper at 6 / 8 / 12 / 20 / 100 / 1000
+// points, bench --stage-cost; the click benchmark's outcomes unchanged). The
 // chosen model is refitted with everything computed and its restarts: from scratch below 20
 // points unless it is the screen's model (whose fit from scratch the ladder holds), else from
 // the ladder's camera (FitReusing; selection.cc says why).

@@ -342,7 +342,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
-                       NormalEquations* normal, bool* settled = nullptr) {
+                       NormalEquations* normal, bool* settled = nullptr,
+                       bool stop_when_converged = false) {
   if (settled != nullptr) *settled = false;
   constexpr int kMaxSteps = 6;
   // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
@@ -398,14 +399,15 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
     // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
     last_step_px = std::sqrt(std::max(0.0, delta.dot(normal->jtj * delta)));
-    if (step_px <= kSettledStepPx) {
+    // With stop_when_converged, a step within the convergence test is the last as well.
+    if (step_px <= kSettledStepPx || (stop_when_converged && converged())) {
       // The last step: take it without another pass over the points. The normal equations stay
       // those one step back, where J^T J differs by ~1e-12 relative (the step's size against
       // the parameters' scales) and the cost by far less than its own rounding.
       *rotation = new_rotation;
       *center = new_center;
       model->value = new_intrinsics;
-      if (settled != nullptr) *settled = true;
+      if (settled != nullptr) *settled = step_px <= kSettledStepPx;
       return true;
     }
     NormalEquations new_normal;
@@ -452,14 +454,15 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     outcome.trace.push_back({0, MicrosecondsSince(start_time),
                              std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
     bool settled = false;
+    const bool scored = polish_first == PolishFirst::kFromNestedMinimumScored;
     const bool polished = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                            &outcome.model, &outcome.normal, &settled);
-    outcome.converged = polish_first == PolishFirst::kFromNestedMinimum ? polished : settled;
+                                            &outcome.model, &outcome.normal, &settled, scored);
+    outcome.converged = polish_first == PolishFirst::kFromClosedForm ? settled : polished;
     have_normal = true;
     if (outcome.converged) {
-      outcome.termination = polish_first == PolishFirst::kFromNestedMinimum
-                                ? "CONVERGENCE: Gauss-Newton from a nested minimum"
-                                : "CONVERGENCE: Gauss-Newton from the closed form";
+      outcome.termination = polish_first == PolishFirst::kFromClosedForm
+                                ? "CONVERGENCE: Gauss-Newton from the closed form"
+                                : "CONVERGENCE: Gauss-Newton from a nested minimum";
     }
   }
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {

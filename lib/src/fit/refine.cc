@@ -62,9 +62,12 @@ bool UnlikeAnyLens(const Model& model, const ImageSize& size) {
 // that LM's first iterations only repeat what Gauss-Newton does in fewer passes over the points
 // (15 % fewer instructions for one fit at 20-100 points; bench --stage-cost --one-fit). Below
 // that the DLT's start can be far off (the second start from the image centre is for that), and
-// LM's damping keeps the first steps in its basin.
-PolishFirst FirstSteps(const Start& start, const Scene& scene) {
-  if (start.method == "warm") return PolishFirst::kFromNestedMinimum;
+// LM's damping keeps the first steps in its basin. A warm start that is only scored (a fit not
+// described: a model selection's candidate) stops at the polish's convergence test.
+PolishFirst FirstSteps(const Start& start, const Scene& scene, const FitEffort& effort) {
+  if (start.method == "warm") {
+    return effort.describe ? PolishFirst::kFromNestedMinimum : PolishFirst::kFromNestedMinimumScored;
+  }
   if (start.method == "dlt" && scene.NumPoints() >= kSecondStartBelowPoints) {
     return PolishFirst::kFromClosedForm;
   }
@@ -96,7 +99,7 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
                                      Clock::time_point start_time) {
   LeastSquaresOutcome best = RefineLeastSquares(
       scene.points, scene.pixels, start.camera.rotation, start.camera.center, start.model, options,
-      start_time, kMaxLeastSquaresRounds, FirstSteps(start, scene));
+      start_time, kMaxLeastSquaresRounds, FirstSteps(start, scene, effort));
   if (start.method == "dlt" && scene.NumPoints() < kSecondStartBelowPoints &&
       scene.model.free[2] && MayBeAboveTheMinimum(best, scene, effort)) {
     // With few points the DLT's principal point can be far off and LM stop in a local minimum
