@@ -21,12 +21,13 @@
 // (tests/candidate_test.cc); where it has several, the nested model's minimum is the one the
 // ladder asks about: whether freeing the group pays at this camera. A warm start goes straight
 // to the Gauss-Newton polish (least_squares.h): from the nested minimum the new one is usually a
-// step or two away, and Levenberg-Marquardt runs only where the polish does not converge. The
-// polish stops at its convergence test (PolishFirst::kFromNestedMinimumScored: the last step
-// under 1e-3 of the noise), not when a step settles under 1e-9 px: the sum of squares is then
-// within ~1e-6 sigma^2 of the minimum's, and the pass over the points that would confirm it is
-// saved (the default path 1 / 3 / 4 / 6 / 7 / 8 % cheaper at 6 / 8 / 12 / 20 / 100 / 1000
-// points, bench --stage-cost; the click benchmark's outcomes unchanged). The
+// step or two away, and Levenberg-Marquardt runs only where the polish does not converge.
+// Every refinement of a candidate, from any start, stops at the polish's convergence test
+// (least_squares.h, PolishUntil::kConverged: the last step under 1e-3 of the noise), not when a
+// step settles under 1e-9 px: its sum of squares is then within ~1e-6 sigma^2 of the minimum's,
+// and the passes over the points that would confirm it are saved (the default path 3 / 7 / 9 /
+// 16 / 16 / 17 % cheaper at 6 / 8 / 12 / 20 / 100 / 1000 points, bench --stage-cost; on the
+// click benchmark the same answers, 3 of 6600 refusals' reasons changed). The
 // chosen model is refitted with everything computed and its restarts: from scratch below 20
 // points unless it is the screen's model (whose fit from scratch the ladder holds), else from
 // the ladder's camera (FitReusing; selection.cc says why).

@@ -439,7 +439,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Matrix3d& start_rotation,
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
-                                       int max_rounds, PolishFirst polish_first) {
+                                       int max_rounds, PolishFirst polish_first,
+                                       PolishUntil until) {
+  const bool scored = until == PolishUntil::kConverged;
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
   outcome.center = start_center;
@@ -454,10 +456,10 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     outcome.trace.push_back({0, MicrosecondsSince(start_time),
                              std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
     bool settled = false;
-    const bool scored = polish_first == PolishFirst::kFromNestedMinimumScored;
     const bool polished = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
                                             &outcome.model, &outcome.normal, &settled, scored);
-    outcome.converged = polish_first == PolishFirst::kFromClosedForm ? settled : polished;
+    outcome.converged =
+        polish_first == PolishFirst::kFromClosedForm && !scored ? settled : polished;
     have_normal = true;
     if (outcome.converged) {
       outcome.termination = polish_first == PolishFirst::kFromClosedForm
@@ -498,7 +500,7 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     }
     if (!have_normal) break;
     outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                          &outcome.model, &outcome.normal);
+                                          &outcome.model, &outcome.normal, nullptr, scored);
   }
   if (!have_normal) outcome.normal = NormalEquations();
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned

@@ -56,18 +56,20 @@ enum class PolishFirst {
   // A start at a nested model's minimum (fit/start.h WarmStart): the new minimum is usually a
   // step or two away; the polish's own convergence test decides.
   kFromNestedMinimum,
-  // The same for a fit that is only scored (a model selection's candidate, fit/candidate.h):
-  // the polish stops at its convergence test's first pass (the last step under 1e-3 of the
-  // residuals' sigma, |J delta|) rather than going on until a step settles under 1e-9 px. The
-  // step is taken, so the camera is then closer than that: its sum of squares exceeds the
-  // minimum's by about |J delta|^2 of the step after it, under 1e-6 sigma^2 (quadratic
-  // convergence), far below any criterion difference the selection reads.
-  kFromNestedMinimumScored,
-  // A closed form on many points (the DLT's start is then close): the polish must settle (a
-  // step under 1e-9 px), not only converge to the test's 1e-3 sigma, so that the answer is the
-  // one LM would reach to rounding; else LM goes on from where it stopped.
+  // A closed form on many points (the DLT's start is then close): for a camera returned
+  // (PolishUntil::kSettled) the polish must settle (a step under 1e-9 px), not only converge to
+  // the test's 1e-3 sigma, so that the answer is the one LM would reach to rounding; else LM
+  // goes on from where it stopped.
   kFromClosedForm,
 };
+
+// How far the polish goes. A camera only scored (its cost, or a rival's camera: a model
+// selection's candidate, fit/candidate.h; a mirrored reading) needs it only to the polish's
+// convergence test, the last step under 1e-3 of the residuals' sigma (|J delta|): the step is
+// taken, so the sum of squares then exceeds the minimum's by about |J delta|^2 of the step after
+// it, under 1e-6 sigma^2 (quadratic convergence), far below any criterion difference read. A
+// camera returned goes on until a step settles under 1e-9 px, saving no pass over the points.
+enum class PolishUntil { kSettled, kConverged };
 
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,
@@ -75,7 +77,8 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
                                        int max_rounds = kMaxLeastSquaresRounds,
-                                       PolishFirst polish_first = PolishFirst::kNo);
+                                       PolishFirst polish_first = PolishFirst::kNo,
+                                       PolishUntil until = PolishUntil::kSettled);
 
 }  // namespace internal
 }  // namespace camproj

@@ -38,11 +38,12 @@ void KeepTheLower(LeastSquaresOutcome other, LeastSquaresOutcome* best) {
 // Refines from `model` (its free values the start) with an SQPnP pose for its pinhole part,
 // and makes it `*best` if it ends at a lower cost.
 void RefineAlsoFrom(const Scene& scene, const Model& model, const FitOptions& options,
-                    Clock::time_point start_time, LeastSquaresOutcome* best) {
+                    Clock::time_point start_time, PolishUntil until, LeastSquaresOutcome* best) {
   StartCamera start;
   if (!PnpStart(scene.points, scene.pixels, model.ToIntrinsics(), &start)) return;
   KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, start.rotation, start.center, model,
-                                  options, start_time),
+                                  options, start_time, kMaxLeastSquaresRounds, PolishFirst::kNo,
+                                  until),
                best);
 }
 
@@ -62,12 +63,9 @@ bool UnlikeAnyLens(const Model& model, const ImageSize& size) {
 // that LM's first iterations only repeat what Gauss-Newton does in fewer passes over the points
 // (15 % fewer instructions for one fit at 20-100 points; bench --stage-cost --one-fit). Below
 // that the DLT's start can be far off (the second start from the image centre is for that), and
-// LM's damping keeps the first steps in its basin. A warm start that is only scored (a fit not
-// described: a model selection's candidate) stops at the polish's convergence test.
-PolishFirst FirstSteps(const Start& start, const Scene& scene, const FitEffort& effort) {
-  if (start.method == "warm") {
-    return effort.describe ? PolishFirst::kFromNestedMinimum : PolishFirst::kFromNestedMinimumScored;
-  }
+// LM's damping keeps the first steps in its basin.
+PolishFirst FirstSteps(const Start& start, const Scene& scene) {
+  if (start.method == "warm") return PolishFirst::kFromNestedMinimum;
   if (start.method == "dlt" && scene.NumPoints() >= kSecondStartBelowPoints) {
     return PolishFirst::kFromClosedForm;
   }
@@ -97,9 +95,11 @@ bool MayBeAboveTheMinimum(const LeastSquaresOutcome& outcome, const Scene& scene
 LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
                                      const FitOptions& options, const FitEffort& effort,
                                      Clock::time_point start_time) {
+  // A fit not described (a model selection's candidate) is only scored.
+  const PolishUntil until = effort.describe ? PolishUntil::kSettled : PolishUntil::kConverged;
   LeastSquaresOutcome best = RefineLeastSquares(
       scene.points, scene.pixels, start.camera.rotation, start.camera.center, start.model, options,
-      start_time, kMaxLeastSquaresRounds, FirstSteps(start, scene, effort));
+      start_time, kMaxLeastSquaresRounds, FirstSteps(start, scene), until);
   if (start.method == "dlt" && scene.NumPoints() < kSecondStartBelowPoints &&
       scene.model.free[2] && MayBeAboveTheMinimum(best, scene, effort)) {
     // With few points the DLT's principal point can be far off and LM stop in a local minimum
@@ -111,7 +111,7 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
     Model centred = start.model;
     centred.value[2] = scene.model.value[2];
     centred.value[3] = scene.model.value[3];
-    RefineAlsoFrom(scene, centred, options, start_time, &best);
+    RefineAlsoFrom(scene, centred, options, start_time, until, &best);
   }
   // With few points the sweep's RMS over the focal length can have several valleys (seen: 4
   // noise-free points fitted at fx 3292 px, RMS 0.19 px, for a true 1220 px; tests/fit_test.cc
@@ -120,7 +120,7 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
     for (const StartCamera& other : valleys) {
       KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, other.rotation, other.center,
                                       ProjectOntoModel(start.model, other.intrinsics), options,
-                                      start_time),
+                                      start_time, kMaxLeastSquaresRounds, PolishFirst::kNo, until),
                    &best);
     }
   };
@@ -167,7 +167,7 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
       model.value[3] = principal_point.y();
       if (model.free[5]) model.value[5] = 0.0;
       if (model.free[6]) model.value[6] = 0.0;
-      RefineAlsoFrom(scene, model, options, start_time, &best);
+      RefineAlsoFrom(scene, model, options, start_time, until, &best);
     }
   }
   return best;
