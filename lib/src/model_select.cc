@@ -542,7 +542,7 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
                          const std::optional<SceneError>& refusal, const std::string& problem,
                          const internal::Screen& screen, const std::vector<int>& left_out,
                          const std::optional<internal::OutlierSearch>& search) {
-  // A failed screen was diagnosed before the outlier search (RunPipeline).
+  // A failed screen was diagnosed before the outlier search (Pipeline).
   if (screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
   if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
   std::string text =
@@ -560,124 +560,154 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
                                     : "; if your points are this noisy, give --sigma PX"));
 }
 
-FitResult RunPipeline(const std::vector<Eigen::Vector3d>& points,
-                      const std::vector<Eigen::Vector2d>& pixels, const ImageSize& size,
-                      const AutoFitOptions& options, Clock::time_point start) {
-  std::vector<std::string> made_names;
-  const std::vector<std::string>& names = NamesOf(options, points.size(), &made_names);
-  const internal::NoiseReference noise = internal::NoiseReferenceOf(options);
-  std::vector<int> left_out;
-  std::string method;
-  std::optional<Gated> gated;
-  if (options.fit.ransac) {
-    gated = ForcedRansac(points, pixels, size, options, noise, &left_out);
-    method = "ransac";
-  } else {
-    // Screen every point with the simplest model that can show a mis-click; if it fails, the
-    // outlier stage looks for the points to leave out. Then the model selection on the rest,
-    // and its gate; a clean screen whose selection still fails the gate gets the search too.
-    const internal::Screen screen = internal::ScreenPoints(points, pixels, size, options, noise);
+// The default path's stages over the state they share: the screen of every point, the outlier
+// search, the selection on the points kept with its gate, and the refusal where none passes.
+class Pipeline {
+ public:
+  Pipeline(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& pixels,
+           const ImageSize& size, const AutoFitOptions& options)
+      : points_(points), pixels_(pixels), size_(size), options_(options),
+        names_(NamesOf(options, points.size(), &made_names_)),
+        noise_(internal::NoiseReferenceOf(options)) {}
+
+  FitResult Run(Clock::time_point start) {
+    if (options_.fit.ransac) {
+      gated_ = ForcedRansac(points_, pixels_, size_, options_, noise_, &left_out_);
+      method_ = "ransac";
+    } else {
+      SelectAfterTheScreen();
+    }
+    FitResult result =
+        Assess(std::move(*gated_), left_out_, method_, points_, pixels_, size_, options_, names_);
+    result.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    return result;
+  }
+
+ private:
+  // Screens every point with the simplest model that can show a mis-click; if it fails, the
+  // outlier stage looks for the points to leave out. Then the model selection on the rest, and
+  // its gate; a clean screen whose selection still fails the gate gets the search too. Leaves
+  // gated_ set, or throws the refusal.
+  void SelectAfterTheScreen() {
+    screen_ = internal::ScreenPoints(points_, pixels_, size_, options_, noise_);
     // A refusal of every point that no choice of points should change is the answer: leaving
     // points out could only find a subset that escapes it (coordinates whose offset leaves too
     // few digits pass the check once a point with a far pixel is dropped).
-    if (screen.refusal && Final(screen.refusal->reason())) throw *screen.refusal;
-    std::optional<internal::OutlierSearch> search;
-    auto run_search = [&] {
-      search = internal::FindOutliers(points, pixels, size, options, noise, names);
-      if (search->found) {
-        left_out = search->outliers;
-        method = search->method;
-      }
-    };
+    if (screen_->refusal && Final(screen_->refusal->reason())) throw *screen_->refusal;
     // A failed screen that the mirrored world passes is a mirror, not outliers: refuse it
     // before the outlier search, which would crawl through samples that no proper camera fits
     // (or find a subset that one does).
-    if (!screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
-    if (!screen.consistent && options.find_outliers) {
-      run_search();
-    } else if (options.find_outliers) {
+    if (!screen_->consistent) MirrorDiagnosis(points_, pixels_, size_, options_, noise_);
+    if (!screen_->consistent && options_.find_outliers) {
+      SearchOutliers();
+    } else if (options_.find_outliers) {
       // A screen that passes may still hold a mis-click its fit absorbed (fit/outliers.h).
       internal::OutlierSearch absorbed =
-          internal::FindAbsorbedOutlier(points, pixels, size, options, noise, screen);
+          internal::FindAbsorbedOutlier(points_, pixels_, size_, options_, noise_, *screen_);
       if (absorbed.found) {
-        left_out = absorbed.outliers;
-        method = absorbed.method;
-        search = std::move(absorbed);
+        left_out_ = absorbed.outliers;
+        method_ = absorbed.method;
+        search_ = std::move(absorbed);
       }
     }
-    std::optional<SceneError> refusal;
-    std::string problem;
-    // The options as the selection reads them, without the names (which `names` holds): each
-    // selection below copies them, and the names are as many as the points.
-    AutoFitOptions unnamed = options;
-    std::vector<std::string>().swap(unnamed.point_names);
-    std::optional<Gated> failed_gate;  // the last selection whose gate failed
-    auto select = [&] {
-      refusal.reset();
-      gated.reset();
-      failed_gate.reset();
-      // After a failed screen that no outliers explain, a richer model must leave N equations
-      // to spare (model_select.h, min_redundancy).
-      AutoFitOptions guarded = unnamed;
-      if (!screen.consistent && left_out.empty()) {
-        guarded.min_redundancy = std::max(options.min_redundancy, static_cast<int>(points.size()));
-      }
-      try {
-        gated = SelectOn(points, pixels, left_out, size, guarded, noise, &screen);
-      } catch (const SceneError& e) {
-        if (Final(e.reason())) throw;
-        refusal = e;
-        return;
-      }
-      if (!gated->check.passed) {
-        problem = "the best camera for " +
-                  (left_out.empty() ? "all " + std::to_string(points.size()) + " points"
-                                    : "the " + std::to_string(points.size() - left_out.size()) +
-                                          " points kept") +
-                  " (" + gated->selection.fit.model + ", rms " + Px(gated->check.rms_px) +
-                  ") does not explain them: " + gated->check.summary + "; largest residuals " +
-                  WorstPoints(gated->residuals_px, left_out, names);
-        failed_gate = std::move(gated);
-        gated.reset();
-      }
-    };
-    select();
-    if (!gated && left_out.empty() && options.find_outliers && !search) {
-      run_search();
-      if (!left_out.empty()) select();
+    // The options as the selection reads them, without the names (which names_ holds): each
+    // selection copies them, and the names are as many as the points.
+    unnamed_ = options_;
+    std::vector<std::string>().swap(unnamed_.point_names);
+    Select();
+    if (!gated_ && left_out_.empty() && options_.find_outliers && !search_) {
+      SearchOutliers();
+      if (!left_out_.empty()) Select();
     }
-    if ((gated || failed_gate) && method == "lo-ransac") {
-      // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at
-      // the noise the inliers show, and select once more if it changed. Also where the gate
-      // failed on the consensus: a random pixel that lands within RANSAC's threshold of its
-      // point's projection but beyond the gate's bound for the rest (seen: 5.4 px against 4.8
-      // px among 91 kept points, 3 of 6000 scenes of FitAutoTest.OutliersAreLeftOutWithoutOptions'
-      // kind) is the outlier the gate names.
-      const Gated& read = gated ? *gated : *failed_gate;
-      const std::vector<int> reread =
-          internal::OutliersAgainst(read.residuals_px, read.check, noise, options);
-      if (reread != left_out && 2 * (points.size() - reread.size()) > points.size() / 2) {
-        const std::vector<int> before = left_out;
-        std::optional<Gated> kept = std::move(gated);
-        const std::optional<SceneError> kept_refusal = refusal;
-        const std::string kept_problem = problem;
-        left_out = reread;
-        select();
-        if (!gated) {
-          left_out = before;
-          gated = std::move(kept);
-          refusal = kept_refusal;
-          problem = kept_problem;
-        }
-      }
+    if ((gated_ || failed_gate_) && method_ == "lo-ransac") RereadTheConsensus();
+    if (!gated_) {
+      Refuse(points_, pixels_, size_, options_, noise_, refusal_, problem_, *screen_, left_out_,
+             search_);
     }
-    if (!gated) Refuse(points, pixels, size, options, noise, refusal, problem, screen, left_out, search);
   }
-  FitResult result =
-      Assess(std::move(*gated), left_out, method, points, pixels, size, options, names);
-  result.time_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  return result;
-}
+
+  void SearchOutliers() {
+    search_ = internal::FindOutliers(points_, pixels_, size_, options_, noise_, names_);
+    if (search_->found) {
+      left_out_ = search_->outliers;
+      method_ = search_->method;
+    }
+  }
+
+  // The selection on the points not left out: gated_ where its gate passes, else failed_gate_
+  // and problem_ (what the gate found), or refusal_ where the selection refused.
+  void Select() {
+    refusal_.reset();
+    gated_.reset();
+    failed_gate_.reset();
+    // After a failed screen that no outliers explain, a richer model must leave N equations
+    // to spare (model_select.h, min_redundancy).
+    AutoFitOptions guarded = unnamed_;
+    if (!screen_->consistent && left_out_.empty()) {
+      guarded.min_redundancy = std::max(options_.min_redundancy, static_cast<int>(points_.size()));
+    }
+    try {
+      gated_ = SelectOn(points_, pixels_, left_out_, size_, guarded, noise_, &*screen_);
+    } catch (const SceneError& e) {
+      if (Final(e.reason())) throw;
+      refusal_ = e;
+      return;
+    }
+    if (!gated_->check.passed) {
+      problem_ = "the best camera for " +
+                 (left_out_.empty() ? "all " + std::to_string(points_.size()) + " points"
+                                    : "the " + std::to_string(points_.size() - left_out_.size()) +
+                                          " points kept") +
+                 " (" + gated_->selection.fit.model + ", rms " + Px(gated_->check.rms_px) +
+                 ") does not explain them: " + gated_->check.summary + "; largest residuals " +
+                 WorstPoints(gated_->residuals_px, left_out_, names_);
+      failed_gate_ = std::move(gated_);
+      gated_.reset();
+    }
+  }
+
+  // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at the
+  // noise the inliers show, and select once more if it changed. Also where the gate failed on
+  // the consensus: a random pixel that lands within RANSAC's threshold of its point's
+  // projection but beyond the gate's bound for the rest (seen: 5.4 px against 4.8 px among 91
+  // kept points, 3 of 6000 scenes of FitAutoTest.OutliersAreLeftOutWithoutOptions' kind) is the
+  // outlier the gate names. The selection before stays where the new one fails.
+  void RereadTheConsensus() {
+    const Gated& read = gated_ ? *gated_ : *failed_gate_;
+    const std::vector<int> reread =
+        internal::OutliersAgainst(read.residuals_px, read.check, noise_, options_);
+    if (reread == left_out_ || 2 * (points_.size() - reread.size()) <= points_.size() / 2) return;
+    const std::vector<int> before = left_out_;
+    std::optional<Gated> kept = std::move(gated_);
+    const std::optional<SceneError> kept_refusal = refusal_;
+    const std::string kept_problem = problem_;
+    left_out_ = reread;
+    Select();
+    if (!gated_) {
+      left_out_ = before;
+      gated_ = std::move(kept);
+      refusal_ = kept_refusal;
+      problem_ = kept_problem;
+    }
+  }
+
+  const std::vector<Eigen::Vector3d>& points_;
+  const std::vector<Eigen::Vector2d>& pixels_;
+  const ImageSize& size_;
+  const AutoFitOptions& options_;
+  std::vector<std::string> made_names_;  // where options_ names no point (NamesOf)
+  const std::vector<std::string>& names_;
+  const internal::NoiseReference noise_;
+  AutoFitOptions unnamed_;
+  std::optional<internal::Screen> screen_;
+  std::vector<int> left_out_;
+  std::string method_;  // how left_out_ was found
+  std::optional<internal::OutlierSearch> search_;
+  std::optional<Gated> gated_;        // the selection whose gate passed
+  std::optional<Gated> failed_gate_;  // the last selection whose gate failed, and why:
+  std::string problem_;
+  std::optional<SceneError> refusal_;  // the last selection's refusal
+};
 
 // A camera whose GL matrices overflow a double (a world scaled by 2^600) could not be written
 // or exported (RequireFiniteViews): refused as too large, with the advice to change units.
@@ -731,7 +761,7 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
           "got ", options.point_names.size(), " point names for ", points_in_world.size(),
           " points");
   try {
-    FitResult result = RunPipeline(points_in_world, observed_pixels, image_size, options, start);
+    FitResult result = Pipeline(points_in_world, observed_pixels, image_size, options).Run(start);
     RequireRepresentableCamera(result.camera);
     return result;
   } catch (const SceneError&) {
