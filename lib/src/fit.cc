@@ -1,6 +1,7 @@
 #include "camproj/fit.h"
 
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -138,9 +139,9 @@ namespace internal {
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px, const CandidateReuse& reuse) {
-  Require(std::isfinite(consistent_at_px) && consistent_at_px > 0.0,
-          "a candidate's noise must be positive (px), got ", consistent_at_px);
+                       std::optional<double> consistent_at_px, const CandidateReuse& reuse) {
+  Require(!consistent_at_px || (std::isfinite(*consistent_at_px) && *consistent_at_px > 0.0),
+          "a candidate's noise must be positive (px), got ", consistent_at_px.value_or(0.0));
   FitEffort effort;
   effort.warm_start = reuse.warm_start;
   effort.geometry = reuse.geometry;

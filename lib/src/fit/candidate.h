@@ -34,6 +34,7 @@
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -54,18 +55,18 @@ struct CandidateReuse {
 };
 
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`
-// (> 0, px per axis), FitResult::linearity, ::views and the covariance not computed, and what
+// (> 0, px per axis; nullopt: never skipped, for a fit the selection may refit its answer from,
+// the screen's), FitResult::linearity, ::views and the covariance not computed, and what
 // `reuse` holds reused.
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
-                       double consistent_at_px, const CandidateReuse& reuse = {});
+                       std::optional<double> consistent_at_px, const CandidateReuse& reuse = {});
 
 // As FitCamera (fit.h), everything computed, restarts included, but started and prepared as
 // `reuse` says: the model selection's chosen model refitted with its covariance, from the
-// ladder's fit of it or (warm_start null) from its closed form; the screen's fit (fit/outliers.h)
-// on the points it prepares for the selection. FitResult::start_method is "warm" where
-// reuse.warm_start is not null.
+// ladder's fit of it or (warm_start null) from its closed form. FitResult::start_method is
+// "warm" where reuse.warm_start is not null.
 FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options,
