@@ -121,6 +121,9 @@ struct AutoFitOptions {
 // plus FitResult::model, ::candidates (every model tried, in order) and, in fixed_parameters,
 // every candidate left out with the reason ("left out: BIC 2.15 above pose+focal's: its better
 // fit does not pay for its extra parameters"). Throws like FitCamera when even the simplest model is refused.
+// A candidate's RMS and criterion are its fit's where the Gauss-Newton polish passes its
+// convergence test (the sum of squares within ~1e-6 sigma^2 of its minimum's); the chosen
+// model's own fit polishes on until a step settles under 1e-9 px, as FitCamera's.
 //
 // This is what `camproj fit` runs, as a pipeline: a screen of every point with pose + focal +
 // principal point (gated) -> if it fails, the outlier stage -> model selection on the points
