@@ -613,7 +613,9 @@ TEST(FitAutoTest, AMisclickThatOnlyTheAssumedNoiseShowsIsLookedFor) {
   };
   const EmbeddedScene scene = Embed(clicks, vertices);
   const std::optional<SceneError> refusal = RefusalOf(scene);
-  if (refusal) EXPECT_EQ(refusal->reason(), SceneError::Reason::kContaminated) << refusal->what();
+  if (refusal) {
+    EXPECT_EQ(refusal->reason(), SceneError::Reason::kContaminated) << refusal->what();
+  }
   AutoFitOptions screened_as_gated;
   screened_as_gated.screen_noise_tolerance = screened_as_gated.noise_tolerance;
   const FitResult absorbed = Auto(scene.points, scene.pixels, screened_as_gated);
