@@ -64,7 +64,7 @@ enum class PolishFirst {
 };
 
 // How far the polish goes. A camera only scored (its cost, or a rival's camera: a model
-// selection's candidate, fit/candidate.h; a mirrored reading) needs it only to the polish's
+// selection's candidate, fit/candidate.h) needs it only to the polish's
 // convergence test, the last step under 1e-3 of the residuals' sigma (|J delta|): the step is
 // taken, so the sum of squares then exceeds the minimum's by about |J delta|^2 of the step after
 // it, under 1e-6 sigma^2 (quadratic convergence), far below any criterion difference read. A
