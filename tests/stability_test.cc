@@ -670,8 +670,11 @@ Row RunNoisyDraws(const Case& c, const std::function<Scenario()>& make, double s
   EXPECT_LE(curved, expect.max_curved)
       << c.label << ": reported curved in " << curved << " of " << kNoisyDraws
       << " draws (worst deviation " << worst_deviation << ")";
-  EXPECT_GE(curved, expect.min_curved)
-      << c.label << ": reported curved in only " << curved << " of " << kNoisyDraws << " draws";
+  // A refused draw is no "linear" report: min_curved counts it with the curved ones (the
+  // refusals have their own rate above).
+  EXPECT_GE(curved + refused, expect.min_curved)
+      << c.label << ": reported curved in only " << curved << " of " << kNoisyDraws
+      << " draws (" << refused << " refused)";
   // The draws' failure chances differ (each its own deviation): the count of failures is
   // Poisson-binomial, whose upper tail beyond the mean is at most the binomial's with the mean
   // chance (Hoeffding 1956), so the bound uses the mean.
@@ -1143,8 +1146,11 @@ std::vector<Case> AllCases() {
       [] {
         NoisyExpectation e;
         e.min_curved = kNoisyDraws - 2;  // 819 of 819 fitted draws curved at offsets 0-40
+        // Per draw; the draws of one seed offset share its object (Synth(11) shifts with the
+        // offset), and some objects refuse more: at offsets 0-400, 55 of 8020 draws, 28 offsets
+        // with any, at most 5 of 20 at one (offset 123), within the bound at this rate.
         e.refusal_rate = 0.01;
-        e.why = "1 of 820 draws refused short of the minimum at seed offsets 0-40";
+        e.why = "55 of 8020 draws refused short of the minimum at seed offsets 0-400";
         return e;
       }()));
   cases.push_back(FittedNoisy(
