@@ -150,67 +150,6 @@ TEST(ModelSelectTest, KeepsRadialDistortionWhenTheLensHasIt) {
   }
 }
 
-// The score test (selection.cc, ScoreOrFit): on a projector with lens shift (the principal point
-// at the bottom edge) seen at 30-100 points, sigma 0.5 px, the ladder keeps the principal point
-// (and, as BIC does by chance, sometimes a null group) and scores the groups that cannot pay for
-// themselves (aspect, skew, k1 at the truth's 0) by one Gauss-Newton step from its minimum
-// instead of fitting them. A scored candidate's criterion is
-// its step's, an upper bound on its fit's (FitCamera, the same model at the selection's noise)
-// by at most the selection's kScoreMargin (its condition to skip: the fit could not have paid
-// either; CandidateTest.AScoredCandidateIsOneGaussNewtonStepTowardItsFit bounds the gap), and
-// never below it by more than the fits' rounding and convergence (1e-6 in criterion units).
-TEST(ModelSelectTest, GroupsThatCannotPayAreScoredByOneGaussNewtonStep) {
-  constexpr double kScoreMargin = 1.0;
-  constexpr double kConvergence = 1e-6;
-  int scored = 0;
-  int scenes = 0;
-  for (const int n : {30, 100}) {
-    for (uint64_t seed = 1; seed <= 10; ++seed) {
-      SCOPED_TRACE(::testing::Message() << "N " << n << " seed " << seed);
-      const SynthScene scene = Projector(seed, n, 0.5, 0.5);
-      const FitResult fit = Auto(scene);
-      ++scenes;
-      double chosen = 0.0;
-      for (const ModelCandidate& c : fit.candidates) {
-        if (c.verdict == "chosen") chosen = c.criterion;
-      }
-      for (const ModelCandidate& c : fit.candidates) {
-        if (!c.scored) continue;
-        SCOPED_TRACE(c.name);
-        ++scored;
-        EXPECT_TRUE(c.fitted);
-        EXPECT_NE(c.verdict.find("scored by one Gauss-Newton step"), std::string::npos);
-        EXPECT_GE(c.criterion, chosen + kScoreMargin);
-        // The candidate fitted: pose + focal and the groups its name lists.
-        FitOptions model;
-        auto mode = [&](const char* group) {
-          return c.name.find(group) != std::string::npos ? ParameterMode::Free()
-                                                         : ParameterMode::Default();
-        };
-        model.principal_point = mode("principal-point");
-        model.aspect = mode("aspect");
-        model.skew = mode("skew");
-        model.k1 = mode("k1");
-        model.k2 = mode("k2");
-        model.pixel_sigma = fit.selection_sigma_px;
-        const FitResult full = FitCamera(scene.correspondences.points_in_world,
-                                         scene.correspondences.pixels, scene.truth.image_size,
-                                         model);
-        ASSERT_EQ(full.model, c.name);
-        const double sum_squares = full.rms_px * full.rms_px * n;
-        const double criterion =
-            sum_squares / (fit.selection_sigma_px * fit.selection_sigma_px) +
-            std::log(2.0 * n) * static_cast<double>(full.free_parameters.size());
-        EXPECT_GE(c.criterion, criterion - kConvergence);
-        EXPECT_LE(c.criterion, criterion + kScoreMargin);
-      }
-    }
-  }
-  // Two groups at least in every scene: those the last rung tried (aspect, skew and k1 after
-  // the principal point).
-  EXPECT_GE(scored, 2 * scenes);
-}
-
 // One view of a plane cannot determine the principal point with the focal length: it is left
 // out as not determined (the fit with it is refused), never fitted.
 TEST(ModelSelectTest, PlaneLeavesOutWhatItCannotDetermine) {

@@ -11,7 +11,6 @@
 #include "fit/assess.h"
 #include "fit/candidate.h"
 #include "fit/common.h"
-#include "fit/least_squares.h"
 #include "fit/orthographic_fit.h"
 #include "fit/ransac.h"
 #include "fit/refine.h"
@@ -160,46 +159,6 @@ FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
   effort.warm_start = reuse.warm_start;
   effort.geometry = reuse.geometry;
   return Fit(points_in_world, observed_pixels, image_size, options, effort);
-}
-
-std::optional<ScoredCandidate> ScoreCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
-                                              const std::vector<Eigen::Vector2d>& observed_pixels,
-                                              const ImageSize& image_size,
-                                              const FitOptions& options,
-                                              const Camera& nested_minimum,
-                                              const SceneGeometry* geometry) {
-  const Clock::time_point start_time = Clock::now();
-  Require(options.projection == Projection::kPerspective && options.loss == LossType::kNone &&
-              !options.ransac && options.refine,
-          "a scored candidate is a perspective least-squares model without RANSAC");
-  const Scene scene = geometry != nullptr
-                          ? ValidateScene(*geometry, options)
-                          : ValidateScene(points_in_world, observed_pixels, image_size, options);
-  const Start start = WarmStart(scene, nested_minimum);
-  GaussNewtonStep step = StepGaussNewton(scene.points, scene.pixels, start.camera.rotation,
-                                         start.camera.center, start.model);
-  if (!step.ok || !(step.model.value[0] > 0.0) || !(step.model.value[1] > 0.0)) {
-    return std::nullopt;
-  }
-  ScoredCandidate scored;
-  scored.start_sum_squares_px2 = step.normal.cost;
-  scored.predicted_reduction_px2 = step.predicted_reduction_px2;
-  RefinedCamera refined;
-  refined.rotation = step.rotation;
-  refined.center = step.center;
-  refined.model = std::move(step.model);
-  // One step from the start: J^T J differs from the stepped camera's by the step's size against
-  // the parameters' scales, as the polish's last step leaves it (the condition is read to refuse).
-  refined.normal = std::move(step.normal);
-  refined.iterations = 1;
-  refined.refiner = "gauss-newton";
-  refined.termination = "scored: one Gauss-Newton step from a nested model's minimum";
-  FitEffort effort;
-  effort.check_linearity = false;
-  effort.describe = false;
-  scored.fit = AssessFit(scene, start.method, std::move(refined), options, effort);
-  scored.fit.time_ms = MicrosecondsSince(start_time) / 1000.0;
-  return scored;
 }
 
 }  // namespace internal

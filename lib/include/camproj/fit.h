@@ -203,10 +203,6 @@ struct ModelCandidate {
   std::string name;          // as FitResult::model
   int num_params = 0;        // pose 6 + free intrinsics
   bool fitted = false;       // false: refused or not determined (see verdict)
-  // Scored, not fitted to its minimum: one Gauss-Newton step from the nested model's minimum
-  // showed it cannot pay for its parameters (docs/model-selection.md, "The score test"); the
-  // sum of squares, RMS and criterion are the step's, upper bounds on its minimum's.
-  bool scored = false;
   double sum_squares_px2 = 0.0;
   double rms_px = 0.0;
   double criterion = 0.0;    // AIC or BIC with the selection's noise

@@ -72,33 +72,6 @@ FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
                     const ImageSize& image_size, const FitOptions& options,
                     const CandidateReuse& reuse);
 
-// A candidate scored instead of fitted: the model selection's score test (fit/selection.cc,
-// ModelSelector::ScoreOrFit). From `nested_minimum` -- the minimum of a model this one frees one
-// more group of, fitted to the same points -- one Gauss-Newton step of this model (the first step
-// its fit would take, least_squares.h StepGaussNewton), and its residuals there: what one pass
-// over the points with the Jacobian and one without cost, where a fit makes two or three of the
-// first. Near the nested minimum the step lowers the sum of squares by its linearized prediction,
-// and the step's sum of squares is then within that prediction's error of the fit's minimum.
-struct ScoredCandidate {
-  // At the stepped camera, as FitCandidate's result (nothing described): camera, residuals, RMS.
-  FitResult fit;
-  double start_sum_squares_px2 = 0.0;  // at nested_minimum
-  // |J delta|^2: the drop in the sum of squares the linearized problem predicts for the step.
-  double predicted_reduction_px2 = 0.0;
-};
-
-// nullopt where the step cannot be taken: a point behind nested_minimum, a step that is not
-// finite, or a step to a focal length or aspect that is not positive. Throws SceneError as
-// FitCandidate does where the scene refuses the model or the stepped camera (points behind it,
-// undetermined). `options`: a perspective model without a loss or RANSAC (std::invalid_argument
-// otherwise); `geometry`: the points prepared once, or null.
-std::optional<ScoredCandidate> ScoreCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
-                                              const std::vector<Eigen::Vector2d>& observed_pixels,
-                                              const ImageSize& image_size,
-                                              const FitOptions& options,
-                                              const Camera& nested_minimum,
-                                              const SceneGeometry* geometry);
-
 }  // namespace internal
 }  // namespace camproj
 

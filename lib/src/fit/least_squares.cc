@@ -1,7 +1,6 @@
 #include "fit/least_squares.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -331,30 +330,6 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   return summary;
 }
 
-// The Gauss-Newton step -(J^T J)^-1 J^T r at `normal` (ComputeNormalEquations' parameters),
-// solved with J^T J's columns scaled to a unit diagonal (Jacobi); `scale` receives the scaling.
-ParamVector GaussNewtonDelta(const NormalEquations& normal, ParamVector* scale) {
-  *scale = normal.jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-  return -(scale->asDiagonal() *
-           SymmetricSolver(ParamMatrix(scale->asDiagonal() * normal.jtj * scale->asDiagonal()))
-               .Solve(scale->asDiagonal() * normal.jtr));
-}
-
-// Moves a camera by `delta` in ComputeNormalEquations' parameters: R -> exp(omega) R,
-// C -> C + dC, each free slot (`free`, Model::free) by its entry.
-void MoveBy(const ParamVector& delta, const std::array<bool, kFitIntrinsicsSize>& free,
-            Eigen::Matrix3d* rotation, Eigen::Vector3d* center, IntrinsicValues* intrinsics) {
-  const double angle = delta.head<3>().norm();
-  if (angle > 0.0) {
-    *rotation = Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix() * *rotation;
-  }
-  *center += delta.segment<3>(3);
-  int next = 6;
-  for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
-    if (free[slot]) (*intrinsics)[slot] += delta(next++);
-  }
-}
-
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
@@ -402,13 +377,24 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   const JacobianColumns columns(*model);
   double previous_step_px = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps; ++step) {
-    ParamVector scale;
-    const ParamVector delta = GaussNewtonDelta(*normal, &scale);
+    const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+    const ParamVector delta =
+        -(scale.asDiagonal() *
+          SymmetricSolver(ParamMatrix(scale.asDiagonal() * normal->jtj * scale.asDiagonal()))
+              .Solve(scale.asDiagonal() * normal->jtr));
     if (!delta.allFinite()) return false;
     Eigen::Matrix3d new_rotation = *rotation;
-    Eigen::Vector3d new_center = *center;
+    const double angle = delta.head<3>().norm();
+    if (angle > 0.0) {
+      new_rotation =
+          Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix() * *rotation;
+    }
+    const Eigen::Vector3d new_center = *center + delta.segment<3>(3);
     IntrinsicValues new_intrinsics = model->value;
-    MoveBy(delta, model->free, &new_rotation, &new_center, &new_intrinsics);
+    int next = 6;
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (model->free[slot]) new_intrinsics[slot] += delta(next++);
+    }
     // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
     // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
@@ -525,24 +511,6 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   outcome.trace.push_back({static_cast<int>(outcome.trace.size()), MicrosecondsSince(start_time),
                            std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
   return outcome;
-}
-
-GaussNewtonStep StepGaussNewton(const std::vector<Eigen::Vector3d>& points,
-                                const std::vector<Eigen::Vector2d>& pixels,
-                                const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                                const Model& model) {
-  GaussNewtonStep step;
-  step.rotation = rotation;
-  step.center = center;
-  step.model = model;
-  if (!ComputeNormalEquations(points, pixels, rotation, center, model, &step.normal)) return step;
-  ParamVector scale;
-  const ParamVector delta = GaussNewtonDelta(step.normal, &scale);
-  if (!delta.allFinite()) return step;
-  MoveBy(delta, model.free, &step.rotation, &step.center, &step.model.value);
-  step.predicted_reduction_px2 = std::max(0.0, delta.dot(step.normal.jtj * delta));
-  step.ok = true;
-  return step;
 }
 
 }  // namespace internal

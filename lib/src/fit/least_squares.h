@@ -80,25 +80,6 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        PolishFirst polish_first = PolishFirst::kNo,
                                        PolishUntil until = PolishUntil::kSettled);
 
-// One Gauss-Newton step of `model` from the camera point_in_cam = rotation * (point - center):
-// a model selection's candidate scored at the nested model's minimum instead of fitted
-// (fit/candidate.h, ScoreCandidate). `normal` holds ComputeNormalEquations at the start (not at
-// the step: the caller evaluates the stepped camera's residuals itself), and
-// predicted_reduction_px2 = |J delta|^2 the drop in the sum of squares the linearized problem
-// predicts for the step (exact where the residuals are linear in the parameters over it).
-struct GaussNewtonStep {
-  bool ok = false;  // false: a point behind the start camera, or a step that is not finite
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();
-  Model model;
-  NormalEquations normal;
-  double predicted_reduction_px2 = 0.0;
-};
-GaussNewtonStep StepGaussNewton(const std::vector<Eigen::Vector3d>& points,
-                                const std::vector<Eigen::Vector2d>& pixels,
-                                const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
-                                const Model& model);
-
 }  // namespace internal
 }  // namespace camproj
 

@@ -57,9 +57,6 @@ struct Evaluation {
   SceneError::Reason reason = SceneError::Reason::kDegenerate;
   double sum_squares = 0.0;
   int num_params = 0;
-  // Scored, not fitted (ModelSelector::ScoreOrFit): `fit` is one Gauss-Newton step from the
-  // nested model's minimum.
-  bool scored = false;
 };
 
 // `consistent_at_px`: the noise at which the candidate's fit may skip its restarts
@@ -192,7 +189,6 @@ class ModelSelector {
 
  private:
   Evaluation FitModel(const FitOptions& model, const Camera* warm_start = nullptr) const;
-  Evaluation ScoreOrFit(const FitOptions& model, const Evaluation& nested) const;
   const Evaluation& Affine(const FitOptions& base);
   double Noise(const FitOptions& base, const std::vector<int>& candidates,
                const Evaluation& base_fit, bool orthographic_allowed);
@@ -242,56 +238,6 @@ Evaluation ModelSelector::FitModel(const FitOptions& model, const Camera* warm_s
   e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points_.size());
   e.num_params = static_cast<int>(e.fit->free_parameters.size());
   return e;
-}
-
-// A candidate one group richer than `nested`, the ladder's current model: scored where one
-// Gauss-Newton step from nested's minimum shows it cannot pay for its parameters (issue #12's
-// score test; fit/candidate.h, ScoreCandidate), else fitted from that step. The step's criterion
-// is an upper bound on the fit's. It is taken to be the fit's where the step lowered the sum of
-// squares by what the linearized problem predicts, within kScoreLinearity sigma^2 (the residuals
-// are then linear in the parameters over the step, which lands at the linearized minimum), and
-// such a step still kScoreMargin above nested's criterion is not fitted further: its camera and
-// criterion stand for the candidate (a rival of the chosen model in the determination check).
-// Measured on the click benchmark (bench --clicks, development and held-out scenes, every
-// skipped candidate also fitted): of 19106 skips, the fit lay within 0.1 sigma^2 of the step in
-// 98.5 %, more than 1 below it in 12, and 2 would have improved on nested (one scene's curved
-// valley at 8 points, where LM from the step ran 9.6 sigma^2 lower). Against fitting every
-// candidate, the default's answers in 6 of 6600 scenes: 5 refusals (ambiguous, degenerate)
-// became answers 0.8-2.7 px off on unseen points, one answer 4.3 px off a refusal as ambiguous;
-// and one silent failure (10.2 px, 50 % outliers at 60 points) a 2.9 px answer. Fitted as
-// before: a nested model without a fit, the orthographic family, a robust loss, the prefit's
-// model (already fitted), and a step that fails, is refused, or is not linear.
-Evaluation ModelSelector::ScoreOrFit(const FitOptions& model, const Evaluation& nested) const {
-  // The step's error against the linearized prediction, in sigma^2, below which the rest of the
-  // descent is taken as negligible; and the criterion margin a scored candidate must clear.
-  constexpr double kScoreLinearity = 0.1;
-  constexpr double kScoreMargin = 1.0;
-  const Camera* warm_start = nested.fit ? &nested.fit->camera : nullptr;
-  if (warm_start == nullptr || model.projection != Projection::kPerspective ||
-      model.loss != LossType::kNone || !model.refine ||
-      (prefit_ != nullptr && SameModel(prefit_->model, model))) {
-    return FitModel(model, warm_start);
-  }
-  std::optional<ScoredCandidate> scored;
-  try {
-    scored = ScoreCandidate(points_, pixels_, image_size_, model, *warm_start, &geometry_);
-  } catch (const std::exception&) {
-    // The fit decides (and says) whether the model is refused.
-  }
-  if (!scored) return FitModel(model, warm_start);
-  Evaluation e;
-  e.options = model;
-  e.sum_squares =
-      scored->fit.rms_px * scored->fit.rms_px * static_cast<double>(points_.size());
-  e.num_params = static_cast<int>(scored->fit.free_parameters.size());
-  e.fit = std::move(scored->fit);
-  e.scored = true;
-  const double reduction = scored->start_sum_squares_px2 - e.sum_squares;
-  const bool linear = std::abs(reduction - scored->predicted_reduction_px2) <=
-                      kScoreLinearity * sigma_ * sigma_;
-  const bool skip = linear && CriterionOf(e) >= CriterionOf(nested) + kScoreMargin;
-  if (skip) return e;
-  return FitModel(model, &e.fit->camera);
 }
 
 // The affine camera (orthographic with aspect and skew free unless the caller fixed them): the
@@ -344,7 +290,6 @@ size_t ModelSelector::Record(const Evaluation& e, const std::string& name,
   ModelCandidate c;
   c.name = name;
   c.fitted = e.fit.has_value();
-  c.scored = e.scored;
   c.num_params = e.num_params;
   if (e.fit) {
     c.name = e.fit->model;
@@ -412,7 +357,8 @@ Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::strin
         tried_.push_back(c);
         continue;
       }
-      Evaluation trial = ScoreOrFit(trial_options, ladder.final);
+      Evaluation trial =
+          FitModel(trial_options, ladder.final.fit ? &ladder.final.fit->camera : nullptr);
       if (!trial.fit) {
         ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
                                  trial.refusal + ")";
@@ -420,12 +366,8 @@ Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::strin
         continue;
       }
       const double delta = CriterionOf(trial) - CriterionOrInf(ladder.final);
-      const std::string versus =
-          Versus(criterion_name_, delta, current_name) +
-          (trial.scored ? " (scored by one Gauss-Newton step from " + current_name + "'s minimum)"
-                        : "");
-      ladder.why_left_out[g] = "left out: " + versus;
-      const size_t index = Record(trial, name, versus);
+      ladder.why_left_out[g] = "left out: " + Versus(criterion_name_, delta, current_name);
+      const size_t index = Record(trial, name, Versus(criterion_name_, delta, current_name));
       if (delta < 0.0 && (best_group < 0 || CriterionOf(trial) < CriterionOf(best))) {
         best_group = g;
         best_index = index;
