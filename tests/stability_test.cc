@@ -596,8 +596,9 @@ struct NoisyExpectation {
   // The draws the fit may report curved: 0 where the model is known linear over the noise's
   // reach (sub-pixel noise, well-conditioned), kNoisyDraws where it may go either way.
   int max_curved = kNoisyDraws;
-  // The draws it must report curved: where the noise's reach is far beyond the linear regime
-  // (the truth's NEES far above its bound in every draw), a "linear" report would be wrong.
+  // The draws it must report curved (a refused draw counts with them: it makes no "linear"
+  // report, and refusals have their own rate): where the noise's reach is far beyond the linear
+  // regime (the truth's NEES far above its bound in every draw), a "linear" report would be wrong.
   int min_curved = 0;
   // The chance per draw of a refusal ("did not reach the minimum"), 0 unless a known weakness
   // of the refinement says otherwise (then `why`, with the measurement).
