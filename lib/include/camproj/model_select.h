@@ -6,7 +6,9 @@
 // the criterion most, and stops when none does, or when the next model would leave fewer than
 // min_redundancy equations to spare. Whether the chosen camera is then determined well enough is
 // the assessment's question (AutoFitOptions::max_uncertainty_px), not the ladder's: a group the
-// residuals ask for is never left out because its own sigma is large.
+// residuals ask for is never left out because its own sigma is large -- except a distortion (k1,
+// k2) the criterion takes only weakly (by at most kEqualFitCriterion) that moves the image's
+// border by more than max_uncertainty_px: beyond the points it is their noise extrapolated.
 // Criterion (geometric AIC, Kanatani; the 3D points are exact, so it is J / sigma^2 + 2 p):
 //   AIC = J / sigma^2 + 2 p,   BIC = J / sigma^2 + p ln(2 N),
 // J the sum of squared reprojection errors (px^2), p the number of parameters (pose 6 + free
