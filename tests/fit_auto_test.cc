@@ -186,6 +186,13 @@ double WorstVertexErrorPx(const Camera& camera, const EmbeddedScene& scene) {
   return worst_px;
 }
 
+// How far `model`, forced (FitCamera), puts the scene's vertices from their true pixels: what a
+// test's rule is for.
+double ForcedVertexErrorPx(const EmbeddedScene& scene, const FitOptions& model) {
+  return WorstVertexErrorPx(FitCamera(scene.points, scene.pixels, {1920, 1080}, model).camera,
+                            scene);
+}
+
 // The default path's refusal of an embedded scene; an answer is a failure of the calling test,
 // reported with how far it is off at the scene's vertices.
 std::optional<SceneError> RefusalOf(const EmbeddedScene& scene) {
@@ -268,8 +275,7 @@ TEST(FitAutoTest, ObjectPointsJudgeTheCameraWhereTheClicksAreNot) {
   FitOptions pose_focal;
   pose_focal.aspect = ParameterMode::Default();
   pose_focal.principal_point = ParameterMode::Default();
-  const FitResult fit = FitCamera(scene.points, scene.pixels, {1920, 1080}, pose_focal);
-  EXPECT_GT(WorstVertexErrorPx(fit.camera, scene), 10.0)
+  EXPECT_GT(ForcedVertexErrorPx(scene, pose_focal), 10.0)
       << "the scene no longer shows what the object points are for";
   AutoFitOptions with_object;
   with_object.object_points_in_world = scene.vertices;
@@ -357,8 +363,7 @@ TEST(FitAutoTest, AWeakDistortionThatBendsTheImageBorderIsLeftOut) {
   FitOptions with_k1;
   with_k1.principal_point = ParameterMode::Free();
   with_k1.k1 = ParameterMode::Free();
-  const FitResult forced = FitCamera(scene.points, scene.pixels, {1920, 1080}, with_k1);
-  EXPECT_GT(WorstVertexErrorPx(forced.camera, scene), 8.0)
+  EXPECT_GT(ForcedVertexErrorPx(scene, with_k1), 8.0)
       << "the scene no longer shows what the rule is for";
 
   const FitResult fit = Auto(scene.points, scene.pixels);
@@ -409,8 +414,7 @@ TEST(FitAutoTest, ACameraThatStandsOnOneUncheckedClickIsRefused) {
   const EmbeddedScene scene = Scene335();
   FitOptions off_axis;
   off_axis.principal_point = ParameterMode::Free();
-  const FitResult forced = FitCamera(scene.points, scene.pixels, {1920, 1080}, off_axis);
-  EXPECT_GT(WorstVertexErrorPx(forced.camera, scene), 30.0)
+  EXPECT_GT(ForcedVertexErrorPx(scene, off_axis), 30.0)
       << "the scene no longer shows what the rule is for";
   const std::optional<SceneError> refusal = RefusalOf(scene);
   ASSERT_TRUE(refusal.has_value());
@@ -532,8 +536,7 @@ TEST(FitAutoTest, ALensShiftTradedForTheFocalLengthIsRefused) {
   FitOptions pose_focal;  // what the default answered before the model average
   pose_focal.aspect = ParameterMode::Default();           // 1
   pose_focal.principal_point = ParameterMode::Default();  // the image centre
-  const FitResult narrow = FitCamera(scene.points, scene.pixels, {1920, 1080}, pose_focal);
-  EXPECT_GT(WorstVertexErrorPx(narrow.camera, scene), 10.0)
+  EXPECT_GT(ForcedVertexErrorPx(scene, pose_focal), 10.0)
       << "the scene no longer shows what the rule is for";
   try {
     const FitResult fit = Auto(scene.points, scene.pixels);
