@@ -498,11 +498,11 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
       internal::CheckDetermination(gated.selection, kept_points, options, &least_checked);
   RefuseIfUndetermined(determination, gated.selection.fit.model, left_out_text,
                        options.fit.pixel_origin);
+  const PointReliability reliability = WordReliability(least_checked, left_out, names);
   if (std::isfinite(options.max_uncertainty_px)) {
     RefuseIfRegionUnbounded(gated.selection.fit, left_out_text);
+    RefuseIfUnchecked(reliability, names, size, noise.sigma_px, left_out_text);
   }
-  const PointReliability reliability = WordReliability(least_checked, left_out, names);
-  RefuseIfUnchecked(reliability, names, size, noise.sigma_px, left_out_text);
 
   FitResult result = std::move(gated.selection.fit);
   result.residuals_px = std::move(gated.residuals_px);

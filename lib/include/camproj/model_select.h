@@ -61,7 +61,9 @@ struct AutoFitOptions {
   // residual test and a camera that is tens of pixels off across the rest of the object. So is
   // one whose own confidence region has no edge (FitResult::linearity infinite: within the
   // 99.99 % region a camera sees points from behind, or fits as well; kDegenerate), whose
-  // linearized sigmas therefore say nothing. Infinity: none of these refusals.
+  // linearized sigmas therefore say nothing. So is one that stands on a click no other point
+  // checks (a mis-click of it anywhere in the image would leave less than the noise in its
+  // residual; FitResult::reliability; kDegenerate). Infinity: none of these refusals.
   double max_uncertainty_px = 5.0;
   // Points of the object that were not clicked (e.g. the vertices of the model being mapped), in
   // the world of points_in_world: the determination check judges the camera, its rivals and
