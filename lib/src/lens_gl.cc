@@ -8,10 +8,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "check.h"
+#include "image_codecs.h"
 
 namespace camproj {
 
@@ -403,7 +403,7 @@ std::string EncodeStMap(const StMap& map, const std::string& extension) {
     }
   }
   std::vector<uchar> bytes;
-  Require(cv::imencode(extension == ".exr" ? ".exr" : ".tiff", image, bytes),
+  Require(internal::EncodeImage(extension == ".exr" ? ".exr" : ".tiff", image, &bytes),
           "OpenCV could not encode the STMap as ", extension);
   return std::string(bytes.begin(), bytes.end());
 }

@@ -7,7 +7,7 @@
 #include <optional>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // cv::IMREAD_COLOR; the codecs: image_codecs.h
 #include <opencv2/imgproc.hpp>
 
 #include "camproj/errors.h"
@@ -15,6 +15,7 @@
 #include "camproj/image_header.h"
 #include "check.h"
 #include "drawing.h"
+#include "image_codecs.h"
 
 namespace camproj {
 
@@ -53,7 +54,7 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
   }
   cv::Mat image;
   try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
+    image = internal::DecodeImage(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
                                  const_cast<char*>(bytes.data())),
                          cv::IMREAD_COLOR);
   } catch (const cv::Exception& e) {
@@ -437,7 +438,7 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
 
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
-  if (!cv::imencode(extension, image, encoded)) {
+  if (!internal::EncodeImage(extension, image, &encoded)) {
     throw InputError(internal::Concat(output_path, ": cannot encode the image as ", extension));
   }
   WriteFileAtomically(output_path, std::string(encoded.begin(), encoded.end()));
