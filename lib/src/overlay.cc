@@ -55,8 +55,8 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
   cv::Mat image;
   try {
     image = internal::DecodeImage(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
-                                 const_cast<char*>(bytes.data())),
-                         cv::IMREAD_COLOR);
+                                          const_cast<char*>(bytes.data())),
+                                  cv::IMREAD_COLOR);
   } catch (const cv::Exception& e) {
     throw InputError(path + ": cannot decode the image: " + e.what());
   }
