@@ -214,7 +214,8 @@ struct ModelCandidate {
 struct LeftOutPoint {
   int index = 0;               // into the caller's points, 0-based
   double residual_px = 0.0;    // |predicted - observed| against the returned camera
-  double rms_with_px = 0.0;    // RMS of the same model fitted with this point put back
+  double rms_with_px = 0.0;    // RMS of the same model refitted, from the returned camera, with
+                               // this point put back (0: not computed, beyond 10 left out)
 };
 
 // FitCameraAuto's final consistency gate (docs/model-selection.md): the returned camera's
