@@ -3,6 +3,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "check.h"
@@ -29,6 +30,8 @@ std::string ValueText(double value) {
 
 Model MakeModel(const FitOptions& options, const ImageSize& size) {
   Model model;
+  auto fixed = std::make_shared<std::vector<FixedParameter>>();
+  model.fixed = fixed;
   if (options.known_intrinsics) {
     const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
                                             PixelOrigin::kCenter);
@@ -36,7 +39,7 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
     std::string text = Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx, ", cy ", k.cy, ", skew ",
                               k.skew, ", k1 ", k.k1, ", k2 ", k.k2);
     if (k.HasBeyondTwoRadial()) text += Concat(", p1 ", k.p1, ", p2 ", k.p2, ", k3 ", k.k3);
-    model.fixed.push_back({"intrinsics", text, "given: pose only"});
+    fixed->push_back({"intrinsics", text, "given: pose only"});
     return model;
   }
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
@@ -53,8 +56,8 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
                                     ? options.principal_point.value2 + shift
                                     : 0.5 * (size.height - 1.0));
     }
-    model.fixed.push_back({name, value,
-                           mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
+    fixed->push_back(
+        {name, value, mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
   };
   // A free focal length's start comes from the closed form; 1 is a placeholder.
   set(0, options.focal, 1.0, options.focal.value, "");

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +29,9 @@ namespace internal {
 struct Model {
   std::array<bool, kFitIntrinsicsSize> free{};
   std::array<double, kFitIntrinsicsSize> value{};
-  std::vector<FixedParameter> fixed;
+  // How the fixed slots are reported: text only, shared by every copy (a Model is copied at
+  // every step of the refinement and the assessment; strings there cost more than the step).
+  std::shared_ptr<const std::vector<FixedParameter>> fixed;
 
   int NumFree() const { return static_cast<int>(std::count(free.begin(), free.end(), true)); }
   // focal, aspect, principal point, skew: what a homography constrains (k1, k2 aside).
