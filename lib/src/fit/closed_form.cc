@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -162,8 +164,12 @@ void RqDecomposition(const Eigen::Matrix3d& m, Eigen::Matrix3d* k, Eigen::Matrix
   *r = rotation;
 }
 
-StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
-                     const std::vector<Eigen::Vector2d>& pixels) {
+namespace {
+
+// DltStart's camera, or nullopt with *behind the number of points behind the best linear camera.
+std::optional<StartCamera> DltCameraOrBehind(const std::vector<Eigen::Vector3d>& points,
+                                             const std::vector<Eigen::Vector2d>& pixels,
+                                             int* behind) {
   Eigen::Matrix<double, 3, 4> p = NormalizedDlt(points, pixels);
   // P = lambda K [R | t]: the third row gives lambda * depth. Choose the sign that puts the
   // points in front; if no sign does, no camera sees them all.
@@ -174,13 +180,8 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
     p = -p;
     in_front = n - in_front;
   }
-  if (in_front != n) {
-    throw SceneError(SceneError::Reason::kPointsBehindCamera,
-                     "the correspondences fit no camera that has every point in front of it (" +
-                         std::to_string(n - in_front) + " of " + std::to_string(n) +
-                         " points behind the best linear camera): check the point order and "
-                         "look for mismatched or mis-clicked points");
-  }
+  *behind = n - in_front;
+  if (in_front != n) return std::nullopt;
   const Eigen::Matrix3d m = p.leftCols<3>();
   Eigen::Matrix3d k;
   Eigen::Matrix3d r;
@@ -202,6 +203,28 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
     start.mirrored = true;
   }
   return start;
+}
+
+}  // namespace
+
+StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector2d>& pixels) {
+  int behind = 0;
+  const std::optional<StartCamera> start = DltCameraOrBehind(points, pixels, &behind);
+  if (!start) {
+    throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                     "the correspondences fit no camera that has every point in front of it (" +
+                         std::to_string(behind) + " of " + std::to_string(points.size()) +
+                         " points behind the best linear camera): check the point order and "
+                         "look for mismatched or mis-clicked points");
+  }
+  return *start;
+}
+
+std::optional<StartCamera> DltStartIfInFront(const std::vector<Eigen::Vector3d>& points,
+                                             const std::vector<Eigen::Vector2d>& pixels) {
+  int behind = 0;
+  return DltCameraOrBehind(points, pixels, &behind);
 }
 
 bool HomographyStart(const std::vector<Eigen::Vector3d>& points,

@@ -3,6 +3,7 @@
 #ifndef CAMPROJ_SRC_FIT_CLOSED_FORM_H_
 #define CAMPROJ_SRC_FIT_CLOSED_FORM_H_
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -28,6 +29,12 @@ struct StartCamera {
 // kPointsBehindCamera when no camera has all points in front.
 StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels);
+
+// DltStart without the exception: nullopt where it throws. For RANSAC's minimal samples, most of
+// which have a point behind their camera: a thrown and caught SceneError (its message built,
+// the stack unwound) cost more than the sample's DLT.
+std::optional<StartCamera> DltStartIfInFront(const std::vector<Eigen::Vector3d>& points,
+                                             const std::vector<Eigen::Vector2d>& pixels);
 
 // The unit eigenvector of the smallest eigenvalue of a symmetric positive semidefinite `m` (the
 // DLT's normal matrix), sign arbitrary: by inverse iteration where that settles and `m` is not

@@ -54,12 +54,9 @@ bool SolveSubset(const std::vector<Eigen::Vector3d>& points,
   } else if (planar) {
     ok = HomographyStart(x, u, plane_basis, guess, model.free[0], model.free[1], camera);
   } else {
-    try {
-      *camera = DltStart(x, u);
-      ok = !camera->mirrored;  // a mirrored sample is no camera of this world
-    } catch (const SceneError&) {
-      ok = false;
-    }
+    const std::optional<StartCamera> dlt = DltStartIfInFront(x, u);
+    ok = dlt && !dlt->mirrored;  // a mirrored sample is no camera of this world
+    if (ok) *camera = *dlt;
   }
   if (!ok || !camera->rotation.allFinite() || !camera->center.allFinite()) return false;
   *fitted_model = known ? model : ProjectOntoModel(model, camera->intrinsics);
