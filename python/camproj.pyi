@@ -86,7 +86,7 @@ class Perspective:
 class LeftOutPoint:
     index: int          # 0-based, into the fitted points
     residual_px: float  # |predicted - observed| against the returned camera
-    rms_with_px: float  # RMS of the same model fitted with the point put back
+    rms_with_px: float  # RMS of the same model refitted from the returned camera with the point put back
 
 class FitReport:
     """What `camproj fit` reports (fit.h's FitResult); pixels are px, angles degrees."""

@@ -6,8 +6,8 @@
 // (0.01 s without it; ~0.35 s under the sanitizers), though only `camproj overlay` and the lens
 // maps of `camproj export` touch an image. The library is opened by the soname this build was
 // compiled against (CAMPROJ_IMGCODECS_SONAME, lib/CMakeLists.txt) and the two functions looked up
-// by their C++ (Itanium) symbol names, which encode the parameter types; tests/image_codecs_test.cc
-// checks that the functions found round-trip a PNG exactly.
+// by their C++ (Itanium) symbol names, which encode the parameter types;
+// tests/image_codecs_test.cc checks that the functions found round-trip a PNG exactly.
 #ifndef CAMPROJ_SRC_IMAGE_CODECS_H_
 #define CAMPROJ_SRC_IMAGE_CODECS_H_
 

@@ -215,7 +215,8 @@ struct LeftOutPoint {
   int index = 0;               // into the caller's points, 0-based
   double residual_px = 0.0;    // |predicted - observed| against the returned camera
   double rms_with_px = 0.0;    // RMS of the same model refitted, from the returned camera, with
-                               // this point put back (0: not computed, beyond 10 left out)
+                               // this point put back (0: not computed, beyond 10 left out;
+                               // inf: no camera fits with it)
 };
 
 // FitCameraAuto's final consistency gate (docs/model-selection.md): the returned camera's
