@@ -237,10 +237,17 @@ UnitWorld ToUnitWorld(const Camera& camera, const std::vector<Eigen::Vector3d>& 
   return world;
 }
 
+// Up to this many fitted points PixelUncertainty keeps J (2 x 16 doubles per point at most:
+// 1 MB here), and a fitted point's rows are read, not recomputed: the determination check asks
+// for every fitted point's rows once per model it judges (its sigma there, its hat block), and
+// at 100 points recomputing them was 5 % of the default path (bench --stage-cost).
+constexpr size_t kKeptJacobianPoints = 4096;
+
 // ReprojectionSigmaPx's linearization of one camera, prepared once: the Jacobi-scaled inverse
-// of J^T J; SigmaAt then costs one point's Jacobian. J is never held whole: J^T J is summed over
-// blocks of points, and a fitted point's rows are recomputed where they are asked for, so the
-// memory does not grow with the points (at a million points J alone would be ~100 MB).
+// of J^T J; SigmaAt then costs one point's Jacobian. Beyond kKeptJacobianPoints J is not held
+// whole: J^T J is summed over blocks of points, and a fitted point's rows are recomputed where
+// they are asked for, so the memory does not grow with the points (at a million points J alone
+// would be ~100 MB).
 class PixelUncertainty {
  public:
   // `fitted_points` (with z negated if mirrored_z) must outlive this object. Throws
@@ -263,18 +270,19 @@ class PixelUncertainty {
     at_ = Linearization{camera, length_scale, params};
 
     constexpr size_t kBlock = 256;  // points per block of J: large enough for a blocked product
+    const size_t count = fitted_points.size();
+    if (count <= kKeptJacobianPoints) jacobian_.resize(2 * count, params.size());
     Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(params.size(), params.size());
     std::vector<Eigen::Vector3d> block;
     Eigen::MatrixXd block_jacobian;
-    for (size_t begin = 0; begin < fitted_points.size(); begin += kBlock) {
+    for (size_t begin = 0; begin < count; begin += kBlock) {
       block.clear();
-      for (size_t i = begin; i < std::min(begin + kBlock, fitted_points.size()); ++i) {
-        block.push_back(Fitted(i));
-      }
+      for (size_t i = begin; i < std::min(begin + kBlock, count); ++i) block.push_back(Fitted(i));
       const std::optional<size_t> behind =
           PixelJacobian(at_, block.data(), block.size(), &block_jacobian);
       Require(!behind, "point ", begin + behind.value_or(0), " is not in front of the camera");
       normal.noalias() += block_jacobian.transpose() * block_jacobian;
+      if (jacobian_.size() > 0) jacobian_.middleRows(2 * begin, block_jacobian.rows()) = block_jacobian;
     }
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
@@ -360,8 +368,9 @@ class PixelUncertainty {
     return x;
   }
 
-  // Rows 2i, 2i + 1 of J.
+  // Rows 2i, 2i + 1 of J: kept, or recomputed (the same numbers).
   PointRows FittedRows(size_t i) const {
+    if (jacobian_.size() > 0) return jacobian_.middleRows<2>(2 * i);
     const Eigen::Vector3d x = Fitted(i);
     PointRows jacobian;
     PixelJacobian(at_, &x, 1, &jacobian);
@@ -377,6 +386,7 @@ class PixelUncertainty {
   const std::vector<Eigen::Vector3d>* fitted_;
   bool mirrored_z_ = false;
   Linearization at_;
+  Eigen::MatrixXd jacobian_;   // J (2 x params per fitted point), or empty beyond kKeptJacobianPoints
   ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
   bool singular_ = false;
 };
