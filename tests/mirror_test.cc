@@ -84,5 +84,44 @@ TEST(MirrorTest, RefinementFromTheReversalOfTheReversalFindsTheTruth) {
   }
 }
 
+// The refinement's early stop (read_below_px2): a reading the caller reads (one that fits) is
+// the same with or without it, and one it stops is left above the cost asked for, never below
+// the full refinement's cost. A strong perspective (the default synthetic cloud, 20 points):
+// the proper world read as mirrored from the true camera's depth reversal fits tens of px off;
+// the mirrored world read from the reversal of the truth fits exactly (as above).
+TEST(MirrorTest, RefinementStopsOnlyWhereTheCostAskedForIsOutOfReach) {
+  constexpr double kReadBelowPx2 = 1.0;  // the caller reads a sum of squares up to 1 px^2
+  FitOptions model;
+  int stopped = 0;
+  for (uint64_t seed = 1; seed <= 50; ++seed) {
+    SynthOptions synth;
+    synth.seed = testing::Seed(seed);
+    synth.num_points = 20;
+    const SynthScene scene = SynthesizeScene(synth);
+    const std::vector<Eigen::Vector3d>& points = scene.correspondences.points_in_world;
+    const std::vector<Eigen::Vector2d>& pixels = scene.correspondences.pixels;
+    const double n = static_cast<double>(points.size());
+    // Read: the same reading to the last bit.
+    const std::vector<Eigen::Vector3d> mirrored = MirroredZ(points);
+    const Camera exact = internal::NeckerReversal(scene.truth, points);
+    const auto fits = internal::FitMirroredReading(exact, model, mirrored, pixels);
+    const auto fits_limited =
+        internal::FitMirroredReading(exact, model, mirrored, pixels, nullptr, kReadBelowPx2);
+    ASSERT_TRUE(fits && fits_limited) << "seed " << seed;
+    EXPECT_EQ(fits_limited->rms_px, fits->rms_px) << "seed " << seed;
+    // Not read: stopped above the cost asked for, or the same as the full refinement.
+    const auto full = internal::FitMirroredReading(scene.truth, model, points, pixels);
+    const auto limited =
+        internal::FitMirroredReading(scene.truth, model, points, pixels, nullptr, kReadBelowPx2);
+    if (!full || !limited) continue;  // a point behind the reading: nothing to compare
+    if (limited->rms_px == full->rms_px) continue;
+    ++stopped;
+    EXPECT_GT(n * limited->rms_px * limited->rms_px, kReadBelowPx2) << "seed " << seed;
+    EXPECT_GT(limited->rms_px, full->rms_px) << "seed " << seed;
+  }
+  // Far out of reach at 20 points of a 45-degree view: most stop (all 50 at seeds 1-50).
+  EXPECT_GE(stopped, 25);
+}
+
 }  // namespace
 }  // namespace camproj

@@ -166,8 +166,13 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
   // The mirrored world prepared once for every reading of it below.
   const internal::SceneGeometry mirrored_world = internal::PrepareScene(
       internal::MirroredZ(kept_points), kept_pixels, size, selection.options.pixel_origin);
-  const std::optional<internal::MirroredReading> reversed = internal::FitMirroredReading(
-      selection.fit.camera, selection.options, kept_points, kept_pixels, &mirrored_world);
+  // A reading counts where it fits about as well or better (the rival check's
+  // kEqualFitCriterion) or significantly better (the refusal's, a lower sum of squares).
+  const double read_below_px2 =
+      n * rms_px * rms_px + kEqualFitCriterion * selection.sigma_px * selection.sigma_px;
+  const std::optional<internal::MirroredReading> reversed =
+      internal::FitMirroredReading(selection.fit.camera, selection.options, kept_points,
+                                   kept_pixels, &mirrored_world, read_below_px2);
   if (reversed) {
     const double gain = n * (rms_px * rms_px - reversed->rms_px * reversed->rms_px);
     if (gain / (noise.sigma_px * noise.sigma_px) > kSignificantChi2) {

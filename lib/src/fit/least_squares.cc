@@ -165,6 +165,7 @@ enum class LmStatus {
   kCostTooSmall,
   kMaxIterations,
   kCostChangeTooSmall,
+  kTargetOutOfReach,
 };
 
 std::string LmStatusText(LmStatus status) {
@@ -173,6 +174,8 @@ std::string LmStatusText(LmStatus status) {
     case LmStatus::kRelativeStepTooSmall: return "CONVERGENCE: relative step below tolerance";
     case LmStatus::kCostTooSmall: return "CONVERGENCE: cost below threshold";
     case LmStatus::kCostChangeTooSmall: return "CONVERGENCE: cost change below tolerance";
+    case LmStatus::kTargetOutOfReach:
+      return "NO_CONVERGENCE: the linear model's minimum is far above the cost asked for";
     case LmStatus::kMaxIterations: break;
   }
   return "NO_CONVERGENCE: maximum number of iterations reached";
@@ -200,8 +203,12 @@ struct LmSummary {
 // J^T r''(v) to the step v, taken as v + a / 2 when |a| <= kGeodesicAlpha |v| / 2 (else the
 // step is rejected and the damping raised). It follows a curved valley to second order where
 // plain LM steps leave it after a tiny fraction of its length (the cost rises across it).
+//
+// With a finite `out_of_reach_px2`, LM also stops (kTargetOutOfReach) at an iterate where the
+// Gauss-Newton model's minimum, twice (cost - g^T (J^T J)^-1 g / 2), is above it.
 LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptions& options,
-                                     Clock::time_point start_time, bool geodesic, ParamVector* u,
+                                     Clock::time_point start_time, bool geodesic,
+                                     double out_of_reach_px2, ParamVector* u,
                                      std::vector<TraceEntry>* trace) {
   // Transtrum and Sethna's defaults: the finite-difference step along v and the largest
   // acceptable |a| / |v| (times 2).
@@ -240,6 +247,15 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
                       std::sqrt(chart.cost / problem.NumPoints())});
   };
 
+  // Whether even the Gauss-Newton model's minimum at the current iterate is out of reach.
+  auto out_of_reach = [&]() {
+    if (!std::isfinite(out_of_reach_px2)) return false;
+    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
+    // J^T J is positive semi-definite: a negative or non-finite decrease is a singular solve,
+    // which tells nothing.
+    return decrease >= 0.0 && std::isfinite(decrease) && 2.0 * (cost - decrease) > out_of_reach_px2;
+  };
+
   NormalEquations chart;
   NormalEquations local;
   summary.iterations = 0;
@@ -252,6 +268,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   }
   if (cost < cost_threshold) {
     summary.status = LmStatus::kCostTooSmall;
+    return summary;
+  }
+  if (out_of_reach()) {
+    summary.status = LmStatus::kTargetOutOfReach;
     return summary;
   }
   double damping = 1.0 / kInitialTrustRegionRadius;
@@ -313,6 +333,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       }
       if (cost < cost_threshold) {
         summary.status = LmStatus::kCostTooSmall;
+        break;
+      }
+      if (out_of_reach()) {
+        summary.status = LmStatus::kTargetOutOfReach;
         break;
       }
       const double t = 2.0 * rho - 1.0;
@@ -440,7 +464,7 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
                                        int max_rounds, PolishFirst polish_first,
-                                       PolishUntil until) {
+                                       PolishUntil until, double out_of_reach_px2) {
   const bool scored = until == PolishUntil::kConverged;
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
@@ -481,8 +505,8 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
       ParamVector u = problem.Pack(outcome.center);
       // The first round is TinySolver's LM; where its answer is short of the minimum (a curved
       // valley), the next rounds add geodesic acceleration.
-      const LmSummary summary =
-          MinimizeLevenbergMarquardt(problem, options, start_time, round > 0, &u, &outcome.trace);
+      const LmSummary summary = MinimizeLevenbergMarquardt(problem, options, start_time, round > 0,
+                                                           out_of_reach_px2, &u, &outcome.trace);
       problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
       outcome.iterations += summary.iterations;
       outcome.termination = LmStatusText(summary.status);
@@ -493,6 +517,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
         outcome.normal = summary.local;
         ToChart(Eigen::Matrix3d::Identity(), outcome.rotation, &outcome.normal);
       }
+      // Not a minimum, and no polish can take it to the cost asked for: the caller reads only
+      // that it is above it.
+      if (have_normal && summary.status == LmStatus::kTargetOutOfReach) break;
     }
     if (!have_normal) {
       have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,

@@ -8,6 +8,7 @@
 #ifndef CAMPROJ_SRC_FIT_LEAST_SQUARES_H_
 #define CAMPROJ_SRC_FIT_LEAST_SQUARES_H_
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,11 @@ struct LeastSquaresOutcome {
 // ends behind the camera or the focal length or aspect is not positive (normal is then empty if
 // the normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one
 // settling step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
+// With a finite `out_of_reach_px2` (a sum of squares in px^2 below which alone the caller reads
+// the answer), LM stops where even its Gauss-Newton model's minimum is above it, and neither
+// polish nor further round follows: the outcome is then a camera with a cost above
+// out_of_reach_px2 (not a minimum; converged false). A linear model's minimum is no bound on the
+// nonlinear one; the caller's margin over it is measured where it is used (fit/mirror.cc).
 // Where the Gauss-Newton polish may run before LM (not with Refiner::kCeres): LM then runs only
 // if the polish does not end at the minimum, and the termination says where it started
 // ("Gauss-Newton from a nested minimum" / "... from the closed form") when it does.
@@ -78,7 +84,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const FitOptions& options, Clock::time_point start_time,
                                        int max_rounds = kMaxLeastSquaresRounds,
                                        PolishFirst polish_first = PolishFirst::kNo,
-                                       PolishUntil until = PolishUntil::kSettled);
+                                       PolishUntil until = PolishUntil::kSettled,
+                                       double out_of_reach_px2 =
+                                           std::numeric_limits<double>::infinity());
 
 }  // namespace internal
 }  // namespace camproj

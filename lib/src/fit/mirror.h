@@ -7,6 +7,7 @@
 #ifndef CAMPROJ_SRC_FIT_MIRROR_H_
 #define CAMPROJ_SRC_FIT_MIRROR_H_
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -38,12 +39,16 @@ using MirroredReading = Reading;
 // the best one near the reversal. Nothing when that refinement ends with a point behind the
 // camera or a non-positive focal length or aspect. `mirrored_world`: MirroredZ(points_in_world)
 // and the pixels as PrepareScene prepares them for model.pixel_origin (shared with
-// FitMirroredWorld), or null (prepared here).
+// FitMirroredWorld), or null (prepared here). `read_below_px2`: the sum of squares (px^2) above
+// which the caller does not read the reading (infinite: always read); the refinement stops
+// where it is far out of reach (kOutOfReachFactor in mirror.cc), and the reading's RMS is then
+// only known to be above it.
 std::optional<MirroredReading> FitMirroredReading(
     const Camera& camera, const FitOptions& model,
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels,
-    const SceneGeometry* mirrored_world = nullptr);
+    const SceneGeometry* mirrored_world = nullptr,
+    double read_below_px2 = std::numeric_limits<double>::infinity());
 
 // Each of `models` fitted to the points with z negated from a start of that world's own, by LM
 // (one round of at most 20 iterations): at few points a mirrored world can fit a proper camera

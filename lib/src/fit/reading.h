@@ -4,6 +4,7 @@
 #ifndef CAMPROJ_SRC_FIT_READING_H_
 #define CAMPROJ_SRC_FIT_READING_H_
 
+#include <limits>
 #include <optional>
 
 #include "camproj/camera.h"
@@ -27,9 +28,11 @@ Model ModelAt(const Model& model, const Intrinsics& intrinsics);
 // LM (one round of options.max_iterations) in `scene`'s normalized world from `start`: the
 // camera as `like` (projection, image size, depth range) with the refined pose and intrinsics,
 // and its RMS; nothing if a point ends behind it or its focal length or aspect is not positive.
-std::optional<Reading> RefineReading(const Scene& scene, const StartCamera& start,
-                                     const Model& start_model, const FitOptions& options,
-                                     const Camera& like);
+// `out_of_reach_px2`: RefineLeastSquares' (fit/least_squares.h).
+std::optional<Reading> RefineReading(
+    const Scene& scene, const StartCamera& start, const Model& start_model,
+    const FitOptions& options, const Camera& like,
+    double out_of_reach_px2 = std::numeric_limits<double>::infinity());
 
 }  // namespace internal
 }  // namespace camproj
