@@ -167,7 +167,8 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
   const internal::SceneGeometry mirrored_world = internal::PrepareScene(
       internal::MirroredZ(kept_points), kept_pixels, size, selection.options.pixel_origin);
   // A reading counts where it fits about as well or better (the rival check's
-  // kEqualFitCriterion) or significantly better (the refusal's, a lower sum of squares).
+  // kEqualFitCriterion) or significantly better (the refusal's, a lower sum of squares); one
+  // with more parameters (the off-axis model below) only further below.
   const double read_below_px2 =
       n * rms_px * rms_px + kEqualFitCriterion * selection.sigma_px * selection.sigma_px;
   const std::optional<internal::MirroredReading> reversed =
@@ -198,7 +199,8 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
     }
     const std::vector<std::optional<internal::MirroredReading>> readings =
         internal::FitMirroredWorld(kept_points, kept_pixels, size, models,
-                                   selection.fit.camera.intrinsics, &mirrored_world);
+                                   selection.fit.camera.intrinsics, &mirrored_world,
+                                   read_below_px2);
     for (size_t i = 0; i < models.size(); ++i) {
       if (readings[i]) consider(readings[i]->camera, models[i], readings[i]->rms_px);
     }

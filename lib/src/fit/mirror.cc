@@ -39,14 +39,19 @@ namespace {
 constexpr int kReversalIterations = 10;
 constexpr int kFreshStartIterations = 20;
 
-// The reversal's refinement stops where the Gauss-Newton model's minimum is above this many
-// times the sum of squares the caller reads it below (fit/least_squares.h): at 100 points a
-// strong perspective leaves the mirrored world 10^3-10^4 times the proper one's cost after 10
+// A refinement stops where the Gauss-Newton model's minimum is above this many times the sum of
+// squares the caller reads it below (fit/least_squares.h). The reversal: at 100 points a strong
+// perspective leaves the mirrored world 10^3-10^4 times the proper one's cost after 10
 // iterations, and those iterations were 13 % of the default path. Measured over 3540 reversals
 // (bench --stage-cost at N = 6-1000 and bench --clicks): at 10 it stops 2882 of them, saving 67 %
 // of their iterations; every one it stops ended the 10 iterations at least 24 times above the
-// cost read (at 3: 15 times), and none that ended below it is stopped.
-constexpr double kOutOfReachFactor = 10.0;
+// cost read (at 3: 15 times), and none that ended below it is stopped. The fresh starts (at <= 8
+// points) come closer: over 2904 of them (bench --stage-cost at N = 6-20, bench --clicks on
+// scenes 0-299) 30 stops 1899, saving 56 % of their iterations, each ending its 20 iterations
+// at least 12.6 times above; at 10 that margin is 3.3, and at 3 two readings that end below the
+// cost read are stopped.
+constexpr double kReversalOutOfReach = 10.0;
+constexpr double kFreshStartOutOfReach = 30.0;
 
 // The mirrored world's scene for `options`: from `mirrored_world` where the caller prepared it.
 Scene MirroredScene(const std::vector<Eigen::Vector3d>& points_in_world,
@@ -75,7 +80,7 @@ std::optional<MirroredReading> FitMirroredReading(
     start.rotation = reversed.cam_from_world.rotation;
     start.center = (CameraCenterInWorld(reversed.cam_from_world) - scene.centroid) / scene.scale;
     return RefineReading(scene, start, ModelAt(scene.model, camera.intrinsics), options, camera,
-                         kOutOfReachFactor * read_below_px2);
+                         kReversalOutOfReach * read_below_px2);
   } catch (const SceneError&) {
     return std::nullopt;  // the mirrored scene has no valid start (ValidateScene's refusals)
   }
@@ -85,7 +90,7 @@ std::vector<std::optional<MirroredReading>> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
     const std::vector<FitOptions>& models, const Intrinsics& intrinsics,
-    const SceneGeometry* mirrored_world) {
+    const SceneGeometry* mirrored_world, double read_below_px2) {
   // The SQPnP pose at `intrinsics` does not depend on the model: solved at most once.
   bool pnp_solved = false;
   std::optional<StartCamera> pnp;
@@ -116,7 +121,8 @@ std::vector<std::optional<MirroredReading>> FitMirroredWorld(
       }
       Camera like;
       like.image_size = image_size;
-      return RefineReading(scene, start, start_model, options, like);
+      return RefineReading(scene, start, start_model, options, like,
+                           kFreshStartOutOfReach * read_below_px2);
     } catch (const SceneError&) {
       return std::nullopt;  // no start, or no valid scene
     }

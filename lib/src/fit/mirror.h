@@ -41,7 +41,7 @@ using MirroredReading = Reading;
 // and the pixels as PrepareScene prepares them for model.pixel_origin (shared with
 // FitMirroredWorld), or null (prepared here). `read_below_px2`: the sum of squares (px^2) above
 // which the caller does not read the reading (infinite: always read); the refinement stops
-// where it is far out of reach (kOutOfReachFactor in mirror.cc), and the reading's RMS is then
+// where it is far out of reach (kReversalOutOfReach in mirror.cc), and the reading's RMS is then
 // only known to be above it.
 std::optional<MirroredReading> FitMirroredReading(
     const Camera& camera, const FitOptions& model,
@@ -57,12 +57,14 @@ std::optional<MirroredReading> FitMirroredReading(
 // `intrinsics` (the fitted camera's: the closed form would refine both readings and refuse,
 // start.cc), solved once for every model. Per model, in order: nothing where no start or no
 // proper camera with every point in front is found. `mirrored_world` as for FitMirroredReading:
-// prepared once, the mirrored world's DLT is read once for every model.
+// prepared once, the mirrored world's DLT is read once for every model. `read_below_px2` as for
+// FitMirroredReading (kFreshStartOutOfReach in mirror.cc).
 std::vector<std::optional<MirroredReading>> FitMirroredWorld(
     const std::vector<Eigen::Vector3d>& points_in_world,
     const std::vector<Eigen::Vector2d>& observed_pixels, const ImageSize& image_size,
     const std::vector<FitOptions>& models, const Intrinsics& intrinsics,
-    const SceneGeometry* mirrored_world = nullptr);
+    const SceneGeometry* mirrored_world = nullptr,
+    double read_below_px2 = std::numeric_limits<double>::infinity());
 
 }  // namespace internal
 }  // namespace camproj
