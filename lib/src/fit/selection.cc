@@ -336,7 +336,8 @@ size_t ModelSelector::Record(const Evaluation& e, const std::string& name,
     c.sum_squares_px2 = e.sum_squares;
     c.rms_px = e.fit->rms_px;
     c.criterion = CriterionOf(e);
-    rivals_.push_back({e.fit->model, e.options, e.fit->camera, c.criterion});
+    rivals_.push_back({e.fit->model, e.options, e.fit->camera, c.criterion,
+                       /*mirrored_world=*/false, /*same_model=*/false, e.sum_squares});
   }
   c.verdict = verdict;
   tried_.push_back(c);

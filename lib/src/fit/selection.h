@@ -29,6 +29,9 @@ struct Rival {
   // The chosen model itself at another of its minima (fit/other_minima.h): it too counts when it
   // fits better, as then the chosen camera is not the least-squares optimum.
   bool same_model = false;
+  // Its sum of squared residuals (px^2) over the selection's points, where the selection fitted
+  // it (a ladder's model); negative where not recorded.
+  double sum_squares_px2 = -1.0;
 };
 
 struct Selection {
