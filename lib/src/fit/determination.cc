@@ -291,7 +291,9 @@ class PixelUncertainty {
           PixelJacobian(at_, block.data(), block.size(), &block_jacobian);
       Require(!behind, "point ", begin + behind.value_or(0), " is not in front of the camera");
       normal.noalias() += block_jacobian.transpose() * block_jacobian;
-      if (jacobian_.size() > 0) jacobian_.middleRows(2 * begin, block_jacobian.rows()) = block_jacobian;
+      if (jacobian_.size() > 0) {
+        jacobian_.middleRows(2 * begin, block_jacobian.rows()) = block_jacobian;
+      }
     }
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
@@ -395,7 +397,7 @@ class PixelUncertainty {
   const std::vector<Eigen::Vector3d>* fitted_;
   bool mirrored_z_ = false;
   Linearization at_;
-  Eigen::MatrixXd jacobian_;   // J (2 x params per fitted point), or empty beyond kKeptJacobianPoints
+  Eigen::MatrixXd jacobian_;   // J (2 rows per fitted point), empty beyond kKeptJacobianPoints
   ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
   bool singular_ = false;
 };

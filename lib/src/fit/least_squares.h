@@ -50,10 +50,11 @@ struct LeastSquaresOutcome {
 // the normal equations could not be formed); `normal` holds ComputeNormalEquations at (or one
 // settling step before) the answer. The trace's times count from start_time; it ends at the answer's RMS.
 // With a finite `out_of_reach_px2` (a sum of squares in px^2 below which alone the caller reads
-// the answer), LM stops where even its Gauss-Newton model's minimum is above it, and neither
-// polish nor further round follows: the outcome is then a camera with a cost above
-// out_of_reach_px2 (not a minimum; converged false). A linear model's minimum is no bound on the
-// nonlinear one; the caller's margin over it is measured where it is used (fit/mirror.cc).
+// the answer), the own LM stops where even its Gauss-Newton model's minimum is above it (not
+// with Refiner::kCeres, which runs to its own end), and neither polish nor further round
+// follows: the outcome is then a camera with a cost above out_of_reach_px2 (not a minimum;
+// converged false). A linear model's minimum is no bound on the nonlinear one; the caller's
+// margin over it is measured where it is used (fit/mirror.cc).
 // Where the Gauss-Newton polish may run before LM (not with Refiner::kCeres): LM then runs only
 // if the polish does not end at the minimum, and the termination says where it started
 // ("Gauss-Newton from a nested minimum" / "... from the closed form") when it does.
