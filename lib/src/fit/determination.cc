@@ -402,6 +402,28 @@ class PixelUncertainty {
   bool singular_ = false;
 };
 
+// A symmetric 2 x 2 matrix's eigenvalues and the larger one's unit eigenvector, in closed form:
+// mean +- radius, and (h01, larger - h00) or, where that vanishes (a diagonal matrix with
+// h00 >= h11), (larger - h11, h01) = (2 radius, 0), the longer of the two.
+struct SymmetricEigen2 {
+  double larger = 0.0;
+  double smaller = 0.0;
+  Eigen::Vector2d larger_vector = Eigen::Vector2d(1.0, 0.0);
+};
+SymmetricEigen2 EigenOf(const Eigen::Matrix2d& h) {
+  const double mean = 0.5 * (h(0, 0) + h(1, 1));
+  const double half_difference = 0.5 * (h(0, 0) - h(1, 1));
+  const double radius = std::hypot(half_difference, h(0, 1));
+  SymmetricEigen2 eigen;
+  eigen.larger = mean + radius;
+  eigen.smaller = mean - radius;
+  const Eigen::Vector2d a(h(0, 1), radius - half_difference);
+  const Eigen::Vector2d b(radius + half_difference, h(0, 1));
+  const Eigen::Vector2d v = a.squaredNorm() > b.squaredNorm() ? a : b;
+  if (v.norm() > 0.0) eigen.larger_vector = v.normalized();
+  return eigen;
+}
+
 // The fitted point whose own pixel the fit follows most: the largest eigenvalue of its hat block
 // over the points, with its eigenvector (PointReliability; `point` its index among the fitted
 // points). `hats`: the blocks already computed (SigmasAt), one slot per fitted point.
@@ -410,21 +432,12 @@ PointReliability LeastChecked(const PixelUncertainty& uncertainty,
   PointReliability least;
   least.checked = true;
   for (size_t i = 0; i < hats.size(); ++i) {
-    const Eigen::Matrix2d h = hats[i] ? *hats[i] : uncertainty.HatAt(i);
-    // The symmetric 2 x 2 block's larger eigenvalue in closed form: mean + radius.
-    const double mean = 0.5 * (h(0, 0) + h(1, 1));
-    const double half_difference = 0.5 * (h(0, 0) - h(1, 1));
-    const double radius = std::hypot(half_difference, h(0, 1));
-    const double redundancy = std::max(0.0, 1.0 - (mean + radius));
+    const SymmetricEigen2 eigen = EigenOf(hats[i] ? *hats[i] : uncertainty.HatAt(i));
+    const double redundancy = std::max(0.0, 1.0 - eigen.larger);
     if (least.point >= 0 && !(redundancy < least.redundancy)) continue;
     least.point = static_cast<int>(i);
     least.redundancy = redundancy;
-    // Its eigenvector: (h01, lambda - h00) or, where that vanishes (a diagonal block with
-    // h00 >= h11), (lambda - h11, h01) = (2 radius, 0).
-    const Eigen::Vector2d a(h(0, 1), radius - half_difference);
-    const Eigen::Vector2d b(radius + half_difference, h(0, 1));
-    const Eigen::Vector2d v = a.squaredNorm() > b.squaredNorm() ? a : b;
-    least.direction = v.norm() > 0.0 ? Eigen::Vector2d(v.normalized()) : Eigen::Vector2d(1.0, 0.0);
+    least.direction = eigen.larger_vector;
   }
   return least;
 }
@@ -557,13 +570,15 @@ double PredictionSumOfSquares(const PixelUncertainty& uncertainty, const Camera&
   for (size_t i = 0; i < points.size(); ++i) {
     const std::optional<Eigen::Vector2d> pixel = PixelFromWorld(camera, points[i]);
     if (!pixel) return std::numeric_limits<double>::infinity();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> free(Eigen::Matrix2d::Identity() -
-                                                              uncertainty.HatAt(i));
-    const Eigen::Vector2d r = free.eigenvectors().transpose() * (*pixel - observed[i]);
-    for (int k = 0; k < 2; ++k) {
-      const double loo_error = r(k) / std::max(free.eigenvalues()(k), kMinFreeLeverage);
-      press += loo_error * loo_error;
-    }
+    // The residual along each eigenvector of I - H_ii (the other is the larger's turned by 90
+    // degrees), over its eigenvalue.
+    const SymmetricEigen2 free = EigenOf(Eigen::Matrix2d::Identity() - uncertainty.HatAt(i));
+    const Eigen::Vector2d r = *pixel - observed[i];
+    const Eigen::Vector2d& v = free.larger_vector;
+    const double along_larger = v.dot(r) / std::max(free.larger, kMinFreeLeverage);
+    const double along_smaller =
+        (v.x() * r.y() - v.y() * r.x()) / std::max(free.smaller, kMinFreeLeverage);
+    press += along_larger * along_larger + along_smaller * along_smaller;
   }
   return press;
 }
