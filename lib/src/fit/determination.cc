@@ -402,6 +402,11 @@ class PixelUncertainty {
   bool singular_ = false;
 };
 
+// A symmetric 2 x 2 matrix's larger eigenvalue, in closed form: mean + radius (EigenOf's).
+double LargerEigenvalueOf(const Eigen::Matrix2d& h) {
+  return 0.5 * (h(0, 0) + h(1, 1)) + std::hypot(0.5 * (h(0, 0) - h(1, 1)), h(0, 1));
+}
+
 // A symmetric 2 x 2 matrix's eigenvalues and the larger one's unit eigenvector, in closed form:
 // mean +- radius, and (h01, larger - h00) or, where that vanishes (a diagonal matrix with
 // h00 >= h11), (larger - h11, h01) = (2 radius, 0), the longer of the two.
@@ -432,12 +437,13 @@ PointReliability LeastChecked(const PixelUncertainty& uncertainty,
   PointReliability least;
   least.checked = true;
   for (size_t i = 0; i < hats.size(); ++i) {
-    const SymmetricEigen2 eigen = EigenOf(hats[i] ? *hats[i] : uncertainty.HatAt(i));
-    const double redundancy = std::max(0.0, 1.0 - eigen.larger);
+    const Eigen::Matrix2d h = hats[i] ? *hats[i] : uncertainty.HatAt(i);
+    // The larger eigenvalue alone first: the eigenvector only for a new least checked point.
+    const double redundancy = std::max(0.0, 1.0 - LargerEigenvalueOf(h));
     if (least.point >= 0 && !(redundancy < least.redundancy)) continue;
     least.point = static_cast<int>(i);
     least.redundancy = redundancy;
-    least.direction = eigen.larger_vector;
+    least.direction = EigenOf(h).larger_vector;
   }
   return least;
 }
