@@ -664,13 +664,15 @@ TestPoints WithScaledBox(TestPoints around, const Camera& camera,
 struct RivalShift {
   double px = 0.0;
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // the returned camera's
+  std::vector<double> rival_sigmas;  // the rival's sigma at each test point
 };
 RivalShift ShiftOf(const Camera& camera, const FittedRival& rival, const Eigen::Vector3d& flip,
                    const TestPoints& test, bool exempt) {
   TestPoints their_test = test;  // as the rival sees them (a mirrored reading: z negated)
   for (Eigen::Vector3d& x : their_test.points) x = flip.asDiagonal() * x;
-  const std::vector<double> rival_sigmas = SigmasAt(rival.uncertainty, their_test);
   RivalShift shift;
+  shift.rival_sigmas = SigmasAt(rival.uncertainty, their_test);
+  const std::vector<double>& rival_sigmas = shift.rival_sigmas;
   for (size_t i = 0; i < test.points.size(); ++i) {
     const std::optional<Eigen::Vector2d> ours = PixelFromWorld(camera, test.points[i]);
     const std::optional<Eigen::Vector2d> theirs = PixelFromWorld(rival.camera, their_test.points[i]);
@@ -768,22 +770,38 @@ std::vector<FittedRival> FittedRivals(const Selection& selection, const UnitWorl
 // adds about 25 / sigma^2 to its sum of squares, beyond kAveragedCriterion at the 1 px prior), and
 // N of them would cost N sigmas per model (the click benchmark's answers are the same without
 // them). A rival that puts a point behind it makes the spread infinite there.
+// `known`: sigmas already computed at the first points of `around` (the same numbers SigmasAt
+// gives): known[0] the returned camera's, known[1 + m] rival m's; a shorter or empty vector
+// where fewer or none are known.
 void AverageOverModels(const Camera& camera, const PixelUncertainty& uncertainty,
                        const std::vector<FittedRival>& rivals, const TestPoints& around,
+                       const std::vector<std::vector<double>>& known,
                        DeterminationCheck* check) {
   double total_weight = 1.0;
   for (const FittedRival& r : rivals) total_weight += r.weight;
   if (total_weight == 1.0) return;
   TestPoints beyond;
+  std::vector<size_t> index;  // of each point of `beyond` in `around`
   for (size_t i = 0; i < around.points.size(); ++i) {
     if (around.fitted[i] >= 0) continue;
     beyond.points.push_back(around.points[i]);
     beyond.fitted.push_back(-1);
+    index.push_back(i);
   }
-  const std::vector<double> own_sigmas = SigmasAt(uncertainty, beyond);
+  // One model's sigmas at `beyond`: read where known, else computed.
+  auto sigmas_of = [&](const PixelUncertainty& model, size_t slot) {
+    const bool all_known = slot < known.size() &&
+                           std::all_of(index.begin(), index.end(),
+                                       [&](size_t i) { return i < known[slot].size(); });
+    if (!all_known) return SigmasAt(model, beyond);
+    std::vector<double> read(index.size());
+    for (size_t j = 0; j < index.size(); ++j) read[j] = known[slot][index[j]];
+    return read;
+  };
+  const std::vector<double> own_sigmas = sigmas_of(uncertainty, 0);
   std::vector<std::vector<double>> their_sigmas(rivals.size());
   for (size_t m = 0; m < rivals.size(); ++m) {
-    if (rivals[m].weight > 0.0) their_sigmas[m] = SigmasAt(rivals[m].uncertainty, beyond);
+    if (rivals[m].weight > 0.0) their_sigmas[m] = sigmas_of(rivals[m].uncertainty, 1 + m);
   }
   std::vector<Eigen::Vector2d> pixels(rivals.size());
   for (size_t i = 0; i < beyond.points.size(); ++i) {
@@ -934,6 +952,12 @@ DeterminationCheck CheckDetermination(const Selection& selection,
           : nullptr;
   std::optional<TestPoints> lens_shift_test;
   if (lens_shift) lens_shift_test = WithScaledBox(*rival_test, camera, points, kLensShiftBoxScale);
+  // The sigmas known at the first points of *rival_test, for the model average: the returned
+  // camera's where the rivals' box is its own (a scene thicker than kRivalBoxThickness), each
+  // rival's where its shift was judged over rival_test (or the lens-shift test, which begins
+  // with it).
+  std::vector<std::vector<double>> known(1 + fitted.size());
+  if (rival_test && rival_test->points == test) known[0] = sigmas;
   for (const FittedRival* counted_rival : counted) {
     const FittedRival& c = *counted_rival;
     const Rival& rival = *c.rival;
@@ -952,7 +976,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
         NestedRivalWithinItsNoise(selection, rival, sigma)) {
       continue;
     }
-    const RivalShift shift = ShiftOf(camera, c, flip, our_test, exempt);
+    RivalShift shift = ShiftOf(camera, c, flip, our_test, exempt);
     if (!(shift.px <= check.rival_shift_px)) {
       check.rival_shift_px = shift.px;
       check.rival_worst_pixel = shift.pixel;
@@ -960,13 +984,17 @@ DeterminationCheck CheckDetermination(const Selection& selection,
       check.rival_predicts_better = &c == predicts_better;
       check.rival_frees_lens_shift = &c == lens_shift;
     }
+    if (!rival.mirrored_world) {
+      known[1 + static_cast<size_t>(&c - fitted.data())] = std::move(shift.rival_sigmas);
+    }
   }
   // The model average over the rivals' test points; for coplanar points over their own (in their
   // plane, and the object points): a plane determines no model with a free intrinsic off itself,
   // and the bundled plane was refused at 30 px off it (docs/model-selection.md).
   if (rival_test) {
     AverageOverModels(camera, uncertainty, fitted,
-                      selection.fit.planar ? test_points : *rival_test, &check);
+                      selection.fit.planar ? test_points : *rival_test,
+                      selection.fit.planar ? std::vector<std::vector<double>>() : known, &check);
   }
   check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px &&
                  check.averaged_sigma_px <= check.bound_px;
