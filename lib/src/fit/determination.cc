@@ -6,6 +6,7 @@
 #include <numeric>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -706,15 +707,14 @@ bool Nests(const FitOptions& outer, const FitOptions& inner) {
 // |(J^T J)^1/2 delta| = (sigma_x / sigma) sqrt(delta^T J^T J delta) (Cauchy-Schwarz; sigma_x its
 // ReprojectionSigmaPx there), and delta^T J^T J delta is the drop in the sum of squares from the
 // chosen fit to the rival's. So a drop of at most (kNestedRivalBound sigma)^2 moves no point by
-// more than kNestedRivalBound sigma_x.
-bool NestedRivalWithinItsNoise(const Selection& selection, const Rival& rival, double sigma) {
+// more than kNestedRivalBound sigma_x. `chosen_sum_squares`: the chosen fit's (px^2).
+bool NestedRivalWithinItsNoise(const FitOptions& chosen, double chosen_sum_squares,
+                               const Rival& rival, double sigma) {
   if (rival.mirrored_world || rival.same_model || rival.sum_squares_px2 < 0.0 ||
-      !Nests(rival.options, selection.options)) {
+      !Nests(rival.options, chosen)) {
     return false;
   }
-  double sum_squares = 0.0;
-  for (const Eigen::Vector2d& r : selection.fit.residuals_px) sum_squares += r.squaredNorm();
-  const double drop = sum_squares - rival.sum_squares_px2;
+  const double drop = chosen_sum_squares - rival.sum_squares_px2;
   // A rival above the chosen fit is at another minimum: not the linearized picture.
   return drop >= 0.0 && drop <= kNestedRivalBound * kNestedRivalBound * sigma * sigma;
 }
@@ -790,9 +790,9 @@ void AverageOverModels(const Camera& camera, const PixelUncertainty& uncertainty
   }
   // One model's sigmas at `beyond`: read where known, else computed.
   auto sigmas_of = [&](const PixelUncertainty& model, size_t slot) {
-    const bool all_known = slot < known.size() &&
-                           std::all_of(index.begin(), index.end(),
-                                       [&](size_t i) { return i < known[slot].size(); });
+    // `index` increases: its last entry decides.
+    const bool all_known =
+        slot < known.size() && (index.empty() || index.back() < known[slot].size());
     if (!all_known) return SigmasAt(model, beyond);
     std::vector<double> read(index.size());
     for (size_t j = 0; j < index.size(); ++j) read[j] = known[slot][index[j]];
@@ -842,6 +842,31 @@ void AverageOverModels(const Camera& camera, const PixelUncertainty& uncertainty
       check->averaged_rival = most ? most->rival->model : "";
     }
   }
+}
+
+// DeterminationCheck::summary of a check whose numbers are set; pixels in `origin_convention`.
+std::string SummaryOf(const DeterminationCheck& check, bool with_object_points,
+                      PixelOrigin origin_convention) {
+  std::string summary = "uncertain by up to " + Px(check.max_sigma_px) +
+                        " (1 sigma) over the box the points span" +
+                        (with_object_points ? " and the object points" : "") +
+                        ", most near pixel " + PixelText(check.worst_pixel, origin_convention) +
+                        "; bound " + Px(check.bound_px);
+  if (check.averaged_sigma_px > 0.0) {
+    summary += "; averaged over the models fitted (BIC weights), " +
+               (std::isfinite(check.averaged_sigma_px)
+                    ? Px(check.averaged_sigma_px)
+                    : std::string("a point behind one of their cameras")) +
+               " near pixel " + PixelText(check.averaged_worst_pixel, origin_convention) +
+               (check.averaged_rival.empty() ? "" : ", most from " + check.averaged_rival);
+  }
+  if (!check.rival.empty()) {
+    summary += "; " + check.rival + " fits about as well" +
+               (check.rival_predicts_better ? ", predicts each point from the others better,"
+                                            : "") +
+               " and moves a point by " + Px(check.rival_shift_px);
+  }
+  return summary;
 }
 
 }  // namespace
@@ -958,6 +983,15 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   // with it).
   std::vector<std::vector<double>> known(1 + fitted.size());
   if (rival_test && rival_test->points == test) known[0] = sigmas;
+  // Beyond kCrossValidationMaxPoints, the chosen fit's sum of squares for the nested rivals.
+  std::optional<double> chosen_sum_squares;
+  if (points.size() > kCrossValidationMaxPoints &&
+      selection.fit.residuals_px.size() == points.size()) {
+    chosen_sum_squares = 0.0;
+    for (const Eigen::Vector2d& r : selection.fit.residuals_px) {
+      *chosen_sum_squares += r.squaredNorm();
+    }
+  }
   for (const FittedRival* counted_rival : counted) {
     const FittedRival& c = *counted_rival;
     const Rival& rival = *c.rival;
@@ -971,9 +1005,8 @@ DeterminationCheck CheckDetermination(const Selection& selection,
     // is a different reading of the data rather than the rival's noise -- except for the rival
     // that predicts the points better and the lens-shift rival (above).
     const bool exempt = &c != predicts_better && &c != lens_shift;
-    if (exempt && points.size() > kCrossValidationMaxPoints &&
-        selection.fit.residuals_px.size() == points.size() &&
-        NestedRivalWithinItsNoise(selection, rival, sigma)) {
+    if (exempt && chosen_sum_squares &&
+        NestedRivalWithinItsNoise(selection.options, *chosen_sum_squares, rival, sigma)) {
       continue;
     }
     RivalShift shift = ShiftOf(camera, c, flip, our_test, exempt);
@@ -998,27 +1031,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   }
   check.passed = check.max_sigma_px <= check.bound_px && check.rival_shift_px <= check.bound_px &&
                  check.averaged_sigma_px <= check.bound_px;
-  const PixelOrigin origin_convention = options.fit.pixel_origin;
-  check.summary = "uncertain by up to " + Px(check.max_sigma_px) +
-                  " (1 sigma) over the box the points span" +
-                  (object_points.empty() ? "" : " and the object points") + ", most near pixel " +
-                  PixelText(check.worst_pixel, origin_convention) + "; bound " +
-                  Px(check.bound_px);
-  if (check.averaged_sigma_px > 0.0) {
-    check.summary += "; averaged over the models fitted (BIC weights), " +
-                     (std::isfinite(check.averaged_sigma_px)
-                          ? Px(check.averaged_sigma_px)
-                          : std::string("a point behind one of their cameras")) +
-                     " near pixel " + PixelText(check.averaged_worst_pixel, origin_convention) +
-                     (check.averaged_rival.empty() ? "" : ", most from " + check.averaged_rival);
-  }
-  if (!check.rival.empty()) {
-    check.summary += "; " + check.rival + " fits about as well" +
-                     (check.rival_predicts_better
-                          ? ", predicts each point from the others better,"
-                          : "") +
-                     " and moves a point by " + Px(check.rival_shift_px);
-  }
+  check.summary = SummaryOf(check, !object_points.empty(), options.fit.pixel_origin);
   return check;
 }
 
