@@ -131,9 +131,17 @@ using ParameterMatrix =
 // length and aspect scale (fx, fy by 1 + a; fy by 1 + a), the principal point and skew move by
 // a * fx, k1 and k2 by a.
 struct Linearization {
+  Linearization() = default;
+  Linearization(const Camera& at, double scale, std::vector<Parameter> parameters)
+      : camera(at), length_scale(scale), params(std::move(parameters)),
+        pose_columns(camera.projection == Projection::kOrthographic ? 5 : 6) {}
+
   Camera camera;
   double length_scale = 1.0;
   std::vector<Parameter> params;
+  // The pose's parameters, first in params (ParametersOf): 3 turns, then 3 eye steps (2 for an
+  // orthographic camera, which does not see a step along its gaze).
+  size_t pose_columns = 6;
 };
 
 // d pixel / d parameter (2 x params) at every point, analytic; rows 2i, 2i+1 for point i.
@@ -180,13 +188,27 @@ std::optional<size_t> PixelJacobian(const Linearization& at, const Eigen::Vector
       by_k1 = pixel_by_distorted * Eigen::Vector2d(x, y) * r2;
       by_k2 = by_k1 * r2;
     }
-    for (size_t j = 0; j < at.params.size(); ++j) {
-      const Parameter& param = at.params[j];
-      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(param.axis);
+    // The pose's columns (ParametersOf puts them first): by_point times e_a x p, a turn about
+    // camera axis a, and times -length_scale e_a, a step of the eye along it.
+    auto set = [&](int j, const Eigen::Vector2d& column) {
+      (*jacobian)(2 * i, j) = column.x();
+      (*jacobian)(2 * i + 1, j) = column.y();
+    };
+    const Eigen::Vector2d b0 = by_point.col(0);
+    const Eigen::Vector2d b1 = by_point.col(1);
+    const Eigen::Vector2d b2 = by_point.col(2);
+    set(0, b1 * -p.z() + b2 * p.y());
+    set(1, b2 * -p.x() + b0 * p.z());
+    set(2, b0 * -p.y() + b1 * p.x());
+    const double step = -at.length_scale;
+    set(3, b0 * step);
+    set(4, b1 * step);
+    if (!orthographic) set(5, b2 * step);
+    for (size_t j = at.pose_columns; j < at.params.size(); ++j) {
       Eigen::Vector2d column = Eigen::Vector2d::Zero();  // every kind sets it below
-      switch (param.kind) {
-        case kRotation: column = by_point * axis.cross(p); break;
-        case kEye: column = by_point * (-at.length_scale * axis); break;
+      switch (at.params[j].kind) {
+        case kRotation:
+        case kEye: break;  // above
         case kFocal: column = scaled; break;
         case kAspect: column << 0.0, scaled.y(); break;
         case kCx: column << k.fx, 0.0; break;
@@ -200,7 +222,7 @@ std::optional<size_t> PixelJacobian(const Linearization& at, const Eigen::Vector
           break;
         }
       }
-      jacobian->template block<2, 1>(2 * i, j) = column;
+      set(static_cast<int>(j), column);
     }
   }
   return std::nullopt;
@@ -282,7 +304,8 @@ class PixelUncertainty {
     constexpr size_t kBlock = 256;  // points per block of J: large enough for a blocked product
     const size_t count = fitted_points.size();
     if (count <= kKeptJacobianPoints) jacobian_.resize(2 * count, params.size());
-    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(params.size(), params.size());
+    // J^T J's lower triangle (a symmetric rank update per block: half the products).
+    Eigen::MatrixXd lower = Eigen::MatrixXd::Zero(params.size(), params.size());
     std::vector<Eigen::Vector3d> block;
     Eigen::MatrixXd block_jacobian;
     for (size_t begin = 0; begin < count; begin += kBlock) {
@@ -291,11 +314,12 @@ class PixelUncertainty {
       const std::optional<size_t> behind =
           PixelJacobian(at_, block.data(), block.size(), &block_jacobian);
       Require(!behind, "point ", begin + behind.value_or(0), " is not in front of the camera");
-      normal.noalias() += block_jacobian.transpose() * block_jacobian;
+      lower.selfadjointView<Eigen::Lower>().rankUpdate(block_jacobian.transpose());
       if (jacobian_.size() > 0) {
         jacobian_.middleRows(2 * begin, block_jacobian.rows()) = block_jacobian;
       }
     }
+    const Eigen::MatrixXd normal = lower.selfadjointView<Eigen::Lower>();
     // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
     // through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
     // (fit/common.h, InverseCholeskyOfScaled: W = D X^T), else through the eigen-decomposition,
