@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "fit/common.h"
 #include "fit/model.h"
 #include "fit/normal_equations.h"
+#include "fit/reprojection_error.h"
 #include "fit/statistics.h"
 
 namespace camproj {
@@ -164,14 +166,22 @@ MovedCamera MoveCamera(const RefinedCamera& at, const ParamVector& u) {
 // Sum of squared residuals of the scene at `u` from `at`; infinite when a point is not in front.
 double SumOfSquaresAt(const Scene& scene, const RefinedCamera& at, const ParamVector& u) {
   const MovedCamera moved = MoveCamera(at, u);
-  double sum = 0.0;
-  for (int i = 0; i < scene.NumPoints(); ++i) {
-    const std::optional<Eigen::Vector2d> pixel =
-        PixelOfCamPoint(moved.model, moved.rotation * (scene.points[i] - moved.center));
-    if (!pixel) return std::numeric_limits<double>::infinity();
-    sum += (*pixel - scene.pixels[i]).squaredNorm();
-  }
-  return sum;
+  // The residuals as the fit's normal equations compute them (ResidualOfCamPoint, whose cost
+  // at.normal.cost is), without their derivatives.
+  auto sum_of_squares = [&](auto radial_only) {
+    double sum = 0.0;
+    for (int i = 0; i < scene.NumPoints(); ++i) {
+      const Eigen::Vector3d p = moved.rotation * (scene.points[i] - moved.center);
+      if (!(p.z() > 0.0)) return std::numeric_limits<double>::infinity();
+      double r[2];
+      ResidualOfCamPoint<decltype(radial_only)::value>(moved.model.value.data(), p,
+                                                       scene.pixels[i], r, nullptr, nullptr);
+      sum += r[0] * r[0] + r[1] * r[1];
+    }
+    return sum;
+  };
+  return RadialOnly(moved.model.value.data()) ? sum_of_squares(std::true_type())
+                                              : sum_of_squares(std::false_type());
 }
 
 // The profile of the sum of squares at `u`: its minimum over the hyperplane through u orthogonal

@@ -331,6 +331,7 @@ class PixelUncertainty {
     if (inverse_cholesky && ReciprocalConditionLowerBoundOf(*inverse_cholesky) >
                                 kBoundMargin * kSingularRcond) {
       whitening_ = d_inverse.asDiagonal() * inverse_cholesky->transpose();
+      upper_triangular_ = true;
       return;
     }
     const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
@@ -362,7 +363,7 @@ class PixelUncertainty {
   // moves its prediction (identity where J^T J is singular).
   Eigen::Matrix2d HatAt(size_t i) const {
     if (singular_) return Eigen::Matrix2d::Identity();
-    const PointRows rows = FittedRows(i).lazyProduct(whitening_);
+    const PointRows rows = Whitened(FittedRows(i));
     return rows * rows.transpose();
   }
 
@@ -392,7 +393,7 @@ class PixelUncertainty {
       *hat = Eigen::Matrix2d::Identity();
       return std::numeric_limits<double>::infinity();
     }
-    const PointRows whitened = FittedRows(i).lazyProduct(whitening_);
+    const PointRows whitened = Whitened(FittedRows(i));
     *hat = whitened * whitened.transpose();
     return sigma_px_ * std::sqrt(whitened.squaredNorm());
   }
@@ -413,9 +414,28 @@ class PixelUncertainty {
     return jacobian;
   }
 
+  // A point's rows times W: where W is upper triangular (the Cholesky path), without the
+  // products with its zeros (p (p + 1) of the 2 p^2 multiply-adds).
+  PointRows Whitened(const PointRows& rows) const {
+    if (!upper_triangular_) return rows.lazyProduct(whitening_);
+    const int p = static_cast<int>(whitening_.cols());
+    PointRows whitened(2, p);
+    for (int j = 0; j < p; ++j) {
+      double first = 0.0;
+      double second = 0.0;
+      for (int k = 0; k <= j; ++k) {
+        first += rows(0, k) * whitening_(k, j);
+        second += rows(1, k) * whitening_(k, j);
+      }
+      whitened(0, j) = first;
+      whitened(1, j) = second;
+    }
+    return whitened;
+  }
+
   // The 1-sigma length of a point's reprojection error from its Jacobian (2 x params).
   double SigmaOf(const PointRows& jacobian) const {
-    return sigma_px_ * std::sqrt(jacobian.lazyProduct(whitening_).squaredNorm());
+    return sigma_px_ * std::sqrt(Whitened(jacobian).squaredNorm());
   }
 
   double sigma_px_;
@@ -424,6 +444,7 @@ class PixelUncertainty {
   Linearization at_;
   Eigen::MatrixXd jacobian_;   // J (2 rows per fitted point), empty beyond kKeptJacobianPoints
   ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
+  bool upper_triangular_ = false;  // W = D X^T (the Cholesky path), else dense
   bool singular_ = false;
 };
 
