@@ -57,10 +57,11 @@ namespace {
 
 // SQPnP on normalized image coordinates (x, y) = (X/Z, Y/Z): K = I (fit/sqpnp.h).
 bool SqPnp(const std::vector<Eigen::Vector3d>& points,
-           const std::vector<Eigen::Vector2d>& normalized, StartCamera* start) {
+           const std::vector<Eigen::Vector2d>& normalized, StartCamera* start,
+           SqPnpSearch search = SqPnpSearch::kGlobal) {
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation;
-  if (!SolveSqPnp(points, normalized, &rotation, &translation)) return false;
+  if (!SolveSqPnp(points, normalized, &rotation, &translation, search)) return false;
   start->rotation = rotation;
   start->center = -rotation.transpose() * translation;
   return true;
@@ -294,7 +295,7 @@ bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
 
 bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
-              StartCamera* start) {
+              StartCamera* start, SqPnpSearch search) {
   std::vector<Eigen::Vector2d> normalized;
   normalized.reserve(pixels.size());
   try {
@@ -305,7 +306,7 @@ bool PnpStart(const std::vector<Eigen::Vector3d>& points,
   } catch (const std::domain_error&) {
     return false;
   }
-  if (!SqPnp(points, normalized, start)) return false;
+  if (!SqPnp(points, normalized, start, search)) return false;
   start->intrinsics = intrinsics;
   return true;
 }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "camproj/intrinsics.h"
+#include "fit/sqpnp.h"
 
 namespace camproj {
 namespace internal {
@@ -66,10 +67,11 @@ bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
                      bool aspect_free, StartCamera* start);
 
 // Pose from known intrinsics (distortion included) by SQPnP (fit/sqpnp.h: OpenCV's
-// SOLVEPNP_SQPNP pose), >= 3 points. Returns false if SQPnP refuses.
+// SOLVEPNP_SQPNP pose), >= 3 points. Returns false if SQPnP refuses. `search`: SolveSqPnp's
+// (kFirstMinimum only for a start kept where it ends lower than another).
 bool PnpStart(const std::vector<Eigen::Vector3d>& points,
               const std::vector<Eigen::Vector2d>& pixels, const Intrinsics& intrinsics,
-              StartCamera* start);
+              StartCamera* start, SqPnpSearch search = SqPnpSearch::kGlobal);
 
 // The shortest focal length FocalSweepStart tries: a 175-degree view across the image width.
 double SweepMinFocalPx(int image_width);

@@ -36,11 +36,18 @@ void KeepTheLower(LeastSquaresOutcome other, LeastSquaresOutcome* best) {
 }
 
 // Refines from `model` (its free values the start) with an SQPnP pose for its pinhole part,
-// and makes it `*best` if it ends at a lower cost.
+// and makes it `*best` if it ends at a lower cost. The pose is SQPnP's first minimum
+// (SqPnpSearch::kFirstMinimum): the intrinsics here are a guess the points need not fit, where
+// OpenCV's search goes on through every eigenvector (at 6 points 11 % of one fit); a worse start
+// only ends higher and is dropped. Measured on 12000 one fits at 6-10 points: the same minima
+// (docs/model-selection.md, session 29).
 void RefineAlsoFrom(const Scene& scene, const Model& model, const FitOptions& options,
                     Clock::time_point start_time, PolishUntil until, LeastSquaresOutcome* best) {
   StartCamera start;
-  if (!PnpStart(scene.points, scene.pixels, model.ToIntrinsics(), &start)) return;
+  if (!PnpStart(scene.points, scene.pixels, model.ToIntrinsics(), &start,
+                SqPnpSearch::kFirstMinimum)) {
+    return;
+  }
   KeepTheLower(RefineLeastSquares(scene.points, scene.pixels, start.rotation, start.center, model,
                                   options, start_time, kMaxLeastSquaresRounds, PolishFirst::kNo,
                                   until),

@@ -710,9 +710,9 @@ bool SearchPlanar(const Problem& problem, const Eigen::Vector3d& normal, Search*
 // SmallestEigenvector) where OpenCV's largest-eigenvalue refusal cannot apply (trace >= 9
 // kMinLargestEigenvalue), the null space has at most 1 dimension, and after the smallest
 // eigenvector's SQP (OpenCV's first step) no further eigenvector is wanted: fewer than 2
-// eigenvalues below min_cost / 3, and the best pose has every point in front. Otherwise the full
-// decomposition. False on OpenCV's refusals.
-bool SearchGeneral(const Problem& problem, Search* search) {
+// eigenvalues below min_cost / 3 (with `extent` kFirstMinimum: whatever they are), and the best
+// pose has every point in front. Otherwise the full decomposition. False on OpenCV's refusals.
+bool SearchGeneral(const Problem& problem, SqPnpSearch extent, Search* search) {
   const Matrix9& omega = problem.omega;
   Vector9 smallest;
   bool started = false;
@@ -720,6 +720,7 @@ bool SearchGeneral(const Problem& problem, Search* search) {
     search->SearchNullSpace<1>(smallest, 1);
     started = true;
     if (search->best_all_in_front()) {
+      if (extent == SqPnpSearch::kFirstMinimum) return true;
       const int below = CountBelow(omega, search->min_cost() / 3.0);
       if (below >= 0 && below <= 1) return true;
     }
@@ -778,7 +779,7 @@ Vector9 Polished(const Problem& problem, const Search& search) {
 
 bool SolveSqPnp(const std::vector<Eigen::Vector3d>& points_in_world,
                 const std::vector<Eigen::Vector2d>& normalized, Eigen::Matrix3d* rotation,
-                Eigen::Vector3d* translation) {
+                Eigen::Vector3d* translation, SqPnpSearch extent) {
   Problem problem;
   Eigen::Matrix3d scatter;
   if (!BuildProblem(points_in_world, normalized, &problem, &scatter)) return false;
@@ -787,7 +788,8 @@ bool SolveSqPnp(const std::vector<Eigen::Vector3d>& points_in_world,
   const Eigen::Vector3d normal = shape.eigenvectors().col(0);
   const bool planar = shape.eigenvalues()(0) <= kPlanar * shape.eigenvalues()(2);
   Search search(problem);
-  if (!(planar ? SearchPlanar(problem, normal, &search) : SearchGeneral(problem, &search))) {
+  if (!(planar ? SearchPlanar(problem, normal, &search)
+               : SearchGeneral(problem, extent, &search))) {
     return false;
   }
   if (!std::isfinite(search.best().cost)) return false;

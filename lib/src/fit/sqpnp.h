@@ -66,9 +66,18 @@ namespace internal {
 // spread (the variance of x plus that of y) below 1e-5, an Omega whose largest eigenvalue is
 // below 1e-7 or with more than 6 eigenvalues below 1e-7 (the three as OpenCV refuses), or no
 // minimum with the points in front. `rotation` and `translation` are written only on success.
+//
+// With SqPnpSearch::kFirstMinimum, non-planar points: the search stops after the smallest
+// eigenvector's SQP where that found a pose with every point in front (the fast path above,
+// without its test for further eigenvectors), and runs in full otherwise. Not the global minimum
+// where a further eigenvector's is lower -- at times the pose turned by 180 degrees at many times
+// the cost (tests/sqpnp_test.cc) -- so only for a start that least squares refines and keeps only
+// where it ends lower than another (fit/refine.cc), where the intrinsics are a guess that the
+// points need not fit and OpenCV's rule then searches every eigenvector (~4x the instructions).
+enum class SqPnpSearch { kGlobal, kFirstMinimum };
 bool SolveSqPnp(const std::vector<Eigen::Vector3d>& points_in_world,
                 const std::vector<Eigen::Vector2d>& normalized, Eigen::Matrix3d* rotation,
-                Eigen::Vector3d* translation);
+                Eigen::Vector3d* translation, SqPnpSearch search = SqPnpSearch::kGlobal);
 
 // The proper rotation nearest to m in the Frobenius norm, by SVD: U diag(1, 1, det(U V^T)) V^T;
 // any of them where it is not unique. SQPnP's fall-back, and the homography start's
