@@ -148,6 +148,7 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
   effort.skip_restarts_when_consistent_at_px = consistent_at_px;
   effort.check_linearity = false;
   effort.describe = false;
+  effort.linearization = reuse.linearization;
   return Fit(points_in_world, observed_pixels, image_size, options, effort);
 }
 

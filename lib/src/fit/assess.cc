@@ -287,6 +287,11 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const int n = scene.NumPoints();
   const Model& model = refined.model;
   const int num_params = 6 + model.NumFree();
+  if (effort.linearization != nullptr) {
+    *effort.linearization = ChartLinearization{refined.normal.jtj, refined.rotation,
+                                               refined.center,     model,
+                                               scene.centroid,     scene.scale};
+  }
   FitResult result;
   result.iterations = refined.iterations;
   result.refiner = std::move(refined.refiner);

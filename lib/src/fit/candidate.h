@@ -40,6 +40,7 @@
 #include <Eigen/Core>
 
 #include "camproj/fit.h"
+#include "fit/normal_equations.h"
 #include "fit/scene.h"
 
 namespace camproj {
@@ -52,6 +53,9 @@ struct CandidateReuse {
   const Camera* warm_start = nullptr;
   // The same points prepared once (fit/scene.h, PrepareScene), for options.pixel_origin.
   const SceneGeometry* geometry = nullptr;
+  // Not a reuse but a return: if not null, receives the fit's normal equations at its answer
+  // (a perspective fit's; left empty otherwise), for the determination check's rivals.
+  ChartLinearization* linearization = nullptr;
 };
 
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`

@@ -64,7 +64,8 @@ inline double RmsRowLength(const Eigen::MatrixXd& centred) {
   return std::sqrt((unit * centred).squaredNorm() / static_cast<double>(centred.rows())) / unit;
 }
 
-struct SceneGeometry;  // fit/scene.h
+struct SceneGeometry;       // fit/scene.h
+struct ChartLinearization;  // fit/normal_equations.h
 
 // What a fit may leave out when the model selection only scores it (fit/candidate.h). The
 // default leaves out nothing: every FitCamera call.
@@ -84,6 +85,8 @@ struct FitEffort {
   // The correspondences already prepared (fit/scene.h, PrepareScene): the scene is made from
   // them instead of again from the points.
   const SceneGeometry* geometry = nullptr;
+  // If not null, receives the answer's normal equations (AssessFit; perspective fits only).
+  ChartLinearization* linearization = nullptr;
 };
 
 // J^T J with its columns scaled to a unit diagonal (Jacobi): its smallest over largest

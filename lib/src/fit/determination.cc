@@ -18,6 +18,8 @@
 #include "check.h"
 #include "fit/common.h"
 #include "fit/gate.h"
+#include "fit/normal_equations.h"
+#include "fit/reprojection_error.h"
 #include "fit/statistics.h"
 
 namespace camproj {
@@ -319,30 +321,26 @@ class PixelUncertainty {
         jacobian_.middleRows(2 * begin, block_jacobian.rows()) = block_jacobian;
       }
     }
-    const Eigen::MatrixXd normal = lower.selfadjointView<Eigen::Lower>();
-    // Jacobi scaling (the parameters' units differ by orders of magnitude), then the inverse
-    // through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
-    // (fit/common.h, InverseCholeskyOfScaled: W = D X^T), else through the eigen-decomposition,
-    // refusing near-singular directions.
-    constexpr double kBoundMargin = 1e3;
-    const Eigen::VectorXd d_inverse = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
-    const std::optional<ParameterMatrix> inverse_cholesky =
-        InverseCholeskyOfScaled(ParameterMatrix(normal));
-    if (inverse_cholesky && ReciprocalConditionLowerBoundOf(*inverse_cholesky) >
-                                kBoundMargin * kSingularRcond) {
-      whitening_ = d_inverse.asDiagonal() * inverse_cholesky->transpose();
-      upper_triangular_ = true;
-      return;
+    SetWhitening(lower.selfadjointView<Eigen::Lower>());
+  }
+
+  // From a fit's own normal equations at its answer (the selection's rivals: `chart`, which must
+  // outlive this object) instead of a pass over the points: the same sigmas, to the step between
+  // those normal equations and the answer (a point's sigma does not depend on the
+  // parameterization). `origin` and `unit` map the unit world of `fitted_points` and of the points
+  // asked about to the world (UnitWorld). Throws std::invalid_argument if a fitted point is not in
+  // front of the camera.
+  PixelUncertainty(const ChartLinearization& chart, const Eigen::Vector3d& origin, double unit,
+                   const std::vector<Eigen::Vector3d>& fitted_points, double sigma_px)
+      : sigma_px_(sigma_px), fitted_(&fitted_points), chart_(&chart), origin_(origin),
+        unit_(unit),
+        radial_only_(RadialOnly(chart.model.value.data()) && !chart.model.free[7] &&
+                     !chart.model.free[8] && !chart.model.free[9]) {
+    Require(!fitted_points.empty(), "no fitted points");
+    for (size_t i = 0; i < fitted_points.size(); ++i) {
+      Require(InChart(fitted_points[i]).z() > 0.0, "point ", i, " is not in front of the camera");
     }
-    const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
-    const Eigen::VectorXd values = eigen.eigenvalues();
-    singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));
-    if (singular_) return;
-    // (J^T J)^-1 = W W^T with W = D^-1 V L^-1/2 (scaled = V L V^T): a point's variance is the
-    // squared norm of J_x W.
-    whitening_ = d_inverse.asDiagonal() * eigen.eigenvectors() *
-                 values.cwiseSqrt().cwiseInverse().asDiagonal();
+    SetWhitening(Eigen::MatrixXd(chart.jtj));
   }
 
   // The 1-sigma length of the reprojection error of `x`; +inf where J^T J is singular or `x` is
@@ -350,6 +348,10 @@ class PixelUncertainty {
   double SigmaAt(const Eigen::Vector3d& x) const {
     const double infinity = std::numeric_limits<double>::infinity();
     if (singular_) return infinity;
+    if (chart_ != nullptr) {
+      const std::optional<PointRows> rows = ChartRows(x);
+      return rows ? SigmaOf(*rows) : infinity;
+    }
     PointRows jacobian;
     try {
       if (PixelJacobian(at_, &x, 1, &jacobian)) return infinity;
@@ -407,11 +409,74 @@ class PixelUncertainty {
 
   // Rows 2i, 2i + 1 of J: kept, or recomputed (the same numbers).
   PointRows FittedRows(size_t i) const {
+    if (chart_ != nullptr) return *ChartRows((*fitted_)[i]);  // in front: the constructor checked
     if (jacobian_.size() > 0) return jacobian_.middleRows<2>(2 * i);
     const Eigen::Vector3d x = Fitted(i);
     PointRows jacobian;
     PixelJacobian(at_, &x, 1, &jacobian);
     return jacobian;
+  }
+
+  // W from J^T J: Jacobi scaling (the parameters' units differ by orders of magnitude), then the
+  // inverse through the Cholesky factor where its bound clears kSingularRcond by kBoundMargin
+  // (fit/common.h, InverseCholeskyOfScaled: W = D X^T), else through the eigen-decomposition,
+  // refusing near-singular directions.
+  void SetWhitening(const Eigen::MatrixXd& normal) {
+    constexpr double kBoundMargin = 1e3;
+    const Eigen::VectorXd d_inverse = normal.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
+    const std::optional<ParameterMatrix> inverse_cholesky =
+        InverseCholeskyOfScaled(ParameterMatrix(normal));
+    if (inverse_cholesky && ReciprocalConditionLowerBoundOf(*inverse_cholesky) >
+                                kBoundMargin * kSingularRcond) {
+      whitening_ = d_inverse.asDiagonal() * inverse_cholesky->transpose();
+      upper_triangular_ = true;
+      return;
+    }
+    const Eigen::MatrixXd scaled = d_inverse.asDiagonal() * normal * d_inverse.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+    const Eigen::VectorXd values = eigen.eigenvalues();
+    singular_ = !(values(0) > kSingularRcond * values(values.size() - 1));
+    if (singular_) return;
+    // (J^T J)^-1 = W W^T with W = D^-1 V L^-1/2 (scaled = V L V^T): a point's variance is the
+    // squared norm of J_x W.
+    whitening_ = d_inverse.asDiagonal() * eigen.eigenvectors() *
+                 values.cwiseSqrt().cwiseInverse().asDiagonal();
+  }
+
+  // The Jacobian's rows at `x` (unit world) in the chart of chart_ (ComputeNormalEquations'
+  // columns: p x a for the turns, -a R for the centre, then the free slots' columns, with a the
+  // residual's derivative by the camera point p); nothing where x is not in front of the camera.
+  std::optional<PointRows> ChartRows(const Eigen::Vector3d& x) const {
+    const ChartLinearization& at = *chart_;
+    const Eigen::Vector3d p = InChart(x);
+    if (!(p.z() > 0.0)) return std::nullopt;
+    double residual[2];
+    double jk[2 * kFitIntrinsicsSize];
+    double jp[6];
+    if (radial_only_) {
+      ResidualOfCamPoint<true>(at.model.value.data(), p, Eigen::Vector2d::Zero(), residual, jk,
+                               jp);
+    } else {
+      ResidualOfCamPoint<false>(at.model.value.data(), p, Eigen::Vector2d::Zero(), residual, jk,
+                                jp);
+    }
+    PointRows rows(2, 6 + at.model.NumFree());
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector3d a(jp[3 * k], jp[3 * k + 1], jp[3 * k + 2]);
+      rows.block<1, 3>(k, 0) = p.cross(a).transpose();
+      rows.block<1, 3>(k, 3) = -(at.rotation.transpose() * a).transpose();
+      int column = 6;
+      for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+        if (at.model.free[slot]) rows(k, column++) = jk[k * kFitIntrinsicsSize + slot];
+      }
+    }
+    return rows;
+  }
+
+  // `x` (unit world) as chart_'s camera sees it.
+  Eigen::Vector3d InChart(const Eigen::Vector3d& x) const {
+    const ChartLinearization& at = *chart_;
+    return at.rotation * ((origin_ + unit_ * x - at.centroid) / at.scale - at.center);
   }
 
   // A point's rows times W: where W is upper triangular (the Cholesky path), without the
@@ -443,6 +508,13 @@ class PixelUncertainty {
   bool mirrored_z_ = false;
   Linearization at_;
   Eigen::MatrixXd jacobian_;   // J (2 rows per fitted point), empty beyond kKeptJacobianPoints
+  // Set by the constructor from a fit's normal equations (at_ and jacobian_ then unused).
+  const ChartLinearization* chart_ = nullptr;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // the unit world's, in the world
+  double unit_ = 1.0;
+  // chart_'s model has no tangential distortion or k3 and frees none (ResidualOfCamPoint<true>,
+  // which writes no column for them).
+  bool radial_only_ = false;
   ParameterMatrix whitening_;  // W: (J^T J)^-1 = W W^T
   bool upper_triangular_ = false;  // W = D X^T (the Cholesky path), else dense
   bool singular_ = false;
@@ -797,11 +869,17 @@ std::vector<FittedRival> FittedRivals(const Selection& selection, const UnitWorl
     const Camera rival_camera =
         InUnitWorld(rival.camera, flip.asDiagonal() * unit_world.origin, unit_world.unit);
     if (rival.same_model && SameMinimum(unit_world.camera, rival_camera, test)) continue;
+    // A fitted rival's uncertainty from its fit's own normal equations: no pass over the points.
+    const bool from_its_fit = rival.linearization != nullptr && !rival.mirrored_world &&
+                              rival.camera.projection == Projection::kPerspective;
     try {
-      fitted.push_back({&rival, rival_camera,
-                        PixelUncertainty(rival_camera, rival.options, unit_world.points, sigma,
-                                         rival.mirrored_world),
-                        about_as_well, averaged ? std::exp(-0.5 * excess) : 0.0});
+      fitted.push_back(
+          {&rival, rival_camera,
+           from_its_fit ? PixelUncertainty(*rival.linearization, unit_world.origin,
+                                           unit_world.unit, unit_world.points, sigma)
+                        : PixelUncertainty(rival_camera, rival.options, unit_world.points, sigma,
+                                           rival.mirrored_world),
+           about_as_well, averaged ? std::exp(-0.5 * excess) : 0.0});
     } catch (const std::invalid_argument&) {
     }
   }
@@ -927,6 +1005,17 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
                                         double sigma_px,
                                         const std::vector<Eigen::Vector3d>& test_points) {
   const PixelUncertainty uncertainty(camera, model, fitted_points, sigma_px);
+  std::vector<double> sigmas;
+  sigmas.reserve(test_points.size());
+  for (const Eigen::Vector3d& x : test_points) sigmas.push_back(uncertainty.SigmaAt(x));
+  return sigmas;
+}
+
+std::vector<double> ReprojectionSigmaFromFitPx(const ChartLinearization& fit,
+                                               const std::vector<Eigen::Vector3d>& fitted_points,
+                                               double sigma_px,
+                                               const std::vector<Eigen::Vector3d>& test_points) {
+  const PixelUncertainty uncertainty(fit, Eigen::Vector3d::Zero(), 1.0, fitted_points, sigma_px);
   std::vector<double> sigmas;
   sigmas.reserve(test_points.size());
   for (const Eigen::Vector3d& x : test_points) sigmas.push_back(uncertainty.SigmaAt(x));

@@ -36,6 +36,14 @@ std::vector<double> ReprojectionSigmaPx(const Camera& camera, const FitOptions& 
                                         double sigma_px,
                                         const std::vector<Eigen::Vector3d>& test_points);
 
+// ReprojectionSigmaPx read from a fit's own normal equations at its answer (the determination
+// check's fitted rivals) instead of a pass over the fitted points: the same sigmas, to the step
+// between those normal equations and the answer (the points in the world, as the fit's).
+std::vector<double> ReprojectionSigmaFromFitPx(const ChartLinearization& fit,
+                                               const std::vector<Eigen::Vector3d>& fitted_points,
+                                               double sigma_px,
+                                               const std::vector<Eigen::Vector3d>& test_points);
+
 // The assessment's check of a selection fitted on `kept_points` (model_select.h,
 // AutoFitOptions::max_uncertainty_px): the test points' uncertainty at the noise the selection's
 // sigmas use, and the largest shift of a test point by a rival that fits about as well, over the

@@ -34,6 +34,21 @@ struct NormalEquations {
 // Every intrinsic slot's value, free or fixed (Model::value's layout).
 using IntrinsicValues = std::array<double, kFitIntrinsicsSize>;
 
+// A fit's J^T J at its answer (or one settling step before it) in ComputeNormalEquations' chart
+// -- turns about the camera's axes, the centre in the scene's normalized world, then the model's
+// free slots in slot order -- with the answer there and the world's normalization
+// (point_in_world = centroid + scale * point). A point's reprojection sigma does not depend on
+// the parameterization, so the determination check reads a fitted rival's from this instead of
+// linearizing its camera over every point again (fit/determination.cc).
+struct ChartLinearization {
+  ParamMatrix jtj;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // point_in_cam = rotation * (x - center)
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Model model;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double scale = 1.0;
+};
+
 // The columns of the Jacobian in the camera's local frame (see LocalNormalEquations), split by
 // how they are summed: the principal point's two columns are the same for every point
 // (d residual / d (cx, cy) = I), so their rows of J^T J are sums of the other columns and need

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <cstdio>
 #include <limits>
 #include <optional>
@@ -97,6 +98,8 @@ struct Evaluation {
   SceneError::Reason reason = SceneError::Reason::kDegenerate;
   double sum_squares = 0.0;
   int num_params = 0;
+  // The fit's normal equations at its answer (perspective fits; null otherwise).
+  std::shared_ptr<const ChartLinearization> linearization = nullptr;
 };
 
 // `consistent_at_px`: the noise at which the candidate's fit may skip its restarts
@@ -109,9 +112,22 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
   e.options = options;
   e.num_params = NumParameters(options);
   try {
-    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, reuse);
+    // The fit's normal equations for the determination check, which reads a fitted rival's
+    // uncertainty from them instead of a pass over the points (fit/normal_equations.h): from
+    // kRivalLinearizationFromPoints on, where that pass costs more than keeping them (bench
+    // --stage-cost: 0.5 % more instructions at 6-12 points, 2.6 / 6.2 / 8.4 % fewer at 20 / 100 /
+    // 1000).
+    constexpr size_t kRivalLinearizationFromPoints = 20;
+    std::shared_ptr<ChartLinearization> linearization;
+    CandidateReuse with = reuse;
+    if (points.size() >= kRivalLinearizationFromPoints) {
+      linearization = std::make_shared<ChartLinearization>();
+      with.linearization = linearization.get();
+    }
+    e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, with);
     e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
+    if (linearization && linearization->jtj.size() > 0) e.linearization = std::move(linearization);
   } catch (const SceneError& error) {
     e.refusal = error.what();
     e.reason = error.reason();
@@ -337,7 +353,8 @@ size_t ModelSelector::Record(const Evaluation& e, const std::string& name,
     c.rms_px = e.fit->rms_px;
     c.criterion = CriterionOf(e);
     rivals_.push_back({e.fit->model, e.options, e.fit->camera, c.criterion,
-                       /*mirrored_world=*/false, /*same_model=*/false, e.sum_squares});
+                       /*mirrored_world=*/false, /*same_model=*/false, e.sum_squares,
+                       e.linearization});
   }
   c.verdict = verdict;
   tried_.push_back(c);

@@ -3,6 +3,7 @@
 #ifndef CAMPROJ_SRC_FIT_SELECTION_H_
 #define CAMPROJ_SRC_FIT_SELECTION_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
+#include "fit/normal_equations.h"
 #include "fit/scene.h"
 
 namespace camproj {
@@ -32,6 +34,8 @@ struct Rival {
   // Its sum of squared residuals (px^2) over the selection's points, where the selection fitted
   // it (a ladder's model); negative where not recorded.
   double sum_squares_px2 = -1.0;
+  // Its fit's normal equations at its answer, where the selection fitted it in perspective.
+  std::shared_ptr<const ChartLinearization> linearization = nullptr;
 };
 
 struct Selection {
