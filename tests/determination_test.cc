@@ -18,6 +18,7 @@
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "fit/candidate.h"
+#include "fit/selection.h"
 #include "seeds.h"
 #include "test_scenes.h"
 
@@ -156,6 +157,57 @@ TEST(DeterminationTest, SigmasFromTheFitsNormalEquationsAreThoseOfAPassOverThePo
               << n << " points, seed " << seed << ", point " << i << (k1 ? ", k1 free" : "");
           worst = std::max(worst, std::abs(from_fit[i] - from_pass[i]) / from_pass[i]);
         }
+      }
+    }
+    std::printf("[ INFO     ] %d points: largest relative difference %.3g\n", n, worst);
+  }
+}
+
+// The chosen model's normal equations as the selection keeps them (Selection::linearization:
+// from kLinearizationFromPoints points on, a perspective answer's; none below) give the sigmas of
+// a pass over the points at the returned camera. The refit settles (its last step under 1e-9 px)
+// and its normal equations are those one step back, where J differs by at most ~1e-9 relative
+// (measured: up to 1e-12; the rounding of the two inverses, condition below 1e4 here, is
+// ~1e-12).
+TEST(DeterminationTest, TheChosenFitsNormalEquationsGiveItsSigmas) {
+  constexpr double kSameLinearization = 1e-9;
+  for (const int n : {12, 20, 100}) {
+    double worst = 0.0;
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+      SynthOptions synth;
+      synth.seed = testing::Seed(700 + seed);
+      synth.num_points = n;
+      synth.noise_px = 0.5;
+      synth.principal_point_offset = Eigen::Vector2d(0.0, seed % 2 ? 0.5 : 0.0);
+      const SynthScene scene = SynthesizeScene(synth);
+      const Correspondences& c = scene.correspondences;
+      internal::Selection selection;
+      try {
+        selection = internal::SelectModel(c.points_in_world, c.pixels, synth.image_size,
+                                          AutoFitOptions());
+      } catch (const SceneError&) {
+        continue;  // a refusal keeps no normal equations
+      }
+      if (static_cast<size_t>(n) < internal::kLinearizationFromPoints) {
+        EXPECT_EQ(selection.linearization, nullptr) << n << " points, seed " << seed;
+        continue;
+      }
+      ASSERT_NE(selection.linearization, nullptr) << n << " points, seed " << seed;
+      std::vector<Eigen::Vector3d> test = c.points_in_world;
+      for (const Eigen::Vector3d& x :
+           internal::SceneTestPoints(selection.fit.camera, c.points_in_world, 0.5)) {
+        test.push_back(x);
+      }
+      const std::vector<double> from_fit = internal::ReprojectionSigmaFromFitPx(
+          *selection.linearization, c.points_in_world, 1.0, test);
+      const std::vector<double> from_pass = internal::ReprojectionSigmaPx(
+          selection.fit.camera, selection.options, c.points_in_world, 1.0, test);
+      ASSERT_EQ(from_fit.size(), from_pass.size());
+      for (size_t i = 0; i < test.size(); ++i) {
+        if (!std::isfinite(from_pass[i])) continue;
+        EXPECT_NEAR(from_fit[i], from_pass[i], kSameLinearization * from_pass[i])
+            << n << " points, seed " << seed << ", point " << i << ", " << selection.fit.model;
+        worst = std::max(worst, std::abs(from_fit[i] - from_pass[i]) / from_pass[i]);
       }
     }
     std::printf("[ INFO     ] %d points: largest relative difference %.3g\n", n, worst);

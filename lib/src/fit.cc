@@ -159,6 +159,7 @@ FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
   FitEffort effort;  // everything else computed
   effort.warm_start = reuse.warm_start;
   effort.geometry = reuse.geometry;
+  effort.linearization = reuse.linearization;
   return Fit(points_in_world, observed_pixels, image_size, options, effort);
 }
 

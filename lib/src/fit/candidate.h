@@ -69,8 +69,9 @@ FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
 
 // As FitCamera (fit.h), everything computed, restarts included, but started and prepared as
 // `reuse` says: the model selection's chosen model refitted with its covariance, from the
-// ladder's fit of it or (warm_start null) from its closed form. FitResult::start_method is
-// "warm" where reuse.warm_start is not null.
+// ladder's fit of it or (warm_start null) from its closed form, its normal equations returned
+// where reuse.linearization is not null. FitResult::start_method is "warm" where
+// reuse.warm_start is not null.
 FitResult FitReusing(const std::vector<Eigen::Vector3d>& points_in_world,
                     const std::vector<Eigen::Vector2d>& observed_pixels,
                     const ImageSize& image_size, const FitOptions& options,

@@ -1077,7 +1077,11 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   const TestPoints test_points = TestPointsOrFitted(camera, points, 0.0, object_points);
   const std::vector<Eigen::Vector3d>& test = test_points.points;
   const double sigma = selection.options.pixel_sigma.value_or(selection.sigma_px);
-  const PixelUncertainty uncertainty(camera, selection.options, points, sigma);
+  // From the chosen fit's own normal equations where it kept them (as a rival's, FittedRivals).
+  const PixelUncertainty uncertainty =
+      selection.linearization != nullptr && camera.projection == Projection::kPerspective
+          ? PixelUncertainty(*selection.linearization, origin, unit, points, sigma)
+          : PixelUncertainty(camera, selection.options, points, sigma);
   std::vector<std::optional<Eigen::Matrix2d>> hats(reliability != nullptr ? points.size() : 0);
   const std::vector<double> sigmas =
       SigmasAt(uncertainty, test_points, reliability != nullptr ? &hats : nullptr);

@@ -113,14 +113,10 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
   e.num_params = NumParameters(options);
   try {
     // The fit's normal equations for the determination check, which reads a fitted rival's
-    // uncertainty from them instead of a pass over the points (fit/normal_equations.h): from
-    // kRivalLinearizationFromPoints on, where that pass costs more than keeping them (bench
-    // --stage-cost: 0.5 % more instructions at 6-12 points, 2.6 / 6.2 / 8.4 % fewer at 20 / 100 /
-    // 1000).
-    constexpr size_t kRivalLinearizationFromPoints = 20;
+    // uncertainty from them (selection.h, kLinearizationFromPoints).
     std::shared_ptr<ChartLinearization> linearization;
     CandidateReuse with = reuse;
-    if (points.size() >= kRivalLinearizationFromPoints) {
+    if (points.size() >= kLinearizationFromPoints) {
       linearization = std::make_shared<ChartLinearization>();
       with.linearization = linearization.get();
     }
@@ -592,9 +588,16 @@ Selection ModelSelector::Refit(const Ladder& chosen, const std::vector<int>& can
   // included: the refit starts at that minimum at any count.
   const bool from_scratch = points_.size() < kFromScratchBelowPoints &&
                             !(prefit_ != nullptr && SameModel(prefit_->model, chosen.final_options));
-  selection.fit = FitReusing(
-      points_, pixels_, image_size_, selection.options,
-      CandidateReuse{from_scratch ? nullptr : &chosen.final.fit->camera, &geometry_});
+  std::shared_ptr<ChartLinearization> linearization;
+  if (points_.size() >= kLinearizationFromPoints) {
+    linearization = std::make_shared<ChartLinearization>();
+  }
+  selection.fit = FitReusing(points_, pixels_, image_size_, selection.options,
+                             CandidateReuse{from_scratch ? nullptr : &chosen.final.fit->camera,
+                                            &geometry_, linearization.get()});
+  if (linearization && linearization->jtj.size() > 0) {
+    selection.linearization = std::move(linearization);
+  }
   if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
   if (!options_.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
   tried_[chosen.final_index].verdict = "chosen";
