@@ -3,7 +3,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <memory>
 #include <string>
 
 #include "check.h"
@@ -18,7 +17,7 @@ const std::array<const char*, kFitIntrinsicsSize> kSlotNames = {
     "focal", "aspect", "cx", "cy", "skew", "k1", "k2", "p1", "p2", "k3"};
 
 // A value as internal::Concat writes it (printf's %.17g in the "C" locale), without a stream:
-// MakeModel describes every fixed slot on every fit, and a stream costs ~5000 instructions.
+// DescribeFixed writes every fixed slot of a described fit, and a stream costs ~5000 instructions.
 std::string ValueText(double value) {
   char text[32];
   const char* end =
@@ -30,46 +29,61 @@ std::string ValueText(double value) {
 
 Model MakeModel(const FitOptions& options, const ImageSize& size) {
   Model model;
-  auto fixed = std::make_shared<std::vector<FixedParameter>>();
-  model.fixed = fixed;
   if (options.known_intrinsics) {
     const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
                                             PixelOrigin::kCenter);
     model.value = {k.fx, k.fy / k.fx, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3};
-    std::string text = Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx, ", cy ", k.cy, ", skew ",
-                              k.skew, ", k1 ", k.k1, ", k2 ", k.k2);
-    if (k.HasBeyondTwoRadial()) text += Concat(", p1 ", k.p1, ", p2 ", k.p2, ", k3 ", k.k3);
-    fixed->push_back({"intrinsics", text, "given: pose only"});
     return model;
   }
   const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
-  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value,
-                 const char* default_why) {
+  auto set = [&](int slot, const ParameterMode& mode, double default_value, double fixed_value) {
     model.free[slot] = mode.IsFree();
     model.value[slot] = mode.kind == ParameterMode::Kind::kFixed ? fixed_value : default_value;
-    if (mode.IsFree() || slot == 3) return;  // cy is described with cx
+  };
+  // A free focal length's start comes from the closed form; 1 is a placeholder.
+  set(0, options.focal, 1.0, options.focal.value);
+  set(1, options.aspect, 1.0, options.aspect.value);
+  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift);
+  set(3, options.principal_point, 0.5 * (size.height - 1.0),
+      options.principal_point.value2 + shift);
+  set(4, options.skew, 0.0, options.skew.value);
+  set(5, options.k1, 0.0, options.k1.value);
+  set(6, options.k2, 0.0, options.k2.value);
+  return model;
+}
+
+std::vector<FixedParameter> DescribeFixed(const FitOptions& options, const ImageSize& size) {
+  std::vector<FixedParameter> fixed;
+  if (options.known_intrinsics) {
+    const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
+                                            PixelOrigin::kCenter);
+    std::string text = Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx, ", cy ", k.cy, ", skew ",
+                              k.skew, ", k1 ", k.k1, ", k2 ", k.k2);
+    if (k.HasBeyondTwoRadial()) text += Concat(", p1 ", k.p1, ", p2 ", k.p2, ", k3 ", k.k3);
+    fixed.push_back({"intrinsics", text, "given: pose only"});
+    return fixed;
+  }
+  const Model model = MakeModel(options, size);
+  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  auto describe = [&](int slot, const ParameterMode& mode, const char* default_why) {
+    if (mode.IsFree()) return;
     std::string name = kSlotNames[slot];
     std::string value = ValueText(model.value[slot]);
-    if (slot == 2) {
+    if (slot == 2) {  // cy is described with cx
       name = "principal point";
       value += ", " + ValueText(mode.kind == ParameterMode::Kind::kFixed
                                     ? options.principal_point.value2 + shift
                                     : 0.5 * (size.height - 1.0));
     }
-    fixed->push_back(
-        {name, value, mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
+    fixed.push_back({name, value, mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
   };
-  // A free focal length's start comes from the closed form; 1 is a placeholder.
-  set(0, options.focal, 1.0, options.focal.value, "");
-  set(1, options.aspect, 1.0, options.aspect.value, "default: square pixels");
-  set(2, options.principal_point, 0.5 * (size.width - 1.0), options.principal_point.value + shift,
-      "default: image centre");
-  set(3, options.principal_point, 0.5 * (size.height - 1.0),
-      options.principal_point.value2 + shift, "");
-  set(4, options.skew, 0.0, options.skew.value, "default: no skew");
-  set(5, options.k1, 0.0, options.k1.value, "default: no distortion");
-  set(6, options.k2, 0.0, options.k2.value, "default: no distortion");
-  return model;
+  describe(0, options.focal, "");
+  describe(1, options.aspect, "default: square pixels");
+  describe(2, options.principal_point, "default: image centre");
+  describe(4, options.skew, "default: no skew");
+  describe(5, options.k1, "default: no distortion");
+  describe(6, options.k2, "default: no distortion");
+  return fixed;
 }
 
 Model ProjectOntoModel(const Model& model, const Intrinsics& k0) {

@@ -1,16 +1,15 @@
 // The intrinsic model of the perspective fit (private): which slots of the fit-intrinsics block
 // (reprojection_error.h's layout: focal, aspect, cx, cy, skew, k1, k2, p1, p2, k3; kCenter px;
 // the last three are never free in a single-view fit, they hold given values or 0) are free, the
-// value of every slot (the start of a free one, the given or default value of a fixed one) and
-// how the fixed ones are reported. MakeModel builds it from FitOptions and ProjectOntoModel puts a
-// closed-form K on it; every stage after the scene carries one: the start sets its free values,
-// the refinement moves them and the assessment names them.
+// value of every slot (the start of a free one, the given or default value of a fixed one).
+// MakeModel builds it from FitOptions and ProjectOntoModel puts a closed-form K on it; every stage
+// after the scene carries one: the start sets its free values, the refinement moves them and the
+// assessment names them, with the fixed ones as DescribeFixed reports them.
 #ifndef CAMPROJ_SRC_FIT_MODEL_H_
 #define CAMPROJ_SRC_FIT_MODEL_H_
 
 #include <algorithm>
 #include <array>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,9 +28,6 @@ namespace internal {
 struct Model {
   std::array<bool, kFitIntrinsicsSize> free{};
   std::array<double, kFitIntrinsicsSize> value{};
-  // How the fixed slots are reported: text only, shared by every copy (a Model is copied at
-  // every step of the refinement and the assessment; strings there cost more than the step).
-  std::shared_ptr<const std::vector<FixedParameter>> fixed;
 
   int NumFree() const { return static_cast<int>(std::count(free.begin(), free.end(), true)); }
   // focal, aspect, principal point, skew: what a homography constrains (k1, k2 aside).
@@ -56,10 +52,15 @@ struct Model {
 
 // The model `options` (checked) ask for, in kCenter px for an image of `size`. Known intrinsics
 // fix every slot ("given: pose only"); otherwise each slot is free, fixed at its given value or
-// at its default (square pixels, the image centre, no skew, no distortion), and every fixed one
-// is described for FitResult::fixed_parameters. A free focal length holds 1, a placeholder for
-// the closed-form start's value.
+// at its default (square pixels, the image centre, no skew, no distortion). A free focal length
+// holds 1, a placeholder for the closed-form start's value.
 Model MakeModel(const FitOptions& options, const ImageSize& size);
+
+// FitResult::fixed_parameters of MakeModel(options, size): every fixed slot with its value and
+// why ("given", or the default's reason); known intrinsics as one entry. Only a described fit
+// reports them (assess.cc): a candidate of the model selection is scored without them, and at six
+// points their text cost ~2 % of the default path when every fit made it.
+std::vector<FixedParameter> DescribeFixed(const FitOptions& options, const ImageSize& size);
 
 // The model with its free slots set from a closed-form K, the fixed ones kept: DLT's K projected
 // onto the model (square pixels: the geometric mean of fx, fy).
