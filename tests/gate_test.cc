@@ -2,6 +2,10 @@
 #include "fit/gate.h"
 
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -9,6 +13,7 @@
 
 #include "camproj/model_select.h"
 #include "fit/statistics.h"
+#include "number_text.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -86,6 +91,30 @@ TEST(GateTest, ChiSquareQuantileIsTheBisectionsRemembered) {
     for (const auto& [nu, p] : keys) {
       EXPECT_EQ(internal::ChiSquareQuantile(nu, p), internal::BisectChiSquareQuantile(nu, p))
           << "nu " << nu << ", p " << p << ", round " << round;
+    }
+  }
+}
+
+// GeneralText is printf's %.<digits>g to the character (std::to_chars with a precision is
+// specified as that conversion): on random magnitudes over the double range, the values where %g
+// switches notation or rounds up a digit, zeros, infinities and NaN.
+TEST(NumberTextTest, GeneralTextIsPrintfsG) {
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.5, 9.995, 9.9949999, 99.95, 999.5,
+                                1e-4, 9.9995e-5, 1e-5, 123456.0, 999999.5, 1e15, 1e16, 1e300,
+                                5e-324, std::numeric_limits<double>::max(),
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::quiet_NaN()};
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> exponent(-300.0, 300.0);
+  std::uniform_real_distribution<double> mantissa(-10.0, 10.0);
+  for (int i = 0; i < 20000; ++i) values.push_back(mantissa(random) * std::pow(10.0, exponent(random)));
+  for (const double value : values) {
+    for (const int digits : {1, 2, 3, 4, 6, 17}) {
+      char expected[64];
+      std::snprintf(expected, sizeof expected, "%.*g", digits, value);
+      EXPECT_EQ(internal::GeneralText(value, digits), std::string(expected))
+          << "digits " << digits;
     }
   }
 }

@@ -2,20 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <tuple>
 
 #include "fit/statistics.h"
+#include "number_text.h"
 
 namespace camproj {
 namespace internal {
 
-std::string Px(double value) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.3g px", value);
-  return buffer;
-}
+std::string Px(double value) { return GeneralText(value, 3) + " px"; }
 
 std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin) {
   const Eigen::Vector2d u = ConvertPixelOrigin(pixel_center, PixelOrigin::kCenter, origin);
@@ -86,8 +82,7 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
   const bool noise_ok = check.noise_estimate_px <= check.noise_bound_px;
   const bool max_ok = check.max_residual_px <= check.max_residual_bound_px;
   check.passed = noise_ok && max_ok;
-  char alpha[32];
-  std::snprintf(alpha, sizeof alpha, "%g %%", 100.0 * options.significance);
+  const std::string alpha = GeneralText(100.0 * options.significance, 6) + " %";
   if (check.passed) {
     check.summary = "consistent with " + Px(noise.sigma_px) + " pixel noise (" +
                     (noise.given ? "given" : "assumed") + "): noise estimate " +

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <cstdio>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -14,6 +13,7 @@
 #include "fit/gate.h"
 #include "fit/orthographic_fit.h"
 #include "fit/statistics.h"
+#include "number_text.h"
 
 namespace camproj {
 namespace internal {
@@ -159,11 +159,7 @@ bool OrthographicIsPossible(const FitOptions& options) {
          !options.known_intrinsics;
 }
 
-std::string Fixed(double value, int digits = 3) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
-  return buffer;
-}
+std::string Fixed(double value, int digits = 3) { return GeneralText(value, digits); }
 
 // A criterion difference in words: "BIC 2.15 above pose+focal+principal-point's: its better
 // fit does not pay for its extra parameters".
