@@ -30,6 +30,32 @@ TEST(GateTest, RepeatsAreExactCopiesOfAnEarlierCorrespondence) {
             std::vector<bool>({false, false, false, true, true}));
 }
 
+// Repeats against its definition, pair by pair (a point repeats one of lower index with the same
+// point and pixel): random sets drawn from a few coordinate values, so that equal x, equal
+// points with other pixels, copies and -0 against +0 (equal) all occur, 500 seeds.
+TEST(GateTest, RepeatsAgreeWithTheirDefinitionOnRandomSets) {
+  std::mt19937_64 random(11);
+  const double values[] = {-1.0, -0.0, 0.0, 2.5};
+  std::uniform_int_distribution<int> pick(0, 3);
+  std::uniform_int_distribution<int> size(0, 40);
+  for (int seed = 0; seed < 500; ++seed) {
+    const int n = size(random);
+    std::vector<Eigen::Vector3d> points(n);
+    std::vector<Eigen::Vector2d> pixels(n);
+    for (int i = 0; i < n; ++i) {
+      points[i] = {values[pick(random)], values[pick(random)], values[pick(random) / 2]};
+      pixels[i] = {values[pick(random) / 2], 7.0};
+    }
+    std::vector<bool> expected(n, false);
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < i; ++j) {
+        if (points[i] == points[j] && pixels[i] == pixels[j]) expected[i] = true;
+      }
+    }
+    EXPECT_EQ(internal::Repeats(points, pixels), expected) << "seed " << seed;
+  }
+}
+
 // Every correspondence written ten times is the same data: the verdict, the noise estimate,
 // its bound, the robust noise and the outlier bound come out the same, and so does the RMS over
 // every point kept. These 8 residuals of a 7-parameter model (noise estimate 2.59 px against
