@@ -142,9 +142,10 @@ TEST(CandidateTest, WarmStartFromTheNestedModelReachesTheClosedFormsOptimum) {
 // its restarts (the same minimum as FitCamera's) against FitCamera, whose polish settles under
 // 1e-9 px, on the bench's clouds at 6-100 points for OpenCV's model and, from 20 points, with k1.
 // The candidate's last step moved the residual vector by |J d| <= 1e-3 of the noise estimate
-// s = sqrt(J / (2N - p)), so its sum of squares exceeds the minimum's by at most ~(1e-3 s)^2
-// (the step taken leaves less), and never falls below it by more than rounding; each parameter
-// is within 1e-3 of its sigma (FitCamera's, from the same s). Rounding: each residual is rounded
+// s = sqrt(J / (2N - p)), or the steps so far predicted the next within that (least_squares.cc:
+// the next step this^2 / before, while they contract), so its sum of squares exceeds the
+// minimum's by at most ~(1e-3 s)^2, and never falls below it by more than rounding; each
+// parameter is within 1e-3 of its sigma (FitCamera's, from the same s). Rounding: each residual is rounded
 // to ~16 ulp of its pixel's magnitude (least_squares.cc's cost allowance), so a sum of squares S
 // is off by at most 2 sqrt(S) 16 u |pixels| (Cauchy-Schwarz), and the two fits' by twice that.
 TEST(CandidateTest, AScoredFitStopsWithinItsConvergenceTestOfTheSettledMinimum) {

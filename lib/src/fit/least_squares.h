@@ -72,10 +72,11 @@ enum class PolishFirst {
 
 // How far the polish goes. A camera only scored (its cost, or a rival's camera: a model
 // selection's candidate, fit/candidate.h) needs it only to the polish's
-// convergence test, the last step under 1e-3 of the residuals' sigma (|J delta|): the step is
-// taken, so the sum of squares then exceeds the minimum's by about |J delta|^2 of the step after
-// it, under 1e-6 sigma^2 (quadratic convergence), far below any criterion difference read. A
-// camera returned goes on until a step settles under 1e-9 px, saving no pass over the points.
+// convergence test, the last step under 1e-3 of the residuals' sigma (|J delta|), or the next
+// step predicted under it by the last two (least_squares.cc): the step is taken without a pass
+// after it, so the sum of squares then exceeds the minimum's by about |J delta|^2 of the step
+// after it, under 1e-6 sigma^2, far below any criterion difference read. A camera returned goes
+// on until a step settles under 1e-9 px, saving no pass over the points.
 enum class PolishUntil { kSettled, kConverged };
 
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
