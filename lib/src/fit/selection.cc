@@ -285,6 +285,7 @@ Evaluation ModelSelector::FitModel(const FitOptions& model, const Camera* warm_s
   e.fit = prefit_->fit;
   e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points_.size());
   e.num_params = static_cast<int>(e.fit->free_parameters.size());
+  e.linearization = prefit_->linearization;
   return e;
 }
 

@@ -75,6 +75,9 @@ struct Prefit {
   FitOptions model;
   FitResult fit;
   SceneGeometry geometry;  // for model.pixel_origin
+  // The fit's normal equations at its answer, kept as a candidate's are (kLinearizationFromPoints),
+  // or null.
+  std::shared_ptr<const ChartLinearization> linearization = nullptr;
 };
 
 // Selects and fits the model for these points (the caller's, in options.fit.pixel_origin;
