@@ -329,7 +329,9 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
                             "points); check them or use a robust loss"));
   }
   result.rms_px = std::sqrt(sum_squares / n);
-  result.median_px = Median(norms);
+  // A fit not described is scored by its sum of squares: its median is read nowhere (the default
+  // path's is recomputed over the points kept).
+  if (effort.describe) result.median_px = Median(norms);
   result.max_px = *std::max_element(norms.begin(), norms.end());
   result.start_method = start_method;
   result.planar = scene.planar;

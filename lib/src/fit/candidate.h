@@ -13,8 +13,9 @@
 // a fit can be consistent with the noise and still sit in a minimum far from the truth.
 //
 // Nor does a candidate check its covariance's linearization (FitResult::linearity, 2p more
-// evaluations of the residuals), compute its covariance or its views (FitResult::views): the
-// selection reads a candidate's residuals and camera, and the chosen model's fit reports the rest.
+// evaluations of the residuals), compute its covariance, its views (FitResult::views), its
+// median residual or its fixed parameters' description: the selection reads a candidate's
+// residuals and camera, and the chosen model's fit reports the rest.
 //
 // The warm start leaves out the closed form (at 6 points the DLT, its pose re-solved, and the
 // second start from the image centre) and reaches the same minimum wherever the scene has one
@@ -63,8 +64,8 @@ struct CandidateReuse {
 
 // As FitCamera (fit.h), with the restarts skipped for a fit consistent at `consistent_at_px`
 // (> 0, px per axis; nullopt: never skipped, for a fit the selection may refit its answer from,
-// the screen's), FitResult::linearity, ::views and the covariance not computed, and what
-// `reuse` holds reused.
+// the screen's), FitResult::linearity, ::views, ::median_px, ::fixed_parameters and the
+// covariance not computed, and what `reuse` holds reused.
 FitResult FitCandidate(const std::vector<Eigen::Vector3d>& points_in_world,
                        const std::vector<Eigen::Vector2d>& observed_pixels,
                        const ImageSize& image_size, const FitOptions& options,
