@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "camproj/model_select.h"
+#include "camproj/number_text.h"
 #include "fit/statistics.h"
-#include "number_text.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -121,10 +121,10 @@ TEST(GateTest, ChiSquareQuantileIsTheBisectionsRemembered) {
   }
 }
 
-// GeneralText is printf's %.<digits>g to the character (std::to_chars with a precision is
+// GeneralDouble is printf's %.<digits>g to the character (std::to_chars with a precision is
 // specified as that conversion): on random magnitudes over the double range, the values where %g
 // switches notation or rounds up a digit, zeros, infinities and NaN.
-TEST(NumberTextTest, GeneralTextIsPrintfsG) {
+TEST(NumberTextTest, GeneralDoubleIsPrintfsG) {
   std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.5, 9.995, 9.9949999, 99.95, 999.5,
                                 1e-4, 9.9995e-5, 1e-5, 123456.0, 999999.5, 1e15, 1e16, 1e300,
                                 5e-324, std::numeric_limits<double>::max(),
@@ -139,7 +139,7 @@ TEST(NumberTextTest, GeneralTextIsPrintfsG) {
     for (const int digits : {1, 2, 3, 4, 6, 17}) {
       char expected[64];
       std::snprintf(expected, sizeof expected, "%.*g", digits, value);
-      EXPECT_EQ(internal::GeneralText(value, digits), std::string(expected))
+      EXPECT_EQ(GeneralDouble(value, digits), std::string(expected))
           << "digits " << digits;
     }
   }

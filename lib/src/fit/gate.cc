@@ -4,13 +4,13 @@
 #include <cmath>
 #include <numeric>
 
+#include "camproj/number_text.h"
 #include "fit/statistics.h"
-#include "number_text.h"
 
 namespace camproj {
 namespace internal {
 
-std::string Px(double value) { return GeneralText(value, 3) + " px"; }
+std::string Px(double value) { return GeneralDouble(value, 3) + " px"; }
 
 std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin) {
   const Eigen::Vector2d u = ConvertPixelOrigin(pixel_center, PixelOrigin::kCenter, origin);
@@ -94,7 +94,7 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
   const bool noise_ok = check.noise_estimate_px <= check.noise_bound_px;
   const bool max_ok = check.max_residual_px <= check.max_residual_bound_px;
   check.passed = noise_ok && max_ok;
-  const std::string alpha = GeneralText(100.0 * options.significance, 6) + " %";
+  const std::string alpha = GeneralDouble(100.0 * options.significance, 6) + " %";
   if (check.passed) {
     check.summary = "consistent with " + Px(noise.sigma_px) + " pixel noise (" +
                     (noise.given ? "given" : "assumed") + "): noise estimate " +

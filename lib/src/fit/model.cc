@@ -1,10 +1,10 @@
 #include "fit/model.h"
 
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <string>
 
+#include "camproj/number_text.h"
 #include "check.h"
 
 namespace camproj {
@@ -18,12 +18,7 @@ const std::array<const char*, kFitIntrinsicsSize> kSlotNames = {
 
 // A value as internal::Concat writes it (printf's %.17g in the "C" locale), without a stream:
 // DescribeFixed writes every fixed slot of a described fit, and a stream costs ~5000 instructions.
-std::string ValueText(double value) {
-  char text[32];
-  const char* end =
-      std::to_chars(text, text + sizeof text, value, std::chars_format::general, 17).ptr;
-  return std::string(static_cast<const char*>(text), end);
-}
+std::string ValueText(double value) { return GeneralDouble(value, 17); }
 
 }  // namespace
 

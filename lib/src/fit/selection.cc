@@ -8,12 +8,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "camproj/number_text.h"
 #include "fit/candidate.h"
 #include "fit/common.h"
 #include "fit/gate.h"
 #include "fit/orthographic_fit.h"
 #include "fit/statistics.h"
-#include "number_text.h"
 
 namespace camproj {
 namespace internal {
@@ -159,7 +159,7 @@ bool OrthographicIsPossible(const FitOptions& options) {
          !options.known_intrinsics;
 }
 
-std::string Fixed(double value, int digits = 3) { return GeneralText(value, digits); }
+std::string Fixed(double value, int digits = 3) { return GeneralDouble(value, digits); }
 
 // A criterion difference in words: "BIC 2.15 above pose+focal+principal-point's: its better
 // fit does not pay for its extra parameters".
