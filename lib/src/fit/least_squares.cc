@@ -230,8 +230,13 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   double cost = 0.0;
   double function_tolerance = 0.0;
   // Makes (chart, local), the normal equations at `at`, the current iterate.
-  auto accept = [&](const ParamVector& at, const NormalEquations& chart,
-                    const NormalEquations& local) {
+  // The local normal equations of the trial and of the last accepted iterate, by pointer: an
+  // accepted trial's become the accepted ones without a copy (summary.local is set once, at the
+  // end).
+  NormalEquations locals[2];
+  NormalEquations* accepted_local = nullptr;
+  NormalEquations* trial_local = &locals[0];
+  auto accept = [&](const ParamVector& at, const NormalEquations& chart) {
     *u = at;
     if (scaling.size() == 0) {
       scaling = (1.0 + chart.jtj.diagonal().array().sqrt()).inverse().matrix();
@@ -241,7 +246,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
     jtj = scaling.asDiagonal() * chart.jtj * scaling.asDiagonal();
     gradient = -(scaling.asDiagonal() * chart.jtr);
     cost = chart.cost / 2.0;
-    summary.local = local;
+    accepted_local = trial_local;
+    trial_local = accepted_local == &locals[0] ? &locals[1] : &locals[0];
     summary.local_at_solution = true;
     trace->push_back({static_cast<int>(trace->size()), MicrosecondsSince(start_time),
                       std::sqrt(chart.cost / problem.NumPoints())});
@@ -257,22 +263,26 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   };
 
   NormalEquations chart;
-  NormalEquations local;
+  // The summary with the last accepted local normal equations (every return below).
+  auto finish = [&]() -> LmSummary {
+    if (accepted_local != nullptr) summary.local = std::move(*accepted_local);
+    return summary;
+  };
   summary.iterations = 0;
   // A point behind the start: nothing to minimize (the polish refuses it too).
-  if (!problem.Linearize(*u, &chart, &local)) return summary;
-  accept(*u, chart, local);
+  if (!problem.Linearize(*u, &chart, trial_local)) return summary;
+  accept(*u, chart);
   if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
     summary.status = LmStatus::kGradientTooSmall;
-    return summary;
+    return finish();
   }
   if (cost < cost_threshold) {
     summary.status = LmStatus::kCostTooSmall;
-    return summary;
+    return finish();
   }
   if (out_of_reach()) {
     summary.status = LmStatus::kTargetOutOfReach;
-    return summary;
+    return finish();
   }
   double damping = 1.0 / kInitialTrustRegionRadius;
   double damping_factor = 2.0;
@@ -308,7 +318,7 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       }
     }
     const ParamVector candidate = *u + step;
-    if (!problem.Linearize(candidate, &chart, &local)) {
+    if (!problem.Linearize(candidate, &chart, trial_local)) {
       // A point behind the camera: no cost to compare. Shrink the trust region as for a
       // rejected step.
       damping *= damping_factor;
@@ -322,7 +332,7 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
     // rho: the actual reduction over the reduction the linear model predicts.
     const double rho = cost_change / model_cost_change;
     if (rho > 0.0) {
-      accept(candidate, chart, local);
+      accept(candidate, chart);
       if (std::abs(cost_change) < function_tolerance) {
         summary.status = LmStatus::kCostChangeTooSmall;
         break;
@@ -351,7 +361,7 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       damping_factor *= 2.0;
     }
   }
-  return summary;
+  return finish();
 }
 
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
