@@ -102,7 +102,8 @@ STAGES = [
     ("ladder", "model selection: the ladder's fits", False,
      lambda a, b: b == "camproj::internal::SelectModel()"),
     ("refit", "model selection: the chosen model refitted with its covariance (from scratch "
-     "below 20 points unless it is the screen's model, else from the ladder's camera)", False,
+     "below 20 points where it frees the principal point and is not the screen's model, else "
+     "from the ladder's camera)", False,
      lambda a, b: a == "camproj::internal::SelectModel()" and
      b == "camproj::internal::FitReusing()"),
     ("gate", "consistency gate on the selection (residuals, chi-square, largest residual)", True,

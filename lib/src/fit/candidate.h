@@ -32,9 +32,10 @@
 // two steps predict the next within that test, at the step before it (the default path 0.2 /
 // 0.9 / 1.2 / 4.0 / 4.5 / 6.6 % cheaper at 6 / 8 / 12 / 20 / 100 / 1000 points; on the click
 // benchmark the same answers and refusals, 11 of 42 500 rows with a refusal's number one unit
-// off in its third digit; the returned cameras the same to 3e-14 relative). The chosen model is refitted with everything computed and its restarts: from scratch below 20
-// points unless it is the screen's model (whose fit from scratch the ladder holds), else from
-// the ladder's camera (FitReusing; selection.cc says why).
+// off in its third digit; the returned cameras the same to 3e-14 relative). The chosen model is
+// refitted with everything computed and its restarts: from scratch below 20 points where it
+// frees the principal point and is not the screen's model (whose fit from scratch the ladder
+// holds), else from the ladder's camera (FitReusing; selection.cc says why).
 #ifndef CAMPROJ_SRC_FIT_CANDIDATE_H_
 #define CAMPROJ_SRC_FIT_CANDIDATE_H_
 
