@@ -229,13 +229,14 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   ParamVector gradient;
   double cost = 0.0;
   double function_tolerance = 0.0;
-  // Makes (chart, local), the normal equations at `at`, the current iterate.
   // The local normal equations of the trial and of the last accepted iterate, by pointer: an
   // accepted trial's become the accepted ones without a copy (summary.local is set once, at the
   // end).
   NormalEquations locals[2];
   NormalEquations* accepted_local = nullptr;
   NormalEquations* trial_local = &locals[0];
+  // Makes `at` the current iterate: `chart` its normal equations in the chart, *trial_local its
+  // local ones.
   auto accept = [&](const ParamVector& at, const NormalEquations& chart) {
     *u = at;
     if (scaling.size() == 0) {
@@ -460,8 +461,9 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     if (step_px <= kSettledStepPx ||
         (stop_when_converged && (converged() || next_predicted_within_test()))) {
       // The last step: take it without another pass over the points. The normal equations stay
-      // those one step back, where J^T J differs by ~1e-12 relative (the step's size against
-      // the parameters' scales) and the cost by far less than its own rounding.
+      // those one step back, where J^T J differs by ~1e-12 relative after a settling step (the
+      // step's size against the parameters' scales), and by what a step of at most
+      // kPredictedStepFraction of the noise changes after a predicted one.
       *rotation = new_rotation;
       *center = new_center;
       model->value = new_intrinsics;
