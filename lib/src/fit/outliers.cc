@@ -75,19 +75,16 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
           effort == SubsetFit::kScored ? std::optional<double>(noise.sigma_px) : std::nullopt;
       // Its normal equations as a candidate of the selection keeps them, for the selection that
       // reads this fit as one (a rival's uncertainty, fit/determination.cc).
-      std::shared_ptr<ChartLinearization> linearization;
-      if (effort == SubsetFit::kForTheSelection && x.size() >= kLinearizationFromPoints) {
-        linearization = std::make_shared<ChartLinearization>();
-      }
+      std::shared_ptr<ChartLinearization> linearization =
+          effort == SubsetFit::kForTheSelection ? LinearizationSlot(x.size()) : nullptr;
       FitResult fit = FitCandidate(x, u, size, model, skip_restarts_when_consistent_at_px,
                                    CandidateReuse{nullptr, &geometry, linearization.get()});
-      if (linearization && linearization->jtj.size() == 0) linearization.reset();
       std::vector<double> lengths;
       for (const auto& r : fit.residuals_px) lengths.push_back(r.norm());
       const ConsistencyCheck check = CheckConsistency(lengths, Repeats(x, u), p, noise, options);
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
-      subset.fit = Prefit{model, std::move(fit), geometry, std::move(linearization)};
+      subset.fit = Prefit{model, std::move(fit), geometry, Filled(std::move(linearization))};
       subset.refusal.reset();
       return subset;
     } catch (const SceneError& e) {

@@ -118,16 +118,13 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
   try {
     // The fit's normal equations for the determination check, which reads a fitted rival's
     // uncertainty from them (selection.h, kLinearizationFromPoints).
-    std::shared_ptr<ChartLinearization> linearization;
+    std::shared_ptr<ChartLinearization> linearization = LinearizationSlot(points.size());
     CandidateReuse with = reuse;
-    if (points.size() >= kLinearizationFromPoints) {
-      linearization = std::make_shared<ChartLinearization>();
-      with.linearization = linearization.get();
-    }
+    with.linearization = linearization.get();
     e.fit = FitCandidate(points, pixels, size, options, consistent_at_px, with);
     e.sum_squares = e.fit->rms_px * e.fit->rms_px * static_cast<double>(points.size());
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
-    if (linearization && linearization->jtj.size() > 0) e.linearization = std::move(linearization);
+    e.linearization = Filled(std::move(linearization));
   } catch (const SceneError& error) {
     e.refusal = error.what();
     e.reason = error.reason();
@@ -590,16 +587,11 @@ Selection ModelSelector::Refit(const Ladder& chosen, const std::vector<int>& can
   const bool from_scratch = points_.size() < kFromScratchBelowPoints &&
                             chosen.final_options.principal_point.IsFree() &&
                             !(prefit_ != nullptr && SameModel(prefit_->model, chosen.final_options));
-  std::shared_ptr<ChartLinearization> linearization;
-  if (points_.size() >= kLinearizationFromPoints) {
-    linearization = std::make_shared<ChartLinearization>();
-  }
+  std::shared_ptr<ChartLinearization> linearization = LinearizationSlot(points_.size());
   selection.fit = FitReusing(points_, pixels_, image_size_, selection.options,
                              CandidateReuse{from_scratch ? nullptr : &chosen.final.fit->camera,
                                             &geometry_, linearization.get()});
-  if (linearization && linearization->jtj.size() > 0) {
-    selection.linearization = std::move(linearization);
-  }
+  selection.linearization = Filled(std::move(linearization));
   if (selection.fit.start_method == "warm") selection.fit.start_method = chosen.start_method;
   if (!options_.fit.pixel_sigma) selection.fit.pixel_sigma_estimated = true;
   tried_[chosen.final_index].verdict = "chosen";

@@ -59,6 +59,19 @@ struct Selection {
 // instructions at 6-12 points; for the rivals 2.6 / 6.2 / 8.4 % fewer at 20 / 100 / 1000).
 inline constexpr size_t kLinearizationFromPoints = 20;
 
+// Where a fit of `num_points` points keeps its normal equations (kLinearizationFromPoints): an
+// empty ChartLinearization for the fit to fill (CandidateReuse::linearization), else null.
+inline std::shared_ptr<ChartLinearization> LinearizationSlot(size_t num_points) {
+  return num_points >= kLinearizationFromPoints ? std::make_shared<ChartLinearization>()
+                                                : nullptr;
+}
+
+// `slot` once the fit ran: itself where the fit filled it (a perspective fit), else null.
+inline std::shared_ptr<const ChartLinearization> Filled(std::shared_ptr<ChartLinearization> slot) {
+  if (slot == nullptr || slot->jtj.size() == 0) return nullptr;
+  return slot;
+}
+
 // The noise the criterion uses without a given sigma: the prior combined with the residuals
 // (sum_squares over dof degrees of freedom) of the richest model the scene supports:
 // sqrt((prior_weight * prior^2 + sum_squares) / (prior_weight + dof)), floored at kMinNoisePx.
