@@ -12,6 +12,7 @@
 #include <string>
 
 #include "camproj/fit_report.h"
+#include "camproj/number_text.h"
 #include "check.h"
 #include "fit/candidate.h"
 #include "fit/common.h"
@@ -322,11 +323,7 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
 // the points did not determine, biased off the points (kDegenerate).
 void RefuseIfPerspectiveShows(const internal::PerspectiveTest& test, const std::string& left_out) {
   if (!test.observable) return;
-  auto g3 = [](double value) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.3g", value);
-    return std::string(buffer);
-  };
+  auto g3 = [](double value) { return GeneralDouble(value, 3); };
   throw SceneError(
       SceneError::Reason::kDegenerate,
       "the points show perspective, which the orthographic camera chosen leaves out: freeing "
@@ -352,11 +349,10 @@ void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) 
   for (const ParameterSigma& s : fit.sigmas) {
     if (s.name == along) along = ParameterSigmaText(s);
   }
-  char level[16];
-  std::snprintf(level, sizeof level, "%.4g", 100.0 * fit.linearity.level);
+  const std::string level = GeneralDouble(100.0 * fit.linearity.level, 4);
   throw SceneError(
       SceneError::Reason::kDegenerate,
-      "the points do not determine the camera: within its " + std::string(level) +
+      "the points do not determine the camera: within its " + level +
           " % confidence region, along " +
           along + ", a camera sees some of them from behind or fits them as well, so how far "
           "it is off beyond them cannot be told. " +
@@ -427,14 +423,13 @@ PointReliability WordReliability(PointReliability least, const std::vector<int>&
   char direction[48];
   std::snprintf(direction, sizeof direction, "(%.2f, %.2f)", least.direction.x(),
                 least.direction.y());
-  char kept_percent[32];
-  std::snprintf(kept_percent, sizeof kept_percent, "%.2g %%", 100.0 * least.redundancy);
+  const std::string kept_percent = GeneralDouble(100.0 * least.redundancy, 2) + " %";
   const std::string& name = names[least.point];
   least.summary = "least checked: " + name +
                   (least.redundancy < kNoRedundancy
                        ? std::string(", which alone fixes the camera along ") + direction +
                              ": a mis-click of it that way would not show in any residual"
-                       : ", whose residual keeps " + std::string(kept_percent) +
+                       : ", whose residual keeps " + kept_percent +
                              " of a mis-click along " + direction);
   if (least.redundancy < kWeakRedundancy) {
     least.summary += "; the other points barely check it: add points (near it), or fix "
