@@ -14,6 +14,7 @@
 #include "camproj/model_select.h"
 #include "camproj/number_text.h"
 #include "fit/statistics.h"
+#include "seeds.h"
 #include "test_scenes.h"
 
 namespace camproj {
@@ -34,7 +35,7 @@ TEST(GateTest, RepeatsAreExactCopiesOfAnEarlierCorrespondence) {
 // point and pixel): random sets drawn from a few coordinate values, so that equal x, equal
 // points with other pixels, copies and -0 against +0 (equal) all occur, 500 seeds.
 TEST(GateTest, RepeatsAgreeWithTheirDefinitionOnRandomSets) {
-  std::mt19937_64 random(11);
+  std::mt19937_64 random(testing::Seed(11));
   const double values[] = {-1.0, -0.0, 0.0, 2.5};
   std::uniform_int_distribution<int> pick(0, 3);
   std::uniform_int_distribution<int> size(0, 40);
@@ -131,7 +132,7 @@ TEST(NumberTextTest, GeneralDoubleIsPrintfsG) {
                                 std::numeric_limits<double>::infinity(),
                                 -std::numeric_limits<double>::infinity(),
                                 std::numeric_limits<double>::quiet_NaN()};
-  std::mt19937_64 random(7);
+  std::mt19937_64 random(testing::Seed(7));
   std::uniform_real_distribution<double> exponent(-300.0, 300.0);
   std::uniform_real_distribution<double> mantissa(-10.0, 10.0);
   for (int i = 0; i < 20000; ++i) values.push_back(mantissa(random) * std::pow(10.0, exponent(random)));
