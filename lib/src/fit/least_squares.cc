@@ -365,6 +365,49 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   return finish();
 }
 
+// The polish's tests on its steps' joint sizes |J delta| (px: the change a step makes to the
+// residual vector), against the residuals' own sigma sqrt(cost / dof).
+struct PolishSteps {
+  // Converged when the last Gauss-Newton step, taken or not, changes the residual vector by at
+  // most kConvergedFraction of the residuals' own sigma (|J delta| in px against
+  // sqrt(cost / (2N - p))), or by rounding alone (kRoundingStepPx): the parameters are then
+  // within 1e-3 of their standard deviation of the minimum in the joint (Mahalanobis) sense.
+  // Where LM stops short on a curved valley, most of the residual is still removable and the
+  // step is about sqrt(2N - p) sigmas.
+  static constexpr double kConvergedFraction = 1e-3;
+  static constexpr double kRoundingStepPx = 1e-8;
+  // A step taken on a prediction (NextPredictedWithinTest) is at most this fraction of the
+  // residuals' sigma: the normal equations returned are then those one such step back, and a
+  // sigma read from them (a rival's, fit/determination.cc) moves by under 3e-4 of itself
+  // (tests/determination_test.cc).
+  static constexpr double kPredictedStepFraction = 1e-2;
+
+  double dof;  // 2N - p, at least 1
+  double last_px = std::numeric_limits<double>::infinity();      // the latest step's
+  // The step before it, with a pass over the points after it (none yet: infinite).
+  double previous_px = std::numeric_limits<double>::infinity();
+
+  bool Converged(double cost) const {
+    const double noise_px = std::sqrt(cost / dof);
+    return last_px <= std::max(kConvergedFraction * noise_px, kRoundingStepPx);
+  }
+
+  // Whether the next step, predicted from the latest one and the one before, is within the
+  // convergence test: Gauss-Newton contracts linearly where the residuals are not small (rate q:
+  // next = q * this = this^2 / before) and quadratically near a small-residual minimum (next ~
+  // c this^2, below this^2 / before once the steps shrink), so this^2 / before bounds it while
+  // the steps contract (by half at least). Measured on the stage-cost scenes at 100 points: 15
+  // polish passes per default fit, most of them the pass after a step of ~1e-2 sigma that only
+  // finds the next of ~1e-5.
+  bool NextPredictedWithinTest(double cost) const {
+    const double noise_px = std::sqrt(cost / dof);
+    return std::isfinite(previous_px) && last_px <= 0.5 * previous_px &&
+           last_px <= kPredictedStepFraction * noise_px &&
+           last_px * last_px <= previous_px * std::max(kConvergedFraction * noise_px,
+                                                       kRoundingStepPx);
+  }
+};
+
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
@@ -387,20 +430,8 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
   // Settled when a step moves the residuals by under this (parameters then move by under 1e-9 of
   // their pixel-noise sigma per px of noise).
   constexpr double kSettledStepPx = 1e-9;
-  // Converged when the last Gauss-Newton step, taken or not, changes the residual vector by at
-  // most kConvergedFraction of the residuals' own sigma (|J delta| in px against
-  // sqrt(cost / (2N - p))), or by rounding alone (kRoundingStepPx): the parameters are then
-  // within 1e-3 of their standard deviation of the minimum in the joint (Mahalanobis) sense.
-  // Where LM stops short on a curved valley, most of the residual is still removable and the
-  // step is about sqrt(2N - p) sigmas.
-  constexpr double kConvergedFraction = 1e-3;
-  constexpr double kRoundingStepPx = 1e-8;
-  double last_step_px = std::numeric_limits<double>::infinity();
-  const double dof = std::max(1.0, 2.0 * points.size() - normal->jtj.rows());
-  auto converged = [&] {
-    const double noise_px = std::sqrt(normal->cost / dof);
-    return last_step_px <= std::max(kConvergedFraction * noise_px, kRoundingStepPx);
-  };
+  PolishSteps steps{std::max(1.0, 2.0 * points.size() - normal->jtj.rows())};
+  auto converged = [&] { return steps.Converged(normal->cost); };
   // The cost's rounding: each residual (a projection less a pixel) is rounded to about
   // kResidualUlps units of the pixel's magnitude, so the cost sum_i |r_i|^2 is rounded to
   // 2 sum_i |r_i| kResidualUlps u |pixel_i| <= 2 kResidualUlps u sqrt(cost) sqrt(sum |pixel_i|^2).
@@ -414,25 +445,6 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                                         std::sqrt(pixel_norm2);
   const JacobianColumns columns(*model);
   double previous_step_px = std::numeric_limits<double>::infinity();
-  // |J delta| of the step before, taken with a pass after it (none yet: infinite).
-  double previous_joint_px = std::numeric_limits<double>::infinity();
-  // A step taken on a prediction is at most this fraction of the residuals' sigma: the normal
-  // equations returned are then those one such step back, and a sigma read from them (a rival's,
-  // fit/determination.cc) moves by under 3e-4 of itself (tests/determination_test.cc).
-  constexpr double kPredictedStepFraction = 1e-2;
-  // The next step predicted from this one and the one before: Gauss-Newton contracts linearly
-  // where the residuals are not small (rate q: next = q * this = this^2 / before) and
-  // quadratically near a small-residual minimum (next ~ c this^2, below this^2 / before once
-  // the steps shrink), so this^2 / before bounds it while the steps contract (by half at least).
-  // Measured on the stage-cost scenes at 100 points: 15 polish passes per default fit, most of
-  // them the pass after a step of ~1e-2 sigma that only finds the next of ~1e-5.
-  auto next_predicted_within_test = [&] {
-    const double noise_px = std::sqrt(normal->cost / dof);
-    return std::isfinite(previous_joint_px) && last_step_px <= 0.5 * previous_joint_px &&
-           last_step_px <= kPredictedStepFraction * noise_px &&
-           last_step_px * last_step_px <=
-               previous_joint_px * std::max(kConvergedFraction * noise_px, kRoundingStepPx);
-  };
   for (int step = 0; step < kMaxSteps; ++step) {
     const ParamVector scale = normal->jtj.diagonal().cwiseSqrt().cwiseMax(1e-300).cwiseInverse();
     const ParamVector delta =
@@ -455,15 +467,16 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
     // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
-    last_step_px = std::sqrt(std::max(0.0, delta.dot(normal->jtj * delta)));
+    steps.last_px = std::sqrt(std::max(0.0, delta.dot(normal->jtj * delta)));
     // With stop_when_converged, a step within the convergence test is the last as well, and so
     // is one whose successor is predicted within it.
     if (step_px <= kSettledStepPx ||
-        (stop_when_converged && (converged() || next_predicted_within_test()))) {
+        (stop_when_converged &&
+         (converged() || steps.NextPredictedWithinTest(normal->cost)))) {
       // The last step: take it without another pass over the points. The normal equations stay
       // those one step back, where J^T J differs by ~1e-12 relative after a settling step (the
       // step's size against the parameters' scales), and by what a step of at most
-      // kPredictedStepFraction of the noise changes after a predicted one.
+      // PolishSteps::kPredictedStepFraction of the noise changes after a predicted one.
       *rotation = new_rotation;
       *center = new_center;
       model->value = new_intrinsics;
@@ -488,7 +501,7 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
     // A step that stops shrinking has reached the rounding floor.
     if (step_px > 0.5 * previous_step_px) return converged();
     previous_step_px = step_px;
-    previous_joint_px = last_step_px;
+    steps.previous_px = steps.last_px;
   }
   return converged();
 }
