@@ -58,7 +58,7 @@ DeterminationCheck CheckDetermination(const Selection& selection,
 
 // Whether an orthographic answer's perspective is observable: the test of "the depth spread is
 // small against the distance". The orthographic camera is the limit e = 0 of the perspective
-// strength e (pixel = c + (u_ortho - c) / (1 + e z_cam), ParametersOf in determination.cc);
+// strength e (pixel = c + (u_ortho - c) / (1 + e z_cam), ParametersOf in pixel_uncertainty.cc);
 // freeing e would lower the kept points' sum of squares J by removed_px2 = r^T H r, linearized
 // (H the hat matrix of the Jacobian with e free, r the selection's residuals, kept points in
 // order). The statistic is that in units of the noise with e free: options.fit.pixel_sigma if
