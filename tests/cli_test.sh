@@ -208,10 +208,13 @@ EOF
     expect_in err "give --fix principal-point"
     [[ ! -e "$work/cam.json" ]] || fail "a camera file for a refusal"
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point -o "$work/cam.json"
+    # Judged over the clicks' box alone, the summary says how to have it judged beyond them.
+    expect_in out "^note: the camera is judged (--max-uncertainty) over the box the points span only, and extrapolated beyond it: give --object-points"
     # The clicks themselves as object points: the same camera, judged over "the object points" too.
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
       --object-points "$work/clicks.csv"
     expect_in out "over the box the points span and the object points"
+    expect_not_in out "^note: the camera is judged"
     # A bad object file is named; a robust loss, which skips the determination check, is refused.
     printf 'X,Y\n1,2\n' >"$work/bad.csv"
     expect_exit 2 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --object-points "$work/bad.csv"

@@ -459,6 +459,9 @@ Command AddFitCommand(CLI::App& root) {
             } else {
               std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
               std::cout << "note: " << NearFarNote(request, fit);
+              if (const std::string judged = JudgedRegionNote(request, fit); !judged.empty()) {
+                std::cout << "note: " << judged;
+              }
               if (fit.camera.world_origin) {
                 const Eigen::Vector3d& o = *fit.camera.world_origin;
                 std::ostringstream line;

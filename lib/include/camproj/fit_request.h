@@ -88,6 +88,11 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
 // points' depths only (the default; with how to cover the whole model), the box, or the options.
 std::string NearFarNote(const FitRequest& request, const FitResult& fit);
 
+// One line (ending in '\n') where the fit's determination check judged the camera over the box
+// the fitted points span alone (no --object-points): beyond that box the camera is
+// extrapolated, and what to give to have it judged there too. Empty otherwise.
+std::string JudgedRegionNote(const FitRequest& request, const FitResult& fit);
+
 // The bounding box of a Wavefront OBJ's vertices (`v x y z` lines; --bounds-mesh). Throws
 // InputError naming the file (and line) for an unreadable file, a bad vertex or no vertices.
 BoxInWorld ReadObjBoundingBox(const std::string& path);
