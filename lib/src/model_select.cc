@@ -252,7 +252,7 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
 // "Fix or drop <them> (left out: ...); add <what>".
 std::string LeftOutThenAdd(const std::string& left_out, const std::string& what) {
   return (left_out.empty() ? std::string("Add ")
-                           : "Fix or drop " + left_out + " (left out: they disagree with the "
+                           : "Fix or drop " + left_out + " (left out as disagreeing with the "
                                                          "rest by far more than the noise); add ") +
          what;
 }
