@@ -419,11 +419,26 @@ TEST(FitAutoTest, ACameraThatStandsOnOneUncheckedClickIsRefused) {
   const std::optional<SceneError> refusal = RefusalOf(scene);
   ASSERT_TRUE(refusal.has_value());
   EXPECT_EQ(refusal->reason(), SceneError::Reason::kDegenerate) << refusal->what();
-  EXPECT_NE(std::string(refusal->what()).find("point 5 is checked by no other point"),
-            std::string::npos)
+  // The message begins with the point's name as the sentence's subject: NamesOf's "point 5"
+  // (no names given), "point 5" for the bare number a points file without ids gives, "c5" as is.
+  EXPECT_EQ(std::string(refusal->what()).rfind("point 5 is checked by no other point", 0), 0u)
       << refusal->what();
   EXPECT_NE(std::string(refusal->what()).find("Add a point near it"), std::string::npos)
       << refusal->what();
+  for (const char* prefix : {"", "c"}) {
+    AutoFitOptions named;
+    for (size_t i = 0; i < scene.points.size(); ++i) {
+      named.point_names.push_back(prefix + std::to_string(i + 1));
+    }
+    const std::string expected =
+        std::string(*prefix ? "c5" : "point 5") + " is checked by no other point";
+    try {
+      Auto(scene.points, scene.pixels, named);
+      ADD_FAILURE() << "answered with point names " << prefix << "1, ...";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(expected, 0), 0u) << e.what();
+    }
+  }
 }
 
 // Scene 64 of the clean 7-point band: pose + focal explains the clicks (rms 0.63 px) and is

@@ -4,6 +4,7 @@
 #include "camproj/model_select.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -403,6 +404,22 @@ Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
               left_out, points, pixels, options, noise);
 }
 
+// A unit direction in the image as "(0.30, 0.95)".
+std::string DirectionText(const Eigen::Vector2d& direction) {
+  char text[48];
+  std::snprintf(text, sizeof text, "(%.2f, %.2f)", direction.x(), direction.y());
+  return text;
+}
+
+// A point's name as a sentence's subject: "point 5" for a bare number (a points file without
+// ids numbers its rows), else the name itself ("c4", or NamesOf's "point 5").
+std::string PointSubject(const std::string& name) {
+  const bool number = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  });
+  return number ? "point " + name : name;
+}
+
 // The least checked kept point (CheckDetermination's, index among the kept points) in the
 // caller's indices and words (PointReliability).
 PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
@@ -420,9 +437,7 @@ PointReliability WordReliability(PointReliability least, const std::vector<int>&
       break;
     }
   }
-  char direction[48];
-  std::snprintf(direction, sizeof direction, "(%.2f, %.2f)", least.direction.x(),
-                least.direction.y());
+  const std::string direction = DirectionText(least.direction);
   const std::string kept_percent = GeneralDouble(100.0 * least.redundancy, 2) + " %";
   const std::string& name = names[least.point];
   least.summary = "least checked: " + name +
@@ -449,12 +464,9 @@ void RefuseIfUnchecked(const PointReliability& least, const std::vector<std::str
   if (!least.checked || least.point < 0) return;
   const double diagonal_px = std::hypot(size.width, size.height);
   if (!(least.redundancy * diagonal_px < sigma_px)) return;
-  char direction[48];
-  std::snprintf(direction, sizeof direction, "(%.2f, %.2f)", least.direction.x(),
-                least.direction.y());
   throw SceneError(SceneError::Reason::kDegenerate,
-                   "point " + names[least.point] + " is checked by no other point" +
-                       ": the camera follows it along " + direction +
+                   PointSubject(names[least.point]) + " is checked by no other point" +
+                       ": the camera follows it along " + DirectionText(least.direction) +
                        ", and a mis-click of it anywhere in the image would leave less than the "
                        "noise (" + Px(sigma_px) + ") in its residual. " +
                        LeftOutThenAdd(left_out, "a point near it, or fix intrinsics you know "
