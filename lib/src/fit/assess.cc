@@ -324,7 +324,8 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   }
   if (behind > 0) {
     throw SceneError(SceneError::Reason::kPointsBehindCamera,
-                     Concat(behind, " of ", n, " points are behind the fitted camera: the "
+                     Concat(behind, " of ", n, behind == 1 ? " points is" : " points are",
+                            " behind the fitted camera: the "
                             "correspondences are inconsistent (mismatched or mis-clicked "
                             "points); check them or use a robust loss"));
   }
