@@ -269,6 +269,8 @@ EOF
     # Default: near and far come from the fitted points only, and the summary says so.
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080
     expect_in out "^note: near .*cover the fitted points' depths only, widened by 10 %.*--bounds"
+    # The points file has no ids: its row numbers name the points, as "point N" in sentences.
+    expect_in out "^reliability: least checked: point [0-9]*, "
     # --bounds-mesh: the box's 8 corners' depths, widened by 10 % (docs: the fit's margin rule),
     # checked against the written camera to 1e-12 relative (the same doubles, a few roundings).
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \

@@ -122,6 +122,18 @@ TEST(GateTest, ChiSquareQuantileIsTheBisectionsRemembered) {
   }
 }
 
+// Messages name a point by its id, with "point " before a bare number (a points file without
+// ids numbers its rows), so that a sentence never reads "7 is checked" or "point point 7".
+TEST(GateTest, PointNamesInMessages) {
+  EXPECT_EQ(internal::PointName("7"), "point 7");
+  EXPECT_EQ(internal::PointName("007"), "point 007");
+  EXPECT_EQ(internal::PointName("point 7"), "point 7");
+  EXPECT_EQ(internal::PointName("c4"), "c4");
+  EXPECT_EQ(internal::PointName("7a"), "7a");
+  EXPECT_EQ(internal::PointName("-7"), "-7");
+  EXPECT_EQ(internal::PointName(""), "");
+}
+
 // GeneralDouble is printf's %.<digits>g to the character (std::to_chars with a precision is
 // specified as that conversion): on random magnitudes over the double range, the values where %g
 // switches notation or rounds up a digit, zeros, infinities and NaN.

@@ -4,7 +4,6 @@
 #include "camproj/model_select.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -92,7 +91,7 @@ std::string WorstPoints(const std::vector<Eigen::Vector2d>& residuals,
   std::string text;
   for (int i = 0; i < std::min<int>(count, static_cast<int>(order.size())); ++i) {
     const double r = residuals[order[i]].norm();
-    text += (i == 0 ? "" : ", ") + names[order[i]] + " (" +
+    text += (i == 0 ? "" : ", ") + internal::PointName(names[order[i]]) + " (" +
             (std::isfinite(r) ? Px(r) : std::string("behind the camera")) + ")";
   }
   return text;
@@ -242,7 +241,7 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
   std::string text;
   for (const int i : left_out) {
     const double r = residuals[i].norm();
-    text += (text.empty() ? "" : ", ") + names[i] + " (" +
+    text += (text.empty() ? "" : ", ") + internal::PointName(names[i]) + " (" +
             (std::isfinite(r) ? Px(r) + " from where the camera puts it"
                               : std::string("behind the camera")) + ")";
   }
@@ -411,15 +410,6 @@ std::string DirectionText(const Eigen::Vector2d& direction) {
   return text;
 }
 
-// A point's name as a sentence's subject: "point 5" for a bare number (a points file without
-// ids numbers its rows), else the name itself ("c4", or NamesOf's "point 5").
-std::string PointSubject(const std::string& name) {
-  const bool number = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c)) != 0;
-  });
-  return number ? "point " + name : name;
-}
-
 // The least checked kept point (CheckDetermination's, index among the kept points) in the
 // caller's indices and words (PointReliability).
 PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
@@ -439,7 +429,7 @@ PointReliability WordReliability(PointReliability least, const std::vector<int>&
   }
   const std::string direction = DirectionText(least.direction);
   const std::string kept_percent = GeneralDouble(100.0 * least.redundancy, 2) + " %";
-  const std::string& name = names[least.point];
+  const std::string name = internal::PointName(names[least.point]);
   least.summary = "least checked: " + name +
                   (least.redundancy < kNoRedundancy
                        ? std::string(", which alone fixes the camera along ") + direction +
@@ -465,7 +455,7 @@ void RefuseIfUnchecked(const PointReliability& least, const std::vector<std::str
   const double diagonal_px = std::hypot(size.width, size.height);
   if (!(least.redundancy * diagonal_px < sigma_px)) return;
   throw SceneError(SceneError::Reason::kDegenerate,
-                   PointSubject(names[least.point]) + " is checked by no other point" +
+                   internal::PointName(names[least.point]) + " is checked by no other point" +
                        ": the camera follows it along " + DirectionText(least.direction) +
                        ", and a mis-click of it anywhere in the image would leave less than the "
                        "noise (" + Px(sigma_px) + ") in its residual. " +

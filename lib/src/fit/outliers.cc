@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "fit/candidate.h"
+#include "fit/gate.h"
 #include "fit/scene.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
@@ -106,7 +107,7 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
 std::string NameList(const std::vector<int>& indices, const std::vector<std::string>& names) {
   std::string text;
   for (size_t i = 0; i < indices.size(); ++i) {
-    text += (i == 0 ? "" : i + 1 == indices.size() ? " or " : ", ") + names[indices[i]];
+    text += (i == 0 ? "" : i + 1 == indices.size() ? " or " : ", ") + PointName(names[indices[i]]);
   }
   return text;
 }

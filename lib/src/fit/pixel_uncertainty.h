@@ -15,7 +15,7 @@
 
 #include "camproj/camera.h"
 #include "camproj/fit.h"
-#include "fit/selection.h"
+#include "fit/normal_equations.h"
 
 namespace camproj {
 namespace internal {
@@ -41,9 +41,10 @@ struct PixelLinearization {
   size_t pose_columns = 6;
 };
 
-// Beyond kKeptJacobianPoints fitted points J is not held whole: J^T J is summed over blocks of
-// points, and a fitted point's rows are recomputed where they are asked for, so the memory does
-// not grow with the points (at a million points J alone would be ~100 MB).
+// Beyond a few thousand fitted points (kKeptJacobianPoints, pixel_uncertainty.cc) J is not held
+// whole: J^T J is summed over blocks of points, and a fitted point's rows are recomputed where
+// they are asked for, so the memory does not grow with the points (at a million points J alone
+// would be ~100 MB).
 class PixelUncertainty {
  public:
   // At `camera` with the parameters `model` frees (an orthographic camera's perspective strength
@@ -82,8 +83,9 @@ class PixelUncertainty {
   // SigmaAtFitted(i) and HatAt(i) from one evaluation of its rows (the same numbers).
   double SigmaAndHatAtFitted(size_t i, Eigen::Matrix2d* hat) const;
 
-  // At least every parameter a model frees (at most 14: the pose's 6, the perspective strength
-  // and 7 intrinsics).
+  // At least every parameter either constructor frees: the pose's 6 and a fit's 10 intrinsic
+  // slots (from its normal equations); the pose's 5 or 6, the perspective strength and 7
+  // intrinsics (from a camera and a model).
   static constexpr int kMaxParameters = 16;
 
  private:
@@ -92,13 +94,14 @@ class PixelUncertainty {
   using ParameterMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParameters, kMaxParameters>;
 
-  Eigen::Vector3d Fitted(size_t i) const;
-  PointRows FittedRows(size_t i) const;
+  // Inline (defined in the .cc, called only there): once per point.
+  inline Eigen::Vector3d Fitted(size_t i) const;
+  inline PointRows FittedRows(size_t i) const;
   void SetWhitening(const Eigen::MatrixXd& normal);
-  std::optional<PointRows> ChartRows(const Eigen::Vector3d& x) const;
-  Eigen::Vector3d InChart(const Eigen::Vector3d& x) const;
-  PointRows Whitened(const PointRows& rows) const;
-  double SigmaOf(const PointRows& jacobian) const;
+  inline std::optional<PointRows> ChartRows(const Eigen::Vector3d& x) const;
+  inline Eigen::Vector3d InChart(const Eigen::Vector3d& x) const;
+  inline PointRows Whitened(const PointRows& rows) const;
+  inline double SigmaOf(const PointRows& jacobian) const;
 
   double sigma_px_;
   const std::vector<Eigen::Vector3d>* fitted_;
