@@ -409,7 +409,7 @@ EmbeddedScene Scene335() {
 // point 680 px right of the image centre, the building's corners up to 116 px off. One click (5) has
 // leverage 1 - 4e-6 along (0.30, 0.95): a mis-click of it anywhere in the image would leave under
 // 0.01 px in its residual. A camera that stands on one unchecked click is refused, naming it
-// (RefuseIfUnchecked, model_select.cc), with what to add.
+// (RefuseIfUnchecked, fit/verdicts.cc), with what to add.
 TEST(FitAutoTest, ACameraThatStandsOnOneUncheckedClickIsRefused) {
   const EmbeddedScene scene = Scene335();
   FitOptions off_axis;

@@ -6,13 +6,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
 
-#include "camproj/fit_report.h"
-#include "camproj/number_text.h"
 #include "check.h"
 #include "fit/candidate.h"
 #include "fit/common.h"
@@ -24,6 +21,7 @@
 #include "fit/scene.h"
 #include "fit/selection.h"
 #include "fit/statistics.h"
+#include "fit/verdicts.h"
 
 namespace camproj {
 
@@ -235,132 +233,6 @@ std::vector<internal::Rival> OtherMinima(const internal::Selection& selection,
   return rivals;
 }
 
-// "c4 (118 px from where the camera puts it), c7 (64 px ...)": the left-out points.
-std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
-                        const std::vector<int>& left_out, const std::vector<std::string>& names) {
-  std::string text;
-  for (const int i : left_out) {
-    const double r = residuals[i].norm();
-    text += (text.empty() ? "" : ", ") + internal::PointName(names[i]) + " (" +
-            (std::isfinite(r) ? Px(r) + " from where the camera puts it"
-                              : std::string("behind the camera")) + ")";
-  }
-  return text;
-}
-
-// The advice that ends a refusal: "Add <what>", or with points left out by the outlier stage
-// "Fix or drop <them> (left out: ...); add <what>".
-std::string LeftOutThenAdd(const std::string& left_out, const std::string& what) {
-  return (left_out.empty() ? std::string("Add ")
-                           : "Fix or drop " + left_out + " (left out as disagreeing with the "
-                                                         "rest by far more than the noise); add ") +
-         what;
-}
-
-// The refusals of the determination check: a camera the points do not pin down to the bound
-// (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
-void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
-                          const std::string& left_out, PixelOrigin pixel_origin) {
-  if (check.passed) return;
-  const std::string add_points =
-      "points where the image has none (toward that pixel) and spread in depth, or fix the "
-      "intrinsics you know (--model, or their values)";
-  const std::string advice = LeftOutThenAdd(left_out, add_points);
-  if (check.rival == internal::kMirroredReadingName && check.rival_shift_px > check.bound_px) {
-    throw SceneError(SceneError::Reason::kAmbiguous,
-                     "the points fit about as well with one world axis flipped, and the two "
-                     "readings put the scene up to " + Px(check.rival_shift_px) +
-                         " apart (bound " + Px(check.bound_px) +
-                         ", --max-uncertainty): the points cannot tell whether the world frame "
-                         "is right- or left-handed. If it may be left-handed, flip one world axis "
-                         "(e.g. negate Z of every point) and refit; otherwise add points spread "
-                         "in depth");
-  }
-  if (check.max_sigma_px > check.bound_px) {
-    throw SceneError(SceneError::Reason::kDegenerate,
-                     "the points do not determine the camera well enough: it is " +
-                         check.summary + " (--max-uncertainty). " + advice);
-  }
-  if (check.rival_shift_px <= check.bound_px) {
-    throw SceneError(
-        SceneError::Reason::kAmbiguous,
-        "the points cannot tell which model is right well enough: " + model + " and the models "
-        "that fit them nearly as well (" + check.averaged_rival + " most), averaged with weights "
-        "from their BIC, " +
-        (std::isfinite(check.averaged_sigma_px)
-             ? "put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma)"
-             : std::string("disagree: one puts a point of the scene behind its camera")) +
-        " near pixel " + internal::PixelText(check.averaged_worst_pixel, pixel_origin) +
-        " (bound " + Px(check.bound_px) + ", --max-uncertainty). " + advice);
-  }
-  // "both fit about as well, but they put the scene up to 8.88 px apart near pixel (445, 673)
-  // (bound 5 px, --max-uncertainty). "
-  const std::string parted =
-      std::string("both fit about as well") +
-      (check.rival_predicts_better
-           ? " (and the latter predicts each point from the others better)"
-           : "") +
-      ", but they put the scene up to " + Px(check.rival_shift_px) + " apart near pixel " +
-      internal::PixelText(check.rival_worst_pixel, pixel_origin) + " (bound " +
-      Px(check.bound_px) + ", --max-uncertainty). ";
-  if (check.rival_frees_lens_shift) {
-    throw SceneError(
-        SceneError::Reason::kAmbiguous,
-        "the points cannot tell where the principal point is: " + model +
-            " leaves it at the image centre and " + check.rival + " frees it; " + parted +
-            "A few points cannot tell a projector's lens shift from a longer focal length and a "
-            "tilt. If the principal point is at the image centre (a camera, or a projector "
-            "without lens shift), give --fix principal-point; if you know where it is, "
-            "--principal-point CX,CY. " + advice);
-  }
-  throw SceneError(SceneError::Reason::kAmbiguous,
-                   "the points cannot tell " + model + " from " + check.rival + ": " + parted +
-                       advice);
-}
-
-// The refusal of an orthographic camera chosen where the points show perspective
-// (fit/determination.h, TestPerspectiveStrength): it can only stand in for a perspective camera
-// the points did not determine, biased off the points (kDegenerate).
-void RefuseIfPerspectiveShows(const internal::PerspectiveTest& test, const std::string& left_out) {
-  if (!test.observable) return;
-  auto g3 = [](double value) { return GeneralDouble(value, 3); };
-  throw SceneError(
-      SceneError::Reason::kDegenerate,
-      "the points show perspective, which the orthographic camera chosen leaves out: freeing "
-      "its perspective strength would remove " + g3(test.removed_px2) + " of its " +
-          g3(test.sum_squares_px2) + " px^2 squared residuals, " + g3(test.statistic) +
-          " times the noise's square (" + Px(test.sigma_px) + " with it free; at most " +
-          g3(test.bound) + " where the depth spread is too small against the distance to "
-          "show perspective), and no perspective model was determined by them or fitted better. " +
-          LeftOutThenAdd(left_out,
-                         "points spread in depth and across the image, or give the intrinsics "
-                         "you know (e.g. --principal-point for a projector's lens shift), so "
-                         "that a perspective camera can be fitted"));
-}
-
-// The refusal of a camera whose confidence region has no edge: within the chosen fit's
-// kLinearityLevel region (its linearity check, fit/assess.cc) a point crosses behind the camera,
-// or the sum of squares along some direction never rises to the region's level. Such a camera's
-// sigmas describe nothing, and the determination check, which propagates them to the test
-// points, cannot see how far it may be off beyond the points (kDegenerate).
-void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) {
-  if (!fit.linearity.checked || std::isfinite(fit.linearity.worst_deviation)) return;
-  std::string along = fit.linearity.worst_direction;
-  for (const ParameterSigma& s : fit.sigmas) {
-    if (s.name == along) along = ParameterSigmaText(s);
-  }
-  const std::string level = GeneralDouble(100.0 * fit.linearity.level, 4);
-  throw SceneError(
-      SceneError::Reason::kDegenerate,
-      "the points do not determine the camera: within its " + level +
-          " % confidence region, along " +
-          along + ", a camera sees some of them from behind or fits them as well, so how far "
-          "it is off beyond them cannot be told. " +
-          LeftOutThenAdd(left_out,
-                         "points where the image has none and spread in depth, or give the "
-                         "intrinsics you know (--model, or their values)"));
-}
-
 // A selection with every point's residual against its camera, recomputed in world coordinates
 // from the camera as returned (and as the camera file stores it), and the gate on the points
 // kept: computed once per selection, read by the pipeline and by the assessment.
@@ -403,66 +275,6 @@ Gated SelectOn(const std::vector<Eigen::Vector3d>& points,
               left_out, points, pixels, options, noise);
 }
 
-// A unit direction in the image as "(0.30, 0.95)".
-std::string DirectionText(const Eigen::Vector2d& direction) {
-  char text[48];
-  std::snprintf(text, sizeof text, "(%.2f, %.2f)", direction.x(), direction.y());
-  return text;
-}
-
-// The least checked kept point (CheckDetermination's, index among the kept points) in the
-// caller's indices and words (PointReliability).
-PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
-                                 const std::vector<std::string>& names) {
-  // Below this a point's residual keeps under 1 % of a mis-click: say what would check it.
-  constexpr double kWeakRedundancy = 0.01;
-  // Redundancy at the hat matrix's rounding (its eigenvalues to ~1e-12 of 1): none.
-  constexpr double kNoRedundancy = 1e-9;
-  if (!least.checked || least.point < 0) return least;
-  int kept = -1;
-  for (int i = 0; i < static_cast<int>(names.size()); ++i) {
-    if (std::binary_search(left_out.begin(), left_out.end(), i)) continue;
-    if (++kept == least.point) {
-      least.point = i;
-      break;
-    }
-  }
-  const std::string direction = DirectionText(least.direction);
-  const std::string kept_percent = GeneralDouble(100.0 * least.redundancy, 2) + " %";
-  const std::string name = internal::PointName(names[least.point]);
-  least.summary = "least checked: " + name +
-                  (least.redundancy < kNoRedundancy
-                       ? std::string(", which alone fixes the camera along ") + direction +
-                             ": a mis-click of it that way would not show in any residual"
-                       : ", whose residual keeps " + kept_percent +
-                             " of a mis-click along " + direction);
-  if (least.redundancy < kWeakRedundancy) {
-    least.summary += "; the other points barely check it: add points (near it), or fix "
-                     "intrinsics you know (e.g. --fix principal-point)";
-  }
-  return least;
-}
-
-// A click no other point checks: `least` (worded) keeps so little of a mis-click along its
-// direction that one anywhere in the image (up to its diagonal) would leave less than the noise
-// in its residual. The camera then stands on that click alone: right if it is, and nothing could
-// show it is not. Measured on the click benchmark's scenes 0-499 (docs/model-selection.md, "A
-// click no other point checks"): the three 6-click scenes whose mis-click the fit absorbed
-// (53-189 px off) are refused, and 63 of 10135 answers, 38 of them at 6 clicks.
-void RefuseIfUnchecked(const PointReliability& least, const std::vector<std::string>& names,
-                       const ImageSize& size, double sigma_px, const std::string& left_out) {
-  if (!least.checked || least.point < 0) return;
-  const double diagonal_px = std::hypot(size.width, size.height);
-  if (!(least.redundancy * diagonal_px < sigma_px)) return;
-  throw SceneError(SceneError::Reason::kDegenerate,
-                   internal::PointName(names[least.point]) + " is checked by no other point" +
-                       ": the camera follows it along " + DirectionText(least.direction) +
-                       ", and a mis-click of it anywhere in the image would leave less than the "
-                       "noise (" + Px(sigma_px) + ") in its residual. " +
-                       LeftOutThenAdd(left_out, "a point near it, or fix intrinsics you know "
-                                                "(e.g. --fix principal-point)"));
-}
-
 // The assessment of the gated selection: the statistics over the kept points, the mirror test,
 // the gate's verdict (kInconsistent when it failed: only the forced-RANSAC path gets here with a
 // failed gate), and the left-out points' report.
@@ -492,21 +304,21 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   for (internal::Rival& rival : OtherMinima(gated.selection, kept_points, kept_pixels, size)) {
     gated.selection.rivals.push_back(std::move(rival));
   }
-  const std::string left_out_text = LeftOutText(gated.residuals_px, left_out, names);
+  const std::string left_out_text = internal::LeftOutText(gated.residuals_px, left_out, names);
   if (options.fit.projection == Projection::kPerspective) {
     // Chosen, not forced: orthographic only where the perspective is not observable.
-    RefuseIfPerspectiveShows(
+    internal::RefuseIfPerspectiveShows(
         internal::TestPerspectiveStrength(gated.selection, kept_points, options), left_out_text);
   }
   PointReliability least_checked;
   const DeterminationCheck determination =
       internal::CheckDetermination(gated.selection, kept_points, options, &least_checked);
-  RefuseIfUndetermined(determination, gated.selection.fit.model, left_out_text,
-                       options.fit.pixel_origin);
-  const PointReliability reliability = WordReliability(least_checked, left_out, names);
+  internal::RefuseIfUndetermined(determination, gated.selection.fit.model, left_out_text,
+                                 options.fit.pixel_origin);
+  const PointReliability reliability = internal::WordReliability(least_checked, left_out, names);
   if (std::isfinite(options.max_uncertainty_px)) {
-    RefuseIfRegionUnbounded(gated.selection.fit, left_out_text);
-    RefuseIfUnchecked(reliability, names, size, noise.sigma_px, left_out_text);
+    internal::RefuseIfRegionUnbounded(gated.selection.fit, left_out_text);
+    internal::RefuseIfUnchecked(reliability, names, size, noise.sigma_px, left_out_text);
   }
 
   FitResult result = std::move(gated.selection.fit);
