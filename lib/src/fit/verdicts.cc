@@ -17,7 +17,7 @@ namespace internal {
 namespace {
 
 // The advice that ends a refusal: "Add <what>", or with points left out by the outlier stage
-// "Fix or drop <them> (left out: ...); add <what>".
+// "Fix or drop <them> (left out as disagreeing ...); add <what>".
 std::string LeftOutThenAdd(const std::string& left_out, const std::string& what) {
   return (left_out.empty() ? std::string("Add ")
                            : "Fix or drop " + left_out + " (left out as disagreeing with the "
@@ -34,7 +34,6 @@ std::string DirectionText(const Eigen::Vector2d& direction) {
 
 }  // namespace
 
-// "c4 (118 px from where the camera puts it), c7 (64 px ...)": the left-out points.
 std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
                         const std::vector<int>& left_out, const std::vector<std::string>& names) {
   std::string text;
@@ -47,8 +46,6 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
   return text;
 }
 
-// The refusals of the determination check: a camera the points do not pin down to the bound
-// (kDegenerate), or one a model fitting about as well puts elsewhere (kAmbiguous).
 void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
                           const std::string& left_out, PixelOrigin pixel_origin) {
   if (check.passed) return;
@@ -108,9 +105,6 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
                        advice);
 }
 
-// The refusal of an orthographic camera chosen where the points show perspective
-// (fit/determination.h, TestPerspectiveStrength): it can only stand in for a perspective camera
-// the points did not determine, biased off the points (kDegenerate).
 void RefuseIfPerspectiveShows(const PerspectiveTest& test, const std::string& left_out) {
   if (!test.observable) return;
   auto g3 = [](double value) { return GeneralDouble(value, 3); };
@@ -128,11 +122,9 @@ void RefuseIfPerspectiveShows(const PerspectiveTest& test, const std::string& le
                          "that a perspective camera can be fitted"));
 }
 
-// The refusal of a camera whose confidence region has no edge: within the chosen fit's
-// kLinearityLevel region (its linearity check, fit/assess.cc) a point crosses behind the camera,
-// or the sum of squares along some direction never rises to the region's level. Such a camera's
-// sigmas describe nothing, and the determination check, which propagates them to the test
-// points, cannot see how far it may be off beyond the points (kDegenerate).
+// No edge: within the chosen fit's kLinearityLevel region (its linearity check, fit/assess.cc) a
+// point crosses behind the camera, or the sum of squares along some direction never rises to the
+// region's level; the determination check propagates sigmas that describe nothing.
 void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) {
   if (!fit.linearity.checked || std::isfinite(fit.linearity.worst_deviation)) return;
   std::string along = fit.linearity.worst_direction;
@@ -151,8 +143,6 @@ void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) 
                          "intrinsics you know (--model, or their values)"));
 }
 
-// The least checked kept point (CheckDetermination's, index among the kept points) in the
-// caller's indices and words (PointReliability).
 PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
                                  const std::vector<std::string>& names) {
   // Below this a point's residual keeps under 1 % of a mis-click: say what would check it.
@@ -184,10 +174,8 @@ PointReliability WordReliability(PointReliability least, const std::vector<int>&
   return least;
 }
 
-// A click no other point checks: `least` (worded) keeps so little of a mis-click along its
-// direction that one anywhere in the image (up to its diagonal) would leave less than the noise
-// in its residual. The camera then stands on that click alone: right if it is, and nothing could
-// show it is not. Measured on the click benchmark's scenes 0-499 (docs/model-selection.md, "A
+// The camera then stands on that click alone: right if it is, and nothing could show it is not.
+// Measured on the click benchmark's scenes 0-499 (docs/model-selection.md, "A
 // click no other point checks"): the three 6-click scenes whose mis-click the fit absorbed
 // (53-189 px off) are refused, and 63 of 10135 answers, 38 of them at 6 clicks.
 void RefuseIfUnchecked(const PointReliability& least, const std::vector<std::string>& names,
