@@ -135,7 +135,11 @@ FitArguments ArgumentsOf(const py::kwargs& kwargs) {
       }
       a.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
     }
-    else if (key == "origin") {
+    else if (key == "bounds_mesh") {
+      a.mesh_vertices_in_world = py::isinstance<py::str>(value)
+                                     ? ReadMeshVertices(value.cast<std::string>())
+                                     : Rows<3>(value.cast<Array>(), "bounds_mesh");
+    } else if (key == "origin") {
       if (py::isinstance<py::str>(value)) {
         if (value.cast<std::string>() != "auto") {
           throw std::invalid_argument("origin: expected \"auto\" or 3 numbers X, Y, Z, got \"" +
@@ -523,7 +527,7 @@ PYBIND11_MODULE(camproj, m) {
           const auto q = Rows<2>(pixels, "pixels");
           return Fit(p, q, IdsOf(ids, q.size()), SizeOf(size), ArgumentsOf(kwargs));
         },
-        "fit(points_in_world, pixels, image_size, *, ids=None, **options) -> Camera\n\n`camproj fit` on arrays: points_in_world (N, 3) in world units seen at pixels (N, 2) in px (OpenCV origin unless pixel_origin=\"corner\"); image_size (width, height) px. Options are the command line's with '-' as '_' (model, criterion, free, fix, focal [px], fovy_deg, aspect, principal_point, skew, k1, k2, intrinsics, pixel_origin, loss, keep_all, ransac_px, sigma [px], max_uncertainty [px], object_points_in_world, near, far, max_iterations). Raises a SceneError subclass with the command line's message when the points cannot determine the camera, ValueError for a bad argument. Conventions: docs/conventions.md.",
+        "fit(points_in_world, pixels, image_size, *, ids=None, **options) -> Camera\n\n`camproj fit` on arrays: points_in_world (N, 3) in world units seen at pixels (N, 2) in px (OpenCV origin unless pixel_origin=\"corner\"); image_size (width, height) px. Options are the command line's with '-' as '_' (model, criterion, free, fix, focal [px], fovy_deg, aspect, principal_point, skew, k1, k2, intrinsics, pixel_origin, loss, keep_all, ransac_px, sigma [px], max_uncertainty [px], object_points_in_world, near, far, bounds (6 numbers), bounds_mesh (an OBJ / PLY path or (M, 3) vertices: near and far cover them and the camera is judged at them), origin, max_iterations). Raises a SceneError subclass with the command line's message when the points cannot determine the camera, ValueError for a bad argument. Conventions: docs/conventions.md.",
         py::arg("points_in_world"), py::arg("pixels"), py::arg("image_size"), py::kw_only(),
         py::arg("ids") = py::none());
   m.def("fit_file",

@@ -209,7 +209,7 @@ EOF
     [[ ! -e "$work/cam.json" ]] || fail "a camera file for a refusal"
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point -o "$work/cam.json"
     # Judged over the clicks' box alone, the summary says how to have it judged beyond them.
-    expect_in out "^note: the camera is judged (--max-uncertainty) over the box the points span only, and extrapolated beyond it: give --object-points"
+    expect_in out "^note: the camera is judged (--max-uncertainty) over the box the points span only, and extrapolated beyond it: give --bounds-mesh model.obj (or .ply) or --object-points"
     # The clicks themselves as object points: the same camera, judged over "the object points" too.
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
       --object-points "$work/clicks.csv"
@@ -227,6 +227,33 @@ EOF
     expect_exit 2 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --object-points "$work/vertices.csv" \
       -o "$work/vertices.csv"
     cmp -s "$work/vertices.csv" "$work/vertices.before" || fail "the object points file was replaced"
+    # The model's mesh (--bounds-mesh) is judged at as its vertices are with --object-points: the
+    # same camera file, near and far aside (the mesh's box), and no note.
+    tail -n +2 "$work/vertices.csv" | tr ',' ' ' | sed 's/^/v /' >"$work/model.obj"
+    expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
+      --object-points "$work/vertices.csv" -o "$work/by_points.json"
+    expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
+      --bounds-mesh "$work/model.obj" -o "$work/by_mesh.json"
+    expect_in out "over the box the points span and the object points"
+    expect_not_in out "^note: the camera is judged"
+    py - "$work/by_points.json" "$work/by_mesh.json" <<'PY' || fail "--bounds-mesh judged otherwise than --object-points"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+for c in (a, b):
+    del c["frustum"], c["fit"]["time_ms"]
+    c.pop("gl", None)
+sys.exit(0 if a["fit"]["determination"] == b["fit"]["determination"] and a["intrinsics"] == b["intrinsics"] else 1)
+PY
+    # Given both, the object points are judged at; a robust loss takes the mesh for near and far.
+    expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
+      --bounds-mesh "$work/model.obj" --object-points "$work/clicks.csv"
+    expect_in out "over the box the points span and the object points"
+    expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --bounds-mesh "$work/model.obj" \
+      --model focal --loss huber:2
+    cp "$work/model.obj" "$work/model.before"
+    expect_exit 2 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --bounds-mesh "$work/model.obj" \
+      -o "$work/model.obj"
+    cmp -s "$work/model.obj" "$work/model.before" || fail "the mesh file was replaced"
     ;;
   fit_robust_loss)
     # A robust loss runs with a forced model (Ceres, said in the summary); the automatic

@@ -146,15 +146,15 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
     arguments.principal_point = Eigen::Vector2d(c[0], c[1]);
   }
   if (!args.intrinsics_path.empty()) arguments.known_intrinsics = ReadIntrinsicsFile(args.intrinsics_path);
-  if (!args.bounds.empty() && !args.bounds_mesh_path.empty()) {
-    throw UsageError("give --bounds or --bounds-mesh, not both");
-  }
   if (!args.bounds.empty()) {
     const std::vector<double> b = ParseNumbers(args.bounds, 6, "--bounds");
     arguments.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
   }
+  if (!args.bounds.empty() && !args.bounds_mesh_path.empty()) {
+    throw UsageError("give --bounds or --bounds-mesh, not both");  // before reading the mesh
+  }
   if (!args.bounds_mesh_path.empty()) {
-    arguments.bounds_in_world = ReadMeshBoundingBox(args.bounds_mesh_path);
+    arguments.mesh_vertices_in_world = ReadMeshVertices(args.bounds_mesh_path);
   }
   if (args.origin == "auto") {
     arguments.auto_world_origin = true;
@@ -195,7 +195,8 @@ struct BatchRow {
 
 // The camera file of each input in `folder`: its name with .json. Two inputs with the same name
 // (a/cam.csv, b/cam.csv) would overwrite each other, and an output that is an input would destroy
-// it (as would one that is the --intrinsics or --object-points file, in `also_read`): both are
+// it (as would one that is the --intrinsics, --object-points or --bounds-mesh file, in
+// `also_read`): both are
 // refused here, before anything is fitted.
 std::vector<std::string> BatchOutputs(const std::vector<std::string>& inputs, const std::string& folder,
                                       const std::vector<std::string>& also_read) {
@@ -237,7 +238,8 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
   if (args.output_path.empty()) throw UsageError("batch fitting needs -o OUTPUT_FOLDER");
   if (args.trace) throw UsageError("--trace is for a single input");
   const std::vector<std::string> outputs =
-      BatchOutputs(inputs, args.output_path, {args.intrinsics_path, args.object_points_path});
+      BatchOutputs(inputs, args.output_path,
+                   {args.intrinsics_path, args.object_points_path, args.bounds_mesh_path});
   std::filesystem::create_directories(args.output_path);
   const int jobs = args.jobs > 0 ? args.jobs
                                  : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -403,8 +405,9 @@ Command AddFitCommand(CLI::App& root) {
                   "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
                   "its 8 corners' depths + 10 %) instead of the fitted points only");
   app->add_option("--bounds-mesh", args->bounds_mesh_path,
-                  "an OBJ or PLY file: near and far cover its vertices' bounding box, as "
-                  "--bounds");
+                  "an OBJ or PLY file of the model: near and far cover its vertices' bounding "
+                  "box, as --bounds, and the camera is judged at its vertices, as "
+                  "--object-points (unless given)");
   app->add_option("--origin", args->origin,
                   "auto or X,Y,Z: record a world origin in the camera file, so that GL exports' "
                   "view matrix takes vertices relative to it (float32 precision for large, e.g. "
@@ -426,8 +429,9 @@ Command AddFitCommand(CLI::App& root) {
             }
             const auto begin = std::chrono::steady_clock::now();
             if (!args->output_path.empty()) {
-              RequireOutputIsNotAnInput(args->output_path, {inputs.front(), args->intrinsics_path,
-                                                            args->object_points_path});
+              RequireOutputIsNotAnInput(args->output_path,
+                                        {inputs.front(), args->intrinsics_path,
+                                         args->object_points_path, args->bounds_mesh_path});
             }
             if (!args->report_path.empty()) {
               try {
@@ -437,7 +441,8 @@ Command AddFitCommand(CLI::App& root) {
               }
               RequireOutputIsNotAnInput(args->report_path,
                                         {inputs.front(), args->intrinsics_path,
-                                         args->object_points_path, args->output_path});
+                                         args->object_points_path, args->bounds_mesh_path,
+                                         args->output_path});
             }
             const auto [data, fit] = FitFile(inputs.front(), size, request);
             const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);

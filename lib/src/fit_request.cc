@@ -19,6 +19,17 @@ namespace camproj {
 
 namespace {
 
+// The smallest box holding `points` (not empty).
+BoxInWorld BoxOfPoints(const std::vector<Eigen::Vector3d>& points) {
+  BoxInWorld box;
+  box.min_in_world = box.max_in_world = points.front();
+  for (const Eigen::Vector3d& p : points) {
+    box.min_in_world = box.min_in_world.cwiseMin(p);
+    box.max_in_world = box.max_in_world.cwiseMax(p);
+  }
+  return box;
+}
+
 const std::vector<std::string> kParameterNames = {"focal", "aspect", "principal-point",
                                                   "skew",  "k1",     "k2"};
 
@@ -176,16 +187,23 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
   if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
-  if (args.bounds_in_world) {
+  if (args.bounds_in_world && !args.mesh_vertices_in_world.empty()) {
+    throw std::invalid_argument("give --bounds or --bounds-mesh, not both");
+  }
+  if (args.bounds_in_world || !args.mesh_vertices_in_world.empty()) {
+    const char* option = args.bounds_in_world ? "--bounds" : "--bounds-mesh";
+    const BoxInWorld box = args.bounds_in_world ? *args.bounds_in_world
+                                                : BoxOfPoints(args.mesh_vertices_in_world);
     try {
-      args.bounds_in_world->Check();
+      box.Check();
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("--bounds: ") + e.what());
+      throw std::invalid_argument(std::string(option) + ": " + e.what());
     }
     if (options.z_near && options.z_far) {
-      throw std::invalid_argument("--bounds sets near and far: give it or both --near and --far, not all three");
+      throw std::invalid_argument(std::string(option) +
+                                  " sets near and far: give it or both --near and --far, not all three");
     }
-    request.bounds_in_world = args.bounds_in_world;
+    request.bounds_in_world = box;
   }
   if (args.world_origin && args.auto_world_origin) {
     throw std::invalid_argument("--origin: give auto or X,Y,Z, not both");
@@ -217,6 +235,10 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
           "robust --loss does not run");
     }
     request.auto_options.object_points_in_world = args.object_points_in_world;
+  } else if (request.automatic) {
+    // The mesh's vertices are where the camera must be right (FitArguments); a robust --loss
+    // runs no determination check, and its mesh sets near and far only.
+    request.auto_options.object_points_in_world = args.mesh_vertices_in_world;
   }
   if (request.automatic) {
     request.auto_options.Check();
@@ -299,38 +321,25 @@ std::string JudgedRegionNote(const FitRequest& request, const FitResult& fit) {
     return "";
   }
   return "the camera is judged (--max-uncertainty) over the box the points span only, and "
-         "extrapolated beyond it: give --object-points (e.g. the model's vertices) to have it "
-         "judged there too\n";
+         "extrapolated beyond it: give --bounds-mesh model.obj (or .ply) or --object-points "
+         "(the model's vertices) to have it judged there too\n";
 }
 
-BoxInWorld ReadObjBoundingBox(const std::string& path) {
-  const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path), path);
-  if (mesh.positions.empty()) throw InputError(path + ": no vertices (v lines) for a bounding box");
-  BoxInWorld box;
-  box.min_in_world = box.max_in_world =
-      Eigen::Vector3d(mesh.positions[0], mesh.positions[1], mesh.positions[2]);
-  for (size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
-    const Eigen::Vector3d p(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]);
-    box.min_in_world = box.min_in_world.cwiseMin(p);
-    box.max_in_world = box.max_in_world.cwiseMax(p);
-  }
-  return box;
-}
-
-BoxInWorld ReadMeshBoundingBox(const std::string& path) {
+std::vector<Eigen::Vector3d> ReadMeshVertices(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension != ".ply") return ReadObjBoundingBox(path);
-  const std::vector<Eigen::Vector3d> positions =
-      internal::PlyVertexPositions(ReadWholeFile(path), path);
-  if (positions.empty()) throw InputError(path + ": no vertices for a bounding box");
-  BoxInWorld box;
-  box.min_in_world = box.max_in_world = positions[0];
-  for (const Eigen::Vector3d& p : positions) {
-    box.min_in_world = box.min_in_world.cwiseMin(p);
-    box.max_in_world = box.max_in_world.cwiseMax(p);
+  std::vector<Eigen::Vector3d> vertices;
+  if (extension == ".ply") {
+    vertices = internal::PlyVertexPositions(ReadWholeFile(path), path);
+  } else {
+    const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path), path);
+    vertices.reserve(mesh.positions.size() / 3);
+    for (size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
+      vertices.emplace_back(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]);
+    }
   }
-  return box;
+  if (vertices.empty()) throw InputError(path + ": no vertices (a mesh's v lines or vertex element)");
+  return vertices;
 }
 
 std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin) {

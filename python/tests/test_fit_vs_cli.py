@@ -28,6 +28,11 @@ CASES = [
     ("projector/points.csv", (1920, 1080), ["--object-points", os.path.join(DATA, "synthetic/points.csv")],
      {"object_points_in_world": camproj.read_points(os.path.join(DATA, "synthetic/points.csv"))[0]}
      if os.path.isdir(DATA) else {}),
+    # The model's mesh: near and far cover it, and the camera is judged at its vertices.
+    ("projector/points.csv", (1920, 1080), ["--bounds-mesh", os.path.join(DATA, "projector/box.obj")],
+     {"bounds_mesh": os.path.join(DATA, "projector/box.obj")}),
+    ("projector/points.csv", (1920, 1080), ["--bounds", "-0.5,-0.3,-0.4,0.5,0.3,0.4", "--origin", "auto"],
+     {"bounds": [-0.5, -0.3, -0.4, 0.5, 0.3, 0.4], "origin": "auto"}),
     ("synthetic/points.csv", (1280, 800), ["--criterion", "aic", "--sigma", "0.5"], {"criterion": "aic", "sigma": 0.5}),
     ("plane/points.csv", (1280, 720), ["--fix", "aspect,principal-point"], {"fix": ["aspect", "principal-point"]}),
     # Refused: a plane with every intrinsic free.

@@ -45,9 +45,15 @@ struct FitArguments {
   std::vector<Eigen::Vector3d> object_points_in_world;
   double z_near = 0.0;  // GL depth range when > 0
   double z_far = 0.0;
-  // --bounds / --bounds-mesh: near and far (those not given above) cover this box, e.g. the
-  // whole model, instead of the fitted points only (DepthRangeCoveringBox, camera.h).
+  // --bounds: near and far (those not given above) cover this box, e.g. the whole model, instead
+  // of the fitted points only (DepthRangeCoveringBox, camera.h).
   std::optional<BoxInWorld> bounds_in_world;
+  // --bounds-mesh: the vertices of the model being mapped (ReadMeshVertices). Near and far cover
+  // their bounding box, as bounds_in_world would (give one of the two); and the default path
+  // judges the camera at them, as object_points_in_world would (unless those are given): the
+  // model is where the camera must be right, and the clicks alone leave the rest of it to
+  // extrapolation (JudgedRegionNote).
+  std::vector<Eigen::Vector3d> mesh_vertices_in_world;
   // --origin: the camera's world_origin (world_origin.h): as given, or with auto_world_origin the
   // fitted points' centroid rounded (AutoOriginOfPoints over the points the fit kept). Neither:
   // no origin.
@@ -89,18 +95,14 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
 std::string NearFarNote(const FitRequest& request, const FitResult& fit);
 
 // One line (ending in '\n') where the fit's determination check judged the camera over the box
-// the fitted points span alone (no --object-points): beyond that box the camera is
+// the fitted points span alone (no --object-points or --bounds-mesh): beyond that box the camera is
 // extrapolated, and what to give to have it judged there too. Empty otherwise.
 std::string JudgedRegionNote(const FitRequest& request, const FitResult& fit);
 
-// The bounding box of a Wavefront OBJ's vertices (`v x y z` lines; --bounds-mesh). Throws
+// --bounds-mesh: the vertex positions of a mesh file, a PLY file's (`.ply`, any case: ascii or
+// binary, the vertex element's x, y, z) or else a Wavefront OBJ's (`v x y z` lines). Throws
 // InputError naming the file (and line) for an unreadable file, a bad vertex or no vertices.
-BoxInWorld ReadObjBoundingBox(const std::string& path);
-
-// --bounds-mesh: the bounding box of a mesh's vertices, a PLY file's (`.ply`, any case: ascii or
-// binary, the vertex element's x, y, z) or else an OBJ's (ReadObjBoundingBox). Throws InputError
-// naming the file and what is wrong.
-BoxInWorld ReadMeshBoundingBox(const std::string& path);
+std::vector<Eigen::Vector3d> ReadMeshVertices(const std::string& path);
 
 // The camera file `camproj fit -o` writes for a fit: cx, cy in `pixel_origin`, the look-at target
 // at the fit's distance, and the `fit` record (fit_report.h).
