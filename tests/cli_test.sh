@@ -160,12 +160,17 @@ case $case in
     expect_exit 3 "$bin" fit "$work/in" --image-size 1920x1080 -o "$work/out_cams" --jobs 2
     expect_in out "projector.csv	ok	pose+focal+principal-point"
     expect_in out "synthetic.csv	ok"
-    expect_in out "plane.csv	ok	pose+focal"
+    # The plane was shot at 1280x720: at 1920x1080 its principal point is assumed 320 px off, and
+    # the camera RANSAC finds leaves out most points (it had been answered so: 16 of its 30 points
+    # left out and k1 -0.25, a wrong camera).
+    expect_in out "plane.csv	refused	.*leaves out [0-9]* of the 30 points, more than half"
+    expect_in out "plane.csv	refused	.*Check the image size"
     expect_in out "line.csv	refused	the 3D points are collinear"
     expect_in out "broken.csv	bad input	.*line 2, column 3 (Z)"
-    expect_in out "3 of 5 fitted"
+    expect_in out "2 of 5 fitted"
     [[ -f "$work/out_cams/projector.json" && -f "$work/out_cams/synthetic.json" ]] || fail "missing camera files"
-    [[ ! -e "$work/out_cams/line.json" && ! -e "$work/out_cams/broken.json" ]] || fail "camera file for a failed input"
+    [[ ! -e "$work/out_cams/line.json" && ! -e "$work/out_cams/broken.json" && ! -e "$work/out_cams/plane.json" ]] ||
+      fail "camera file for a failed input"
     expect_exit 1 "$bin" fit "$work/in/projector.csv" "$work/in/synthetic.csv" --image-size 1920x1080
     expect_in err "needs -o"
     ;;

@@ -6,6 +6,7 @@
 // other than kNumerical ("a bug: please report it"); nothing else (the command line would exit
 // 2). A returned camera
 //   - passed the consistency gate (FitResult::consistency);
+//   - keeps at least half of the points (a minority consensus is refused);
 //   - reports the rms_px a reader of the camera file recomputes: PixelFromWorld over the kept
 //     points (not in FitResult::outliers), every one of them in front of the camera;
 //   - survives CameraToJsonText -> CameraFromJsonText with the same RMS.
@@ -548,6 +549,10 @@ std::string CheckCamera(const FitResult& fit, const StressScene& s) {
       return "outlier index " + std::to_string(i) + " is out of range or repeated";
     }
     kept[i] = false;
+  }
+  if (2 * fit.outliers.size() > s.points.size()) {
+    return "left out " + std::to_string(fit.outliers.size()) + " of " +
+           std::to_string(s.points.size()) + " points, more than half";
   }
   std::string violation;
   const std::optional<double> rms = RecomputedRms(fit.camera, s, kept, &violation);

@@ -390,7 +390,8 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
                          const AutoFitOptions& options, const internal::NoiseReference& noise,
                          const std::optional<SceneError>& refusal, const std::string& problem,
                          const internal::Screen& screen, const std::vector<int>& left_out,
-                         const std::optional<internal::OutlierSearch>& search) {
+                         const std::optional<internal::OutlierSearch>& search,
+                         bool no_outlier_shows) {
   // A failed screen was diagnosed before the outlier search (Pipeline).
   if (screen.consistent) MirrorDiagnosis(points, pixels, size, options, noise);
   if (refusal && (problem.empty() || left_out.empty())) throw *refusal;
@@ -402,6 +403,10 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
                             "and leave out the points that disagree");
   }
   if (search && !search->found) text += "; and " + search->why_not;
+  if (no_outlier_shows) {
+    text += "; no point stands out (their median residual says the same noise as their RMS, as "
+            "Gaussian noise's would), so no choice of points to leave out explains them";
+  }
   throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
                                             : SceneError::Reason::kInconsistent,
                    text + ". Check the correspondences (ids, order, mis-clicks) and refit" +
@@ -448,7 +453,7 @@ class Pipeline {
     // (or find a subset that one does).
     if (!screen_->consistent) MirrorDiagnosis(points_, pixels_, size_, options_, noise_);
     if (!screen_->consistent && options_.find_outliers) {
-      SearchOutliers();
+      if (MayBeOutliers(screen_->check)) SearchOutliers();
     } else if (options_.find_outliers) {
       // A screen that passes may still hold a mis-click its fit absorbed (fit/outliers.h).
       internal::OutlierSearch absorbed =
@@ -464,15 +469,30 @@ class Pipeline {
     unnamed_ = options_;
     std::vector<std::string>().swap(unnamed_.point_names);
     Select();
-    if (!gated_ && left_out_.empty() && options_.find_outliers && !search_) {
+    if (!gated_ && left_out_.empty() && options_.find_outliers && !search_ && !no_outlier_shows_ &&
+        (!failed_gate_ || MayBeOutliers(failed_gate_->check))) {
       SearchOutliers();
       if (!left_out_.empty()) Select();
     }
     if ((gated_ || failed_gate_) && method_ == "lo-ransac") RereadTheConsensus();
+    if (gated_ && 2 * left_out_.size() > points_.size()) RefuseAMinority();
     if (!gated_) {
       Refuse(points_, pixels_, size_, options_, noise_, refusal_, problem_, *screen_, left_out_,
-             search_);
+             search_, no_outlier_shows_);
     }
+  }
+
+  // internal::MayBeOutliers for a gate failure over every point; where not, the residuals look
+  // like noise larger than assumed (no_outlier_shows_) and are not searched: LO-RANSAC at the
+  // assumed noise's threshold would look for a consensus among points that all fit alike (at
+  // 1000 points with 2 px noise against the 1 px prior, 11 % of the refusal's instructions), and
+  // whatever it left out would be the noise's tails.
+  bool MayBeOutliers(const ConsistencyCheck& check) {
+    if (internal::MayBeOutliers(check, static_cast<int>(points_.size()), options_, noise_)) {
+      return true;
+    }
+    no_outlier_shows_ = true;
+    return false;
   }
 
   void SearchOutliers() {
@@ -515,6 +535,22 @@ class Pipeline {
     }
   }
 
+  // A camera that most points disagree with is not what the points say: a minority consensus
+  // can be any systematic error's (seen: a plane fitted at the wrong image size, its principal
+  // point assumed 320 px off, answered with 16 of its 30 points left out and k1 -0.25). Random
+  // pixels leave the good points the largest consensus up to half of them (the click
+  // benchmark's 50 % bands: exactly half left out, never more).
+  [[noreturn]] void RefuseAMinority() const {
+    throw SceneError(
+        SceneError::Reason::kContaminated,
+        "the camera the most points agree on (" + gated_->selection.fit.model + ", found by " +
+            method_ + ") leaves out " + std::to_string(left_out_.size()) + " of the " +
+            std::to_string(points_.size()) +
+            " points, more than half: a minority does not say which camera the points agree on. "
+            "Check the image size (a wrong --image-size moves every point alike) and the "
+            "correspondences (ids, order); --keep-all shows the fit of every point");
+  }
+
   // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at the
   // noise the inliers show, and select once more if it changed. Also where the gate failed on
   // the consensus: a random pixel that lands within RANSAC's threshold of its point's
@@ -525,7 +561,8 @@ class Pipeline {
     const Gated& read = gated_ ? *gated_ : *failed_gate_;
     const std::vector<int> reread =
         internal::OutliersAgainst(read.residuals_px, read.check, noise_, options_);
-    if (reread == left_out_ || 2 * (points_.size() - reread.size()) <= points_.size() / 2) return;
+    // Never a minority of the points (LoRansac, fit/outliers.cc).
+    if (reread == left_out_ || 2 * reread.size() > points_.size()) return;
     const std::vector<int> before = left_out_;
     std::optional<Gated> kept = std::move(gated_);
     const std::optional<SceneError> kept_refusal = refusal_;
@@ -552,6 +589,7 @@ class Pipeline {
   std::vector<int> left_out_;
   std::string method_;  // how left_out_ was found
   std::optional<internal::OutlierSearch> search_;
+  bool no_outlier_shows_ = false;  // a failed gate's residuals showed no outlier: not searched
   std::optional<Gated> gated_;        // the selection whose gate passed
   std::optional<Gated> failed_gate_;  // the last selection whose gate failed, and why:
   std::string problem_;

@@ -85,6 +85,7 @@ Screen FitSubset(const std::vector<Eigen::Vector3d>& points,
       const ConsistencyCheck check = CheckConsistency(lengths, Repeats(x, u), p, noise, options);
       subset.consistent = check.passed;
       subset.summary = fit.model + ", rms " + Px(fit.rms_px) + ": " + check.summary;
+      subset.check = check;
       subset.fit = Prefit{model, std::move(fit), geometry, Filled(std::move(linearization))};
       subset.refusal.reset();
       return subset;
@@ -195,9 +196,7 @@ OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
   const int n = static_cast<int>(points.size());
   OutlierSearch search;
   search.method = "lo-ransac";
-  // Inliers within the gate's outlier bound at the largest noise it accepts.
-  const double threshold = MaxResidualBound(n, options.significance) * options.noise_tolerance *
-                           noise.sigma_px;
+  const double threshold = RansacThresholdPx(n, options, noise);
   std::string last_refusal;
   for (FitOptions model : DetectionModels(options)) {
     if (model.projection != Projection::kPerspective) break;
@@ -266,6 +265,20 @@ OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points,
     search.method = "leave-one-out";
   }
   return search;
+}
+
+double RansacThresholdPx(int n, const AutoFitOptions& options, const NoiseReference& noise) {
+  // Inliers within the gate's outlier bound at the largest noise it accepts.
+  return MaxResidualBound(n, options.significance) * options.noise_tolerance * noise.sigma_px;
+}
+
+bool MayBeOutliers(const ConsistencyCheck& check, int n, const AutoFitOptions& options,
+                   const NoiseReference& noise) {
+  if (n <= options.exhaustive_max_points || !check.checked) return true;
+  // The robust noise times the Rayleigh median is the median residual over the leverage's
+  // sqrt(dof / 2N) <= 1: a little above it, so the search runs where it is in doubt.
+  const double median_px = check.robust_noise_px * kRayleighMedian;
+  return ShowsOutliers(check, n, options) || !(median_px <= RansacThresholdPx(n, options, noise));
 }
 
 OutlierSearch FindOutliers(const std::vector<Eigen::Vector3d>& points,

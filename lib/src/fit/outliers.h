@@ -37,6 +37,7 @@ struct OutlierSearch {
 struct Screen {
   bool consistent = false;
   std::string summary;  // the gate's verdict, or the last refusal
+  ConsistencyCheck check;  // the gate's record, where a model was fitted
   std::optional<Prefit> fit;  // the model fitted and its fit, unless every model was refused
   std::optional<SceneError> refusal;  // the last model's, when every model was refused
 };
@@ -67,6 +68,20 @@ OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points_in_
                                   const std::vector<Eigen::Vector2d>& observed_pixels,
                                   const ImageSize& image_size, const AutoFitOptions& options,
                                   const NoiseReference& noise, const Screen& screen);
+
+// LO-RANSAC's inlier threshold at n points: the gate's outlier bound at the largest noise it
+// accepts, sqrt(2 ln(n / alpha)) * noise_tolerance * noise.
+double RansacThresholdPx(int n, const AutoFitOptions& options, const NoiseReference& noise);
+
+// Whether a gate failure over all n points (`check`) may be outliers, worth the outlier stage:
+// always at up to exhaustive_max_points points (exact and cheap there); above, unless the
+// residuals look like Gaussian noise larger than `noise` around a camera most points agree
+// with -- no outlier shows (ShowsOutliers, gate.h) and the median residual is within
+// RansacThresholdPx, so that least squares already holds the consensus LO-RANSAC would look for.
+// (At 50 % random pixels the least-squares camera is far from every point, the residuals all
+// alike: the median is far beyond the threshold.)
+bool MayBeOutliers(const ConsistencyCheck& check, int n, const AutoFitOptions& options,
+                   const NoiseReference& noise);
 
 // The points whose residual (every point's, against one camera) exceeds the gate's outlier
 // bound for the robust noise of the points kept (`kept_check`, the gate's record over them):
