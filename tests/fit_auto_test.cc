@@ -1217,6 +1217,40 @@ TEST(FitAutoTest, AMinorityConsensusIsRefused) {
   EXPECT_GE(refused_as_minority, 1);
 }
 
+// Eight clicks on a plane shot at 1280 x 720, fitted as 1920 x 1080: a refusal for residuals
+// no point explains says where the principal point was assumed and to check the image size
+// (a plane does not show it); at the right size the same clicks are answered.
+TEST(FitAutoTest, APlaneRefusedForItsResidualsNamesTheAssumedPrincipalPoint) {
+  int refused_for_residuals = 0;
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    SynthOptions synth;
+    synth.seed = testing::Seed(seed);
+    synth.num_points = 8;
+    synth.noise_px = 0.7;
+    synth.object = SynthObject::kPlane;
+    synth.image_size = {1280, 720};
+    synth.fovy_deg = 50.0;
+    const SynthScene scene = SynthesizeScene(synth);
+    const auto& points = scene.correspondences.points_in_world;
+    const auto& pixels = scene.correspondences.pixels;
+    try {
+      FitCameraAuto(points, pixels, {1920, 1080}, {});
+    } catch (const SceneError& e) {
+      if (e.reason() == SceneError::Reason::kInconsistent ||
+          e.reason() == SceneError::Reason::kContaminated) {
+        ++refused_for_residuals;
+        EXPECT_NE(std::string(e.what()).find("assumed at the image's centre (960, 540); check "
+                                             "that the image size is the image's"),
+                  std::string::npos)
+            << "seed " << seed << ": " << e.what();
+      }
+    }
+  }
+  // 9 of 10 at seed offset 0 (the 10th is answered: its clicks fit a camera with the principal
+  // point at the assumed centre within the noise).
+  EXPECT_GE(refused_for_residuals, 1);
+}
+
 // Purely random pixels are refused, never answered.
 TEST(FitAutoTest, RandomPixelsAreRefused) {
   for (const int n : {8, 30, 200}) {

@@ -407,9 +407,23 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
     text += "; no point stands out (their median residual says the same noise as their RMS, as "
             "Gaussian noise's would), so no choice of points to leave out explains them";
   }
+  // On a plane the principal point is not fitted but assumed at the image's centre, so an image
+  // size that is not the image's moves every point alike (data/plane at 1920 x 1080 for its
+  // 1280 x 720: 320 px off); a scene in depth would show it.
+  const bool centre_assumed = screen.fit && screen.fit->geometry.scene.planar &&
+                              options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
+                              !options.fit.known_intrinsics;
+  const std::string centre =
+      centre_assumed
+          ? ". The points are on a plane, which does not show the principal point: it is "
+            "assumed at the image's centre " +
+                internal::PixelText(Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1)),
+                                    options.fit.pixel_origin) +
+                "; check that the image size is the image's, or give --principal-point"
+          : std::string();
   throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
                                             : SceneError::Reason::kInconsistent,
-                   text + ". Check the correspondences (ids, order, mis-clicks) and refit" +
+                   text + centre + ". Check the correspondences (ids, order, mis-clicks) and refit" +
                        (noise.given ? std::string()
                                     : "; if your points are this noisy, give --sigma PX"));
 }
