@@ -139,6 +139,10 @@ FitArguments ArgumentsOf(const py::kwargs& kwargs) {
       a.mesh_vertices_in_world = py::isinstance<py::str>(value)
                                      ? ReadMeshVertices(value.cast<std::string>())
                                      : Rows<3>(value.cast<Array>(), "bounds_mesh");
+      // An empty mesh file is refused by its reader; so is an empty array (not "no mesh").
+      if (a.mesh_vertices_in_world.empty()) {
+        throw std::invalid_argument("bounds_mesh: no vertices");
+      }
     } else if (key == "origin") {
       if (py::isinstance<py::str>(value)) {
         if (value.cast<std::string>() != "auto") {

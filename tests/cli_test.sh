@@ -233,7 +233,8 @@ EOF
       -o "$work/vertices.csv"
     cmp -s "$work/vertices.csv" "$work/vertices.before" || fail "the object points file was replaced"
     # The model's mesh (--bounds-mesh) is judged at as its vertices are with --object-points: the
-    # same camera file, near and far aside (the mesh's box), and no note.
+    # same camera and the same fit record (its time aside), near and far from the mesh's box, and
+    # no note.
     tail -n +2 "$work/vertices.csv" | tr ',' ' ' | sed 's/^/v /' >"$work/model.obj"
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
       --object-points "$work/vertices.csv" -o "$work/by_points.json"
@@ -245,14 +246,20 @@ EOF
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])
 for c in (a, b):
-    del c["frustum"], c["fit"]["time_ms"]
-    c.pop("gl", None)
-sys.exit(0 if a["fit"]["determination"] == b["fit"]["determination"] and a["intrinsics"] == b["intrinsics"] else 1)
+    del c["fit"]["time_ms"]
+same = all(a[k] == b[k] for k in ("cam_from_world", "intrinsics", "fit"))
+sys.exit(0 if same and a["frustum"] != b["frustum"] else 1)
 PY
-    # Given both, the object points are judged at; a robust loss takes the mesh for near and far.
+    # Given both, the object points are judged at, not the mesh's vertices: the determination
+    # reads as with those object points alone. A robust loss takes the mesh for near and far.
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
-      --bounds-mesh "$work/model.obj" --object-points "$work/clicks.csv"
-    expect_in out "over the box the points span and the object points"
+      --object-points "$work/clicks.csv" -o "$work/by_clicks.json"
+    expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --fix principal-point \
+      --bounds-mesh "$work/model.obj" --object-points "$work/clicks.csv" -o "$work/both.json"
+    py -c "import json, sys; a, b = (json.load(open(f))['fit']['determination'] for f in sys.argv[1:]); sys.exit(a != b)" \
+      "$work/by_clicks.json" "$work/both.json" || fail "--object-points with --bounds-mesh judged at the mesh"
+    py -c "import json, sys; a, b = (json.load(open(f))['fit']['determination'] for f in sys.argv[1:]); sys.exit(a == b)" \
+      "$work/by_clicks.json" "$work/by_mesh.json" || fail "the mesh's vertices judged as the clicks alone"
     expect_exit 0 "$bin" fit "$work/clicks.csv" --image-size 1920x1080 --bounds-mesh "$work/model.obj" \
       --model focal --loss huber:2
     cp "$work/model.obj" "$work/model.before"

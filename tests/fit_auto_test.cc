@@ -1127,15 +1127,17 @@ TEST(FitAutoTest, OutliersAreLeftOutWithoutOptions) {
 }
 
 // Gaussian noise of 2.5 px against the 1 px prior, no outlier: refused as noisier than assumed,
-// without an outlier search (ShowsOutliers, fit/gate.h) that would leave out the noise's tails,
-// saying so and how to state the noise; with --sigma 2.5 the same points are answered with every
-// point kept. Per scene, the residuals of 100-300 points show outliers by chance in at most
-// 0.4 % (gate_test: 0.36 % at 100), and the gate passes 2.5 px noise for 1 px x 1.5 never (its
-// bound is 1.76 px at 100 points); with the noise given, the gate's two tests fail clean points
-// in about 2 alpha = 0.2 % (their significance, AutoFitOptions), and LO-RANSAC may then leave
-// out a point. Bound: p = 1 % per scene for either.
+// without an outlier search (MayBeOutliers, fit/outliers.h) that would leave out the noise's
+// tails, saying so and how to state the noise; with --sigma 2.5 the same points are answered
+// with every point kept. Per scene, independent residuals of 100-300 points show outliers by
+// chance in 0.25-0.34 % (gate_test), and the robust noise (2.5 px) falls within the gate's bound
+// and its sampling margin (RobustNoiseBeyondTheBound: 2.18 px at 100 points, log sd 0.072: 1.9
+// sd below 2.5 px) in 2.7 % at 100 points and never at 300; measured on the fits: 4 of 120
+// scenes at seed offsets 0-500 (each searched, then refused otherwise). With the noise given, the gate's two
+// tests fail clean points in about 2 alpha = 0.2 % (AutoFitOptions::significance), and
+// LO-RANSAC may then leave out a point. Bound: p = 3 % per scene for either.
 TEST(FitAutoTest, NoiseAboveTheAssumedIsRefusedWithoutLeavingPointsOut) {
-  constexpr double kPerScene = 0.01;
+  constexpr double kPerScene = 0.03;
   int trials = 0;
   int not_as_noise = 0;
   int given_not_kept = 0;
@@ -1176,6 +1178,38 @@ TEST(FitAutoTest, NoiseAboveTheAssumedIsRefusedWithoutLeavingPointsOut) {
   }
   testing::ExpectRate("noisier than assumed, not refused as noise", not_as_noise, trials, kPerScene);
   testing::ExpectRate("noise given, refused or points left out", given_not_kept, trials, kPerScene);
+}
+
+// A mis-click among points a little noisier than assumed (1.8 px for the 1 px prior, 40 points,
+// one 12 px off): the robust noise is within the gate's bound, so the outlier stage runs
+// (MayBeOutliers, fit/outliers.h) and every answer leaves the mis-click out (with it, now and
+// then, a good point beyond the 1 px prior's bound); no refusal says that no point stands out.
+// (Skipping the search on the ratio test alone refused such scenes saying so, where the search
+// answers: found in a review of session 32. Answered: 9-16 of 20 at seed offsets 0-300.)
+TEST(FitAutoTest, AMisclickAmongNoiseAboveTheAssumedIsStillLookedFor) {
+  int answered = 0;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    SynthOptions synth;
+    synth.seed = testing::Seed(seed);
+    synth.num_points = 40;
+    synth.noise_px = 1.8;
+    synth.object = SynthObject::kBox;
+    synth.principal_point_offset = Eigen::Vector2d(0.0, 0.4);
+    const SynthScene scene = SynthesizeScene(synth);
+    std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
+    pixels[0].x() += 12.0;
+    try {
+      const FitResult fit = Auto(scene.correspondences.points_in_world, pixels);
+      ++answered;
+      EXPECT_TRUE(std::binary_search(fit.outliers.begin(), fit.outliers.end(), 0))
+          << "seed " << seed << ": the mis-click kept";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).find("no point stands out"), std::string::npos)
+          << "seed " << seed << ": " << e.what();
+    }
+  }
+  std::printf("[ INFO     ] answered with the mis-click left out: %d of 20\n", answered);
+  EXPECT_GE(answered, 1);
 }
 
 // A plane shot at 1280 x 720 and fitted as 1920 x 1080 (its principal point assumed 320 px

@@ -146,15 +146,16 @@ std::vector<double> NoisyLengths(std::mt19937_64& random, int n, double sigma_px
   return lengths;
 }
 
-// Gaussian noise twice the 1 px reference shows no outliers: where it fails the gate (from about
-// 30 observations on), the outlier stage does not search it (model_select.cc). Per trial the ratio test calls it
-// contaminated at its asymptotic level alpha = 0.1 %, the outlier test at about alpha; at 13
-// observations the ratio's tail is heavier (gate.h) and the median noisier: 1.26 % of 5000
-// simulated trials there, 0.76 % at 30, 0.36 % at 100, 0.26 % at 1000. Bound: p = 1.5 %.
+// Gaussian noise twice the 1 px reference shows no outliers (where it also fails the gate, the
+// outlier stage does not search it: MayBeOutliers, fit/outliers.h). Per trial the ratio test
+// calls it contaminated at its asymptotic level alpha = 0.1 %, the outlier test at about alpha;
+// at 13 observations the ratio's tail is heavier (gate.h) and the median noisier. This test's
+// draws at seed offsets 1-10 (20 000 trials per n): 0.71 % at 13, 0.49 % at 30, 0.34 % at 100,
+// 0.25 % at 1000. Bound: p = 1 %.
 TEST(GateTest, GaussianNoiseAboveTheReferenceShowsNoOutliers) {
   constexpr int kNumParams = 7;
   constexpr int kTrials = 2000;
-  constexpr double kFalseAlarm = 0.015;
+  constexpr double kFalseAlarm = 0.01;
   const internal::NoiseReference noise;  // 1 px, the default prior
   const AutoFitOptions options;
   std::mt19937_64 random(testing::Seed(41));

@@ -405,7 +405,8 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   if (search && !search->found) text += "; and " + search->why_not;
   if (no_outlier_shows) {
     text += "; no point stands out (their median residual says the same noise as their RMS, as "
-            "Gaussian noise's would), so no choice of points to leave out explains them";
+            "Gaussian noise's would), and no point left out could bring that noise within the "
+            "bound: none was left out";
   }
   // On a plane the principal point is not fitted but assumed at the image's centre, so an image
   // size that is not the image's moves every point alike (data/plane at 1920 x 1080 for its
@@ -483,7 +484,7 @@ class Pipeline {
     unnamed_ = options_;
     std::vector<std::string>().swap(unnamed_.point_names);
     Select();
-    if (!gated_ && left_out_.empty() && options_.find_outliers && !search_ && !no_outlier_shows_ &&
+    if (!gated_ && left_out_.empty() && options_.find_outliers && !search_ &&
         (!failed_gate_ || MayBeOutliers(failed_gate_->check))) {
       SearchOutliers();
       if (!left_out_.empty()) Select();
@@ -496,17 +497,14 @@ class Pipeline {
     }
   }
 
-  // internal::MayBeOutliers for a gate failure over every point; where not, the residuals look
-  // like noise larger than assumed (no_outlier_shows_) and are not searched: LO-RANSAC at the
-  // assumed noise's threshold would look for a consensus among points that all fit alike (at
-  // 1000 points with 2 px noise against the 1 px prior, 11 % of the refusal's instructions), and
-  // whatever it left out would be the noise's tails.
+  // internal::MayBeOutliers for a gate failure over every point; where not (no_outlier_shows_),
+  // the points look like Gaussian noise larger than the gate accepts and are not searched:
+  // LO-RANSAC's consensus would be about every point (at 1000 points with 2 px noise against
+  // the 1 px prior, 11 % of the refusal's instructions), and whatever it left out would be the
+  // noise's tails.
   bool MayBeOutliers(const ConsistencyCheck& check) {
-    if (internal::MayBeOutliers(check, static_cast<int>(points_.size()), options_, noise_)) {
-      return true;
-    }
-    no_outlier_shows_ = true;
-    return false;
+    no_outlier_shows_ = !internal::MayBeOutliers(check, options_, noise_);
+    return !no_outlier_shows_;
   }
 
   void SearchOutliers() {
@@ -557,12 +555,12 @@ class Pipeline {
   [[noreturn]] void RefuseAMinority() const {
     throw SceneError(
         SceneError::Reason::kContaminated,
-        "the camera the most points agree on (" + gated_->selection.fit.model + ", found by " +
-            method_ + ") leaves out " + std::to_string(left_out_.size()) + " of the " +
-            std::to_string(points_.size()) +
-            " points, more than half: a minority does not say which camera the points agree on. "
+        "the camera of the largest consensus " + method_ + " found (" +
+            gated_->selection.fit.model + ") leaves out " + std::to_string(left_out_.size()) +
+            " of the " + std::to_string(points_.size()) +
+            " points, more than half: so few agreeing points do not say which camera it is. "
             "Check the image size (a wrong --image-size moves every point alike) and the "
-            "correspondences (ids, order); --keep-all shows the fit of every point");
+            "correspondences (ids, order)");
   }
 
   // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at the
@@ -575,7 +573,7 @@ class Pipeline {
     const Gated& read = gated_ ? *gated_ : *failed_gate_;
     const std::vector<int> reread =
         internal::OutliersAgainst(read.residuals_px, read.check, noise_, options_);
-    // Never a minority of the points (LoRansac, fit/outliers.cc).
+    // Never a minority of the points (RefuseAMinority).
     if (reread == left_out_ || 2 * reread.size() > points_.size()) return;
     const std::vector<int> before = left_out_;
     std::optional<Gated> kept = std::move(gated_);

@@ -4,6 +4,7 @@ import glob
 import json
 import os
 
+import numpy as np
 import pytest
 
 import camproj
@@ -78,6 +79,19 @@ def test_fit_on_arrays_equals_fit_file(data_dir):
     a = camproj.fit(points, pixels, (1920, 1080), ids=ids)
     b = camproj.fit_file(path, (1920, 1080))
     assert_same_json(load_json(a.to_json()), load_json(b.to_json()))
+
+
+def test_bounds_mesh_as_vertices_equals_the_mesh_file(data_dir):
+    # The mesh's vertices as an array are the mesh file: the same camera file.
+    path = os.path.join(data_dir, "projector/points.csv")
+    mesh = os.path.join(data_dir, "projector/box.obj")
+    vertices = np.array([[float(v) for v in line.split()[1:4]]
+                         for line in open(mesh) if line.startswith("v ")])
+    a = camproj.fit_file(path, (1920, 1080), bounds_mesh=mesh)
+    b = camproj.fit_file(path, (1920, 1080), bounds_mesh=vertices)
+    assert_same_json(load_json(a.to_json()), load_json(b.to_json()))
+    with pytest.raises(ValueError, match="bounds_mesh: no vertices"):
+        camproj.fit_file(path, (1920, 1080), bounds_mesh=np.zeros((0, 3)))
 
 
 def test_outliers_by_index_and_id(cli, data_dir, tmp_path):

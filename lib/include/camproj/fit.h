@@ -233,6 +233,7 @@ struct ConsistencyCheck {
   double max_residual_px = 0.0;    // largest residual among the points kept
   double max_residual_bound_px = 0.0;  // outlier bound: sqrt(2 ln(N / alpha)) * noise
   double significance = 0.0;   // alpha of both tests
+  int observations = 0;        // N: the points kept, each repeated correspondence counted once
   std::string summary;         // one line in words
 };
 

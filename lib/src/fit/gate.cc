@@ -84,6 +84,7 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
     check.rms_px = std::sqrt(sum_squares_all / static_cast<double>(residual_lengths_px.size()));
   }
   const int n = static_cast<int>(observed.size());
+  check.observations = n;
   double sum_squares = 0.0;
   for (const double r : observed) sum_squares += r * r;
   const int dof = 2 * n - num_params;
@@ -122,19 +123,41 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
   return check;
 }
 
+namespace {
+
+// z_{1 - alpha}, the standard normal's upper quantile.
+double NormalUpperQuantile(double alpha) {
+  return std::sqrt(ChiSquareQuantile(1.0, 1.0 - 2.0 * alpha));
+}
+
+// N times the variance of the log of the median-based noise estimate, for Gaussian residuals
+// per axis (|r| Rayleigh): 1 / (4 (f(m) m)^2) with f(m) m = ln 2 at the median m.
+double MedianLogVarianceTimesN() {
+  const double ln2 = std::log(2.0);
+  return 0.25 / (ln2 * ln2);
+}
+
+}  // namespace
+
+bool RobustNoiseBeyondTheBound(const ConsistencyCheck& check, const AutoFitOptions& options) {
+  if (!check.checked || check.observations < 1) return false;
+  const double margin = std::exp(NormalUpperQuantile(options.significance) *
+                                 std::sqrt(MedianLogVarianceTimesN() / check.observations));
+  return check.robust_noise_px > margin * check.noise_bound_px;
+}
+
 bool ShowsOutliers(const ConsistencyCheck& check, int num_observations,
                    const AutoFitOptions& options) {
   // The variance of log(noise estimate / robust noise) times N for Gaussian residuals per axis
   // (|r| Rayleigh): 1/4 for the log of the RMS, ln(2)^-2 / 4 = 0.520 for the log of the median
   // (its density f(m) m = ln 2 at the median m), covariance 1/4 (Bahadur's representation of
-  // the median; E[r^2; r <= m] = (1 - ln 2) 2 sigma^2): 0.25 + 0.520 - 0.5. Simulated: 0.27 at
-  // 100-3000 observations, 0.26 at 13.
-  const double ln2 = std::log(2.0);
-  const double kNoiseRatioLogVariance = 0.25 + 0.25 / (ln2 * ln2) - 0.5;
+  // the median; E[r^2; r <= m] = (1 - ln 2) sigma^2): 0.25 + 0.520 - 0.5. Simulated: 0.27 at
+  // 100-3000 observations, 0.24-0.26 at 13-30.
+  const double kNoiseRatioLogVariance = 0.25 + MedianLogVarianceTimesN() - 0.5;
   if (!(check.max_residual_px <= check.max_residual_bound_px)) return true;
   if (!(check.robust_noise_px > 0.0) || num_observations < 1) return true;
-  const double z = std::sqrt(ChiSquareQuantile(1.0, 1.0 - 2.0 * options.significance));
-  const double bound = std::exp(z * std::sqrt(kNoiseRatioLogVariance / num_observations));
+  const double bound = std::exp(NormalUpperQuantile(options.significance) *
+                                std::sqrt(kNoiseRatioLogVariance / num_observations));
   return !(check.noise_estimate_px <= bound * check.robust_noise_px);
 }
 

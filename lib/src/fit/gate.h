@@ -65,6 +65,13 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
 bool ShowsOutliers(const ConsistencyCheck& check, int num_observations,
                    const AutoFitOptions& options);
 
+// Whether the robust noise of a CheckConsistency record (the median's, which no outlier among
+// fewer than half the points moves far) exceeds the bound on the noise estimate by more than its
+// own sampling error at significance alpha: for Gaussian residuals the log of the median's
+// estimate has variance ln(2)^-2 / (4N) (gate.cc), 0.52 / N. The points' own noise is then
+// beyond what the gate accepts, with or without outliers.
+bool RobustNoiseBeyondTheBound(const ConsistencyCheck& check, const AutoFitOptions& options);
+
 }  // namespace internal
 }  // namespace camproj
 

@@ -73,14 +73,15 @@ OutlierSearch FindAbsorbedOutlier(const std::vector<Eigen::Vector3d>& points_in_
 // accepts, sqrt(2 ln(n / alpha)) * noise_tolerance * noise.
 double RansacThresholdPx(int n, const AutoFitOptions& options, const NoiseReference& noise);
 
-// Whether a gate failure over all n points (`check`) may be outliers, worth the outlier stage:
-// always at up to exhaustive_max_points points (exact and cheap there); above, unless the
-// residuals look like Gaussian noise larger than `noise` around a camera most points agree
-// with -- no outlier shows (ShowsOutliers, gate.h) and the median residual is within
-// RansacThresholdPx, so that least squares already holds the consensus LO-RANSAC would look for.
-// (At 50 % random pixels the least-squares camera is far from every point, the residuals all
-// alike: the median is far beyond the threshold.)
-bool MayBeOutliers(const ConsistencyCheck& check, int n, const AutoFitOptions& options,
+// Whether points left out could make a gate failure over every point (`check`) pass, so that
+// the outlier stage is worth running: always at up to exhaustive_max_points observations (exact
+// and cheap there); above, unless the residuals look like Gaussian noise around a camera most
+// points agree with, and that noise is beyond what the gate accepts: no outlier shows
+// (ShowsOutliers, gate.h), the median residual is within RansacThresholdPx (so LO-RANSAC's
+// consensus would be about every point; at 50 % random pixels the least-squares camera is far
+// from every point and the median far beyond it), and the robust noise exceeds the gate's bound
+// on the noise estimate by more than its sampling error (RobustNoiseBeyondTheBound, gate.h).
+bool MayBeOutliers(const ConsistencyCheck& check, const AutoFitOptions& options,
                    const NoiseReference& noise);
 
 // The points whose residual (every point's, against one camera) exceeds the gate's outlier
