@@ -134,6 +134,30 @@ TEST(GateTest, PointNamesInMessages) {
   EXPECT_EQ(internal::PointName(""), "");
 }
 
+// The binomial tail the left-out points' randomness test reads (fit/statistics.h): exact values
+// (sums of binomial coefficients over 2^n) to 1e-12 relative, its edges, the complement of the
+// lower tail, and a large n whose sum stops early.
+TEST(GateTest, BinomialTailAtLeastIsTheSumOfItsTerms) {
+  EXPECT_NEAR(internal::BinomialTailAtLeast(10, 0.5, 5), 638.0 / 1024.0, 1e-12);
+  EXPECT_NEAR(internal::BinomialTailAtLeast(10, 0.5, 10), 1.0 / 1024.0, 1e-12 / 1024.0);
+  EXPECT_NEAR(internal::BinomialTailAtLeast(3, 0.1, 2), 3 * 0.01 * 0.9 + 0.001, 1e-15);
+  EXPECT_EQ(internal::BinomialTailAtLeast(7, 0.3, 0), 1.0);
+  EXPECT_EQ(internal::BinomialTailAtLeast(7, 0.3, 8), 0.0);
+  EXPECT_EQ(internal::BinomialTailAtLeast(7, 0.0, 1), 0.0);
+  EXPECT_EQ(internal::BinomialTailAtLeast(7, 1.0, 7), 1.0);
+  // P(X >= k) + P(X < k) = 1, the lower tail summed directly.
+  for (const int k : {1, 5, 12, 30}) {
+    double lower = 0.0;
+    for (int j = 0; j < k; ++j) {
+      lower += std::exp(std::lgamma(61.0) - std::lgamma(j + 1.0) - std::lgamma(61.0 - j) +
+                        j * std::log(0.2) + (60 - j) * std::log(0.8));
+    }
+    EXPECT_NEAR(internal::BinomialTailAtLeast(60, 0.2, k) + lower, 1.0, 1e-12) << "k " << k;
+  }
+  // A million trials at p = 1e-6: P(X >= 3) = 1 - e^-1 (1 + 1 + 1/2) (Poisson) to ~1e-6.
+  EXPECT_NEAR(internal::BinomialTailAtLeast(1000000, 1e-6, 3), 1.0 - std::exp(-1.0) * 2.5, 1e-6);
+}
+
 // Residual lengths of n observations with Gaussian pixel noise `sigma_px` per axis, the first
 // `num_outliers` replaced by lengths uniform in [0, 600] px (random pixels).
 std::vector<double> NoisyLengths(std::mt19937_64& random, int n, double sigma_px, int num_outliers) {

@@ -89,6 +89,23 @@ inline double MaxResidualBound(int num_points, double alpha) {
   return std::sqrt(2.0 * std::log(std::max(1, num_points) / alpha));
 }
 
+// P(X >= k) for X ~ Binomial(n, p), summed term by term in log space (n up to millions: the
+// terms fall off geometrically beyond the mean, and the sum stops when they no longer count).
+inline double BinomialTailAtLeast(int n, double p, int k) {
+  if (k <= 0) return 1.0;
+  if (k > n || p <= 0.0) return 0.0;
+  if (p >= 1.0) return 1.0;
+  double tail = 0.0;
+  for (int j = k; j <= n; ++j) {
+    const double term = std::exp(std::lgamma(n + 1.0) - std::lgamma(j + 1.0) -
+                                 std::lgamma(n - j + 1.0) + j * std::log(p) +
+                                 (n - j) * std::log1p(-p));
+    tail += term;
+    if (j > n * p && term < 1e-17 * tail) break;
+  }
+  return std::min(1.0, tail);
+}
+
 // The median of |r| for a 2D Gaussian with sigma 1 per axis (Rayleigh): sqrt(2 ln 2).
 inline constexpr double kRayleighMedian = 1.1774100225154747;
 
