@@ -1212,6 +1212,19 @@ TEST(FitAutoTest, AMisclickAmongNoiseAboveTheAssumedIsStillLookedFor) {
   EXPECT_GE(answered, 1);
 }
 
+// A plane seen by a 1280 x 720 camera with a 50 deg vertical view (the tests below fit it as
+// 1920 x 1080: an image size that is not the image's).
+SynthScene PlaneShotAt1280x720(uint64_t seed, int num_points, double noise_px) {
+  SynthOptions synth;
+  synth.seed = testing::Seed(seed);
+  synth.num_points = num_points;
+  synth.noise_px = noise_px;
+  synth.object = SynthObject::kPlane;
+  synth.image_size = {1280, 720};
+  synth.fovy_deg = 50.0;
+  return SynthesizeScene(synth);
+}
+
 // A plane shot at 1280 x 720 and fitted as 1920 x 1080 (its principal point assumed 320 px
 // right of and 180 px below the truth): every point moves alike, and LO-RANSAC's consensus is
 // part of the points, the rest left out as if outliers (data/plane: 16 of 30 points left out,
@@ -1225,14 +1238,7 @@ TEST(FitAutoTest, AMinorityConsensusIsRefused) {
   int refused_as_minority = 0;
   int trials = 0;
   for (uint64_t seed = 1; seed <= 20; ++seed) {
-    SynthOptions synth;
-    synth.seed = testing::Seed(seed);
-    synth.num_points = 30;
-    synth.noise_px = 0.5;
-    synth.object = SynthObject::kPlane;
-    synth.image_size = {1280, 720};
-    synth.fovy_deg = 50.0;
-    const SynthScene scene = SynthesizeScene(synth);
+    const SynthScene scene = PlaneShotAt1280x720(seed, 30, 0.5);
     const auto& points = scene.correspondences.points_in_world;
     const auto& pixels = scene.correspondences.pixels;
     ++trials;
@@ -1257,18 +1263,11 @@ TEST(FitAutoTest, AMinorityConsensusIsRefused) {
 
 // Eight clicks on a plane shot at 1280 x 720, fitted as 1920 x 1080: a refusal for residuals
 // no point explains says where the principal point was assumed and to check the image size
-// (a plane does not show it); at the right size the same clicks are answered.
+// (a plane does not show it).
 TEST(FitAutoTest, APlaneRefusedForItsResidualsNamesTheAssumedPrincipalPoint) {
   int refused_for_residuals = 0;
   for (uint64_t seed = 1; seed <= 10; ++seed) {
-    SynthOptions synth;
-    synth.seed = testing::Seed(seed);
-    synth.num_points = 8;
-    synth.noise_px = 0.7;
-    synth.object = SynthObject::kPlane;
-    synth.image_size = {1280, 720};
-    synth.fovy_deg = 50.0;
-    const SynthScene scene = SynthesizeScene(synth);
+    const SynthScene scene = PlaneShotAt1280x720(seed, 8, 0.7);
     const auto& points = scene.correspondences.points_in_world;
     const auto& pixels = scene.correspondences.pixels;
     try {
