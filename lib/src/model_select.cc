@@ -411,7 +411,12 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   // On a plane the principal point is not fitted but assumed at the image's centre, so an image
   // size that is not the image's moves every point alike (data/plane at 1920 x 1080 for its
   // 1280 x 720: 320 px off); a scene in depth would show it.
-  const bool centre_assumed = screen.fit && screen.fit->geometry.scene.planar &&
+  // (The screen's geometry where it fitted a model; where every screen model was refused, the
+  // points' own.)
+  const bool planar =
+      screen.fit ? screen.fit->geometry.scene.planar
+                 : internal::PrepareScene(points, pixels, size, options.fit.pixel_origin).scene.planar;
+  const bool centre_assumed = planar &&
                               options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
                               !options.fit.known_intrinsics;
   const std::string centre =
