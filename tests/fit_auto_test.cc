@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include "camproj/camera.h"
@@ -79,10 +80,14 @@ AutoFitOptions Forced() {
 // every seed at 20 and 300 points; at 6 points some are refused for another reason first (a
 // point behind the best linear camera, a camera not determined): the click benchmark's mirrored
 // N = 6 band names another reason in 7 of 99 refusals (docs/bench/clicks), so the rate asserted
-// is p = 0.15 per scene, twice that.
+// is p = 0.15 per scene, twice that. Six clicks that all lie on one face of the box are not a
+// mirrored world to the fit: a plane's mirror image is the plane turned over (see
+// PlanesAreNeverRefusedAsPossiblyMirrored), so they are left out of this test (seen: box seed
+// 9 at seed offset 20000, answered as the plane seen from its other side, rms 0.74 px).
 TEST(FitAutoTest, MirroredWorldsAreRefused) {
   int six_point_refusals = 0;
   int six_point_unnamed = 0;
+  int coplanar = 0;
   for (const int n : {6, 20, 300}) {
     for (const SynthObject object : {SynthObject::kBox, SynthObject::kCloud}) {
       // Fewer seeds at 300 points: each costs ~100 fits (CI runs this under ASan too).
@@ -90,6 +95,18 @@ TEST(FitAutoTest, MirroredWorldsAreRefused) {
         const SynthScene scene = Clicks(seed, n, object);
         std::vector<Eigen::Vector3d> mirrored = scene.correspondences.points_in_world;
         for (auto& x : mirrored) x.z() = -x.z();
+        // On one plane exactly (the box's faces are exact): the smallest principal spread
+        // vanishes to rounding against the largest.
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (const auto& x : mirrored) mean += x / static_cast<double>(mirrored.size());
+        for (const auto& x : mirrored) scatter += (x - mean) * (x - mean).transpose();
+        const Eigen::Vector3d spreads = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter)
+                                            .eigenvalues();  // ascending
+        if (spreads(0) <= 1e-20 * spreads(2)) {
+          ++coplanar;
+          continue;
+        }
         for (const bool forced : {false, true}) {
           try {
             const FitResult fit = Auto(mirrored, scene.correspondences.pixels,
@@ -111,6 +128,7 @@ TEST(FitAutoTest, MirroredWorldsAreRefused) {
   }
   testing::ExpectRate("mirrored 6-point scenes refused without naming the mirror",
                       six_point_unnamed, six_point_refusals, 0.15);
+  std::printf("[ INFO     ] scenes on one plane, left out: %d\n", coplanar);
 }
 
 // Six clicked corners of a mirrored world (bench --clicks, band "mirrored N=6", scenes 29 and
