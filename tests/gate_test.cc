@@ -189,7 +189,7 @@ TEST(GateTest, GaussianNoiseAboveTheReferenceShowsNoOutliers) {
       const std::vector<double> lengths = NoisyLengths(random, n, 2.0, 0);
       const ConsistencyCheck check =
           internal::CheckConsistency(lengths, {}, kNumParams, noise, options);
-      shown += internal::ShowsOutliers(check, n, options) ? 1 : 0;
+      shown += internal::ShowsOutliers(check, options) ? 1 : 0;
     }
     testing::ExpectRate("Gaussian noise called contaminated, n = " + std::to_string(n), shown,
                         kTrials, kFalseAlarm);
@@ -213,7 +213,7 @@ TEST(GateTest, RandomPixelsAmongTheNoiseShowAsOutliers) {
         const int k = static_cast<int>(std::lround(fraction * n));
         const ConsistencyCheck check = internal::CheckConsistency(
             NoisyLengths(random, n, 2.0, k), {}, kNumParams, noise, options);
-        missed += internal::ShowsOutliers(check, n, options) ? 0 : 1;
+        missed += internal::ShowsOutliers(check, options) ? 0 : 1;
       }
       testing::ExpectRate("random pixels not shown, n = " + std::to_string(n) + ", fraction " +
                               GeneralDouble(fraction, 2),
@@ -223,7 +223,7 @@ TEST(GateTest, RandomPixelsAmongTheNoiseShowAsOutliers) {
   std::vector<double> lengths = NoisyLengths(random, 1000, 2.0, 0);
   lengths[500] = 100.0;
   const ConsistencyCheck check = internal::CheckConsistency(lengths, {}, kNumParams, noise, options);
-  EXPECT_TRUE(internal::ShowsOutliers(check, 1000, options)) << check.summary;
+  EXPECT_TRUE(internal::ShowsOutliers(check, options)) << check.summary;
 }
 
 // GeneralDouble is printf's %.<digits>g to the character (std::to_chars with a precision is

@@ -146,8 +146,7 @@ bool RobustNoiseBeyondTheBound(const ConsistencyCheck& check, const AutoFitOptio
   return check.robust_noise_px > margin * check.noise_bound_px;
 }
 
-bool ShowsOutliers(const ConsistencyCheck& check, int num_observations,
-                   const AutoFitOptions& options) {
+bool ShowsOutliers(const ConsistencyCheck& check, const AutoFitOptions& options) {
   // The variance of log(noise estimate / robust noise) times N for Gaussian residuals per axis
   // (|r| Rayleigh): 1/4 for the log of the RMS, ln(2)^-2 / 4 = 0.520 for the log of the median
   // (its density f(m) m = ln 2 at the median m), covariance 1/4 (Bahadur's representation of
@@ -155,9 +154,9 @@ bool ShowsOutliers(const ConsistencyCheck& check, int num_observations,
   // 100-3000 observations, 0.24-0.26 at 13-30.
   const double kNoiseRatioLogVariance = 0.25 + MedianLogVarianceTimesN() - 0.5;
   if (!(check.max_residual_px <= check.max_residual_bound_px)) return true;
-  if (!(check.robust_noise_px > 0.0) || num_observations < 1) return true;
+  if (!(check.robust_noise_px > 0.0) || check.observations < 1) return true;
   const double bound = std::exp(NormalUpperQuantile(options.significance) *
-                                std::sqrt(kNoiseRatioLogVariance / num_observations));
+                                std::sqrt(kNoiseRatioLogVariance / check.observations));
   return !(check.noise_estimate_px <= bound * check.robust_noise_px);
 }
 

@@ -55,15 +55,14 @@ ConsistencyCheck CheckConsistency(const std::vector<double>& residual_lengths_px
                                   const std::vector<bool>& repeats, int num_params,
                                   const NoiseReference& noise, const AutoFitOptions& options);
 
-// Whether residuals that failed CheckConsistency (its record `check`, over num_observations
-// observations) show outliers rather than noise larger than the reference: the largest residual
+// Whether residuals that failed CheckConsistency (its record `check`, over check.observations
+// observations, N) show outliers rather than noise larger than the reference: the largest residual
 // beyond the outlier bound (test 2 above), or the noise estimate sqrt(J / (2N - p)) above the
 // robust noise (median-based) by more than Gaussian residuals' at significance alpha. For those
 // log(noise estimate / robust noise) is asymptotically normal, mean 0, variance
 // kNoiseRatioLogVariance / N (gate.cc); at 13-30 observations its tail is heavier than that, so
 // Gaussian residuals are called contaminated up to 0.6 % of the time instead of 0.1 %.
-bool ShowsOutliers(const ConsistencyCheck& check, int num_observations,
-                   const AutoFitOptions& options);
+bool ShowsOutliers(const ConsistencyCheck& check, const AutoFitOptions& options);
 
 // Whether the robust noise of a CheckConsistency record (the median's, which no outlier among
 // fewer than half the points moves far) exceeds the bound on the noise estimate by more than its

@@ -283,7 +283,7 @@ bool MayBeOutliers(const ConsistencyCheck& check, const AutoFitOptions& options,
   // mis-click and the rest pass (40 points at 1.8 px noise for 1 px, one point 12 px off; the
   // bound 1.9 px): only a robust noise beyond the bound by more than its sampling error says
   // that no subset of most points would.
-  return ShowsOutliers(check, n, options) || !(median_px <= RansacThresholdPx(n, options, noise)) ||
+  return ShowsOutliers(check, options) || !(median_px <= RansacThresholdPx(n, options, noise)) ||
          !RobustNoiseBeyondTheBound(check, options);
 }
 
