@@ -1,13 +1,19 @@
-// The closed forms (lib/src/fit/closed_form.h): the DLT's smallest eigenvector.
+// The closed forms (lib/src/fit/closed_form.h): the DLT's smallest eigenvector; the start a
+// plane gets (fit/start.h).
 #include "fit/closed_form.h"
 
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "camproj/fit.h"
+#include "fit/scene.h"
+#include "fit/start.h"
 #include "seeds.h"
 
 namespace camproj {
@@ -88,6 +94,49 @@ TEST(ClosedFormTest, SingularMatricesGetTheEigenSolversVector) {
     const Eigen::SelfAdjointEigenSolver<Matrix12> eigen(m);
     const Vector12 expected = eigen.eigenvectors().col(0);
     EXPECT_EQ(internal::SmallestEigenvector(m), expected) << "draw " << draw;
+  }
+}
+
+// A plane tilted about the image's x axis does not determine the aspect (the homography's two
+// equations in 1 / fx^2, 1 / fy^2 become one: r1 . r2 = 0 holds for any pair), so with the
+// focal length and aspect free its closed form has no pair of focal lengths. The start is then
+// the homography's one focal length at the aspect's start value (1), not the focal sweep's 48
+// SQPnP poses: noise-free, the true focal length, to the homography's rounding (a normalized
+// 8-parameter fit of 20 exact points: 1e-8 relative leaves four orders over its ~1e-12).
+TEST(PlaneStartTest, APlaneTiltedAboutTheImageXAxisStartsFromItsHomography) {
+  constexpr double kFocalPx = 1500.0;
+  constexpr double kCx = 959.5;
+  constexpr double kCy = 1079.5;  // a projector's lens shift
+  constexpr double kRelativeTolerance = 1e-8;
+  const ImageSize size{1920, 1080};
+  for (const double tilt_deg : {20.0, 35.0, 50.0, 65.0}) {
+    // The plane z = 0, turned about the camera's x axis by the tilt, 4 units ahead.
+    const Eigen::Matrix3d cam_from_world =
+        Eigen::AngleAxisd(tilt_deg * 3.14159265358979323846 / 180.0, Eigen::Vector3d::UnitX())
+            .toRotationMatrix();
+    const Eigen::Vector3d translation(0.0, 0.0, 4.0);
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector2d> pixels;
+    for (int i = 0; i < 5; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        const Eigen::Vector3d x(-1.0 + 0.5 * i, -0.6 + 0.4 * j, 0.0);
+        const Eigen::Vector3d p = cam_from_world * x + translation;
+        points.push_back(x);
+        pixels.emplace_back(kFocalPx * p.x() / p.z() + kCx, kFocalPx * p.y() / p.z() + kCy);
+      }
+    }
+    FitOptions options;
+    options.pixel_origin = PixelOrigin::kCenter;
+    options.aspect = ParameterMode::Free();
+    options.principal_point = ParameterMode::Fixed(kCx, kCy);
+    const internal::Scene scene = internal::ValidateScene(points, pixels, size, options);
+    const internal::Start start =
+        internal::ClosedFormStart(scene, options, std::chrono::steady_clock::now());
+    EXPECT_EQ(start.method, "homography") << "tilt " << tilt_deg << " deg";
+    EXPECT_NEAR(start.camera.intrinsics.fx / kFocalPx, 1.0, kRelativeTolerance)
+        << "tilt " << tilt_deg << " deg";
+    EXPECT_NEAR(start.camera.intrinsics.fy / kFocalPx, 1.0, kRelativeTolerance)
+        << "tilt " << tilt_deg << " deg";
   }
 }
 

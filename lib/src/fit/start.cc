@@ -113,6 +113,12 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
     if (HomographyStart(points, pixels, scene.plane_basis, plane_guess, focal_free,
                         start_model.free[1], &start)) {
       *method = "homography";
+    } else if (start_model.free[1] && HomographyStart(points, pixels, scene.plane_basis,
+                                                      plane_guess, focal_free, false, &start)) {
+      // The homography's two equations give no pair of focal lengths (a plane tilted about an
+      // image axis does not determine the aspect): its one focal length at the aspect's start
+      // value is the start, as for a model with the aspect fixed.
+      *method = "homography";
     } else if (focal_free && FocalSweepStart(points, pixels, guess, start_model.value[1],
                                              scene.image_size.width, &start,
                                              other_sweep_minima)) {
