@@ -542,9 +542,6 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     }
   }
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
-    // The cost where a round from the second on begins (the last round's polish's).
-    const double round_cost =
-        round > 0 ? outcome.normal.cost : std::numeric_limits<double>::quiet_NaN();
     have_normal = false;
     if (options.refiner == Refiner::kCeres) {
       // The same residuals in a ceres::Problem; each round resumes from the last.
@@ -581,14 +578,6 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     if (!have_normal) break;
     outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
                                           &outcome.model, &outcome.normal, nullptr, scored);
-    // A round from the second on (each runs the same geodesic LM and polish from where the
-    // last ended) that lowers the cost by no more than LM's own function tolerance asks of one
-    // step has found no way further along the valley: the next starts where it ended, and so
-    // on (seen: 17 rounds at the same cost to ten digits on a plane with the aspect free).
-    if (round > 0 && !outcome.converged &&
-        !(round_cost - outcome.normal.cost > options.function_tolerance * round_cost)) {
-      break;
-    }
   }
   if (!have_normal) outcome.normal = NormalEquations();
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned

@@ -26,9 +26,8 @@ namespace internal {
 // LM's stopping rules can fire while it crawls along a curved, nearly flat valley (a nearly
 // planar scene with the full model: 100 iterations left it 6 sigma from the optimum; at
 // thickness 1e-4 it needs 700). The polish then does not converge, and LM resumes from where it
-// stopped; after this many rounds, or after a round from the second on that lowers the cost by no
-// more than options.function_tolerance (relative), the caller refuses rather than return a
-// camera short of the minimum.
+// stopped; after this many rounds the caller refuses rather than return a camera short of the
+// minimum.
 inline constexpr int kMaxLeastSquaresRounds = 20;
 
 struct LeastSquaresOutcome {
