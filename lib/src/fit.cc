@@ -116,7 +116,10 @@ FitResult Fit(const std::vector<Eigen::Vector3d>& points_in_world,
     return result;
   }
 
-  const internal::Start start = effort.warm_start != nullptr
+  // A model whose minimum is found in closed form starts there, from any start offered.
+  std::optional<internal::Start> at_minimum = internal::PlaneAspectStart(scene, options);
+  const internal::Start start = at_minimum                    ? std::move(*at_minimum)
+                                : effort.warm_start != nullptr
                                     ? internal::WarmStart(scene, *effort.warm_start)
                                     : internal::ClosedFormStart(scene, options, start_time);
   internal::RefinedCamera refined =

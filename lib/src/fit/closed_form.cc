@@ -32,25 +32,115 @@ Eigen::Matrix3d HartleyTransform(const std::vector<Eigen::Vector2d>& pixels) {
   return t;
 }
 
+// The DLT's homography between points already Hartley-normalized (x: plane, u: pixels; both
+// homogeneous with w = 1), scale arbitrary.
+Eigen::Matrix3d DltHomography(const std::vector<Eigen::Vector3d>& x,
+                              const std::vector<Eigen::Vector3d>& u) {
+  const int n = static_cast<int>(x.size());
+  Eigen::MatrixXd a(2 * n, 9);
+  for (int i = 0; i < n; ++i) {
+    a.row(2 * i) << x[i].transpose(), Eigen::RowVector3d::Zero(), -u[i].x() * x[i].transpose();
+    a.row(2 * i + 1) << Eigen::RowVector3d::Zero(), x[i].transpose(), -u[i].y() * x[i].transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
+  const Eigen::VectorXd h = svd.matrixV().col(8);
+  Eigen::Matrix3d hn;
+  hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
+  return hn;
+}
+
+// The points of `p` through the Hartley transform `t`, homogeneous.
+std::vector<Eigen::Vector3d> Transformed(const Eigen::Matrix3d& t,
+                                         const std::vector<Eigen::Vector2d>& p) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(p.size());
+  for (const Eigen::Vector2d& q : p) out.push_back(t * q.homogeneous());
+  return out;
+}
+
+// The sum over the points of |pi(h x_i) - u_i|^2 (normalized units), or nothing where a point
+// maps to w <= 0 (behind the camera of every reading of h with h(2, 2) > 0).
+std::optional<double> HomographyCost(const Eigen::Matrix3d& h, const std::vector<Eigen::Vector3d>& x,
+                                     const std::vector<Eigen::Vector3d>& u) {
+  double sum = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const Eigen::Vector3d p = h * x[i];
+    if (!(p.z() > 0.0)) return std::nullopt;
+    sum += (p.head<2>() / p.z() - u[i].head<2>()).squaredNorm();
+  }
+  return sum;
+}
+
 }  // namespace
 
 Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
                                      const std::vector<Eigen::Vector2d>& pixels) {
   const Eigen::Matrix3d t_plane = HartleyTransform(plane);
   const Eigen::Matrix3d t_pixel = HartleyTransform(pixels);
-  const int n = static_cast<int>(plane.size());
-  Eigen::MatrixXd a(2 * n, 9);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d x = t_plane * plane[i].homogeneous();
-    const Eigen::Vector3d u = t_pixel * pixels[i].homogeneous();
-    a.row(2 * i) << x.transpose(), Eigen::RowVector3d::Zero(), -u.x() * x.transpose();
-    a.row(2 * i + 1) << Eigen::RowVector3d::Zero(), x.transpose(), -u.y() * x.transpose();
+  return t_pixel.inverse() *
+         DltHomography(Transformed(t_plane, plane), Transformed(t_pixel, pixels)) * t_plane;
+}
+
+std::optional<Eigen::Matrix3d> LeastSquaresHomography(const std::vector<Eigen::Vector2d>& plane,
+                                                      const std::vector<Eigen::Vector2d>& pixels) {
+  // Levenberg-Marquardt (Marquardt's diagonal damping) on the eight entries other than h(2, 2),
+  // held at 1, in Hartley's frames: there h(2, 2) is the depth scale of the plane's centroid,
+  // which every camera with the points in front makes positive; the pixel frame's isotropic
+  // scale leaves the minimizer the same. Stops where a step changes no entry by more than
+  // kSettled (relative to |h|), or after kMaxIterations.
+  constexpr int kMaxIterations = 50;
+  constexpr double kSettled = 1e-12;
+  constexpr double kMaxDamping = 1e12;
+  const Eigen::Matrix3d t_plane = HartleyTransform(plane);
+  const Eigen::Matrix3d t_pixel = HartleyTransform(pixels);
+  const std::vector<Eigen::Vector3d> x = Transformed(t_plane, plane);
+  const std::vector<Eigen::Vector3d> u = Transformed(t_pixel, pixels);
+  Eigen::Matrix3d h = DltHomography(x, u);
+  if (!(std::abs(h(2, 2)) > 1e-9 * h.norm())) return std::nullopt;
+  h /= h(2, 2);
+  std::optional<double> cost = HomographyCost(h, x, u);
+  if (!cost) return std::nullopt;
+  double damping = 1e-3;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    // Normal equations of the residuals pi(h x) - u in the entries h(0, 0..2), h(1, 0..2),
+    // h(2, 0..1).
+    Eigen::Matrix<double, 8, 8> jtj = Eigen::Matrix<double, 8, 8>::Zero();
+    Eigen::Matrix<double, 8, 1> jtr = Eigen::Matrix<double, 8, 1>::Zero();
+    for (size_t i = 0; i < x.size(); ++i) {
+      const Eigen::Vector3d p = h * x[i];
+      const double inv_w = 1.0 / p.z();
+      const Eigen::Vector2d projected = p.head<2>() * inv_w;
+      const Eigen::Vector2d r = projected - u[i].head<2>();
+      Eigen::Matrix<double, 2, 8> j = Eigen::Matrix<double, 2, 8>::Zero();
+      j.block<1, 3>(0, 0) = x[i].transpose() * inv_w;
+      j.block<1, 3>(1, 3) = x[i].transpose() * inv_w;
+      j.block<1, 2>(0, 6) = -projected.x() * inv_w * x[i].head<2>().transpose();
+      j.block<1, 2>(1, 6) = -projected.y() * inv_w * x[i].head<2>().transpose();
+      jtj.noalias() += j.transpose() * j;
+      jtr.noalias() += j.transpose() * r;
+    }
+    bool stepped = false;
+    while (damping <= kMaxDamping) {
+      Eigen::Matrix<double, 8, 8> damped = jtj;
+      damped.diagonal() += damping * jtj.diagonal();
+      const Eigen::Matrix<double, 8, 1> step = -damped.ldlt().solve(jtr);
+      if (!step.allFinite()) return std::nullopt;
+      Eigen::Matrix3d trial = h;
+      for (int k = 0; k < 8; ++k) trial(k / 3, k % 3) += step(k);
+      const std::optional<double> trial_cost = HomographyCost(trial, x, u);
+      if (trial_cost && *trial_cost <= *cost) {
+        const bool settled = step.cwiseAbs().maxCoeff() <= kSettled * h.norm();
+        h = trial;
+        cost = trial_cost;
+        damping = std::max(damping / 10.0, 1e-12);
+        stepped = !settled;
+        break;
+      }
+      damping *= 10.0;
+    }
+    if (!stepped) break;
   }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
-  const Eigen::VectorXd h = svd.matrixV().col(8);
-  Eigen::Matrix3d hn;
-  hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
-  return t_pixel.inverse() * hn * t_plane;
+  return t_pixel.inverse() * h * t_plane;
 }
 
 namespace {
@@ -228,15 +318,25 @@ std::optional<StartCamera> DltStartIfInFront(const std::vector<Eigen::Vector3d>&
   return DltCameraOrBehind(points, pixels, &behind);
 }
 
+std::vector<Eigen::Vector2d> PlaneCoordinates(const std::vector<Eigen::Vector3d>& points,
+                                              const Eigen::Matrix3d& plane_basis) {
+  std::vector<Eigen::Vector2d> plane;
+  plane.reserve(points.size());
+  for (const auto& x : points) plane.push_back((plane_basis.transpose() * x).head<2>());
+  return plane;
+}
+
 bool HomographyStart(const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector2d>& pixels,
                      const Eigen::Matrix3d& plane_basis, const Intrinsics& guess, bool focal_free,
                      bool aspect_free, StartCamera* start) {
-  std::vector<Eigen::Vector2d> plane;
-  plane.reserve(points.size());
-  for (const auto& x : points) plane.push_back((plane_basis.transpose() * x).head<2>());
-  const Eigen::Matrix3d h = NormalizedHomography(plane, pixels);
+  return StartFromHomography(NormalizedHomography(PlaneCoordinates(points, plane_basis), pixels),
+                             plane_basis, guess, focal_free, aspect_free, start);
+}
 
+bool StartFromHomography(const Eigen::Matrix3d& h, const Eigen::Matrix3d& plane_basis,
+                         const Intrinsics& guess, bool focal_free, bool aspect_free,
+                         StartCamera* start) {
   // G = T^-1 H with T the principal point and skew part of K: G ~ diag(fx, fy, 1) [r1 r2 t].
   Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
   t(0, 2) = guess.cx;

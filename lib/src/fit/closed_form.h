@@ -55,6 +55,26 @@ Eigen::Matrix3d NormalizedHomography(const std::vector<Eigen::Vector2d>& plane,
 // determinant has the sign of det(M)).
 void RqDecomposition(const Eigen::Matrix3d& m, Eigen::Matrix3d* k, Eigen::Matrix3d* r);
 
+// The least-squares homography (Hartley and Zisserman's "gold standard" with the plane
+// coordinates exact): the H (plane coordinates -> pixels, H(2, 2) > 0 in Hartley's frames)
+// minimizing sum_i |pi(H x_i) - u_i|^2, by Levenberg-Marquardt from the normalized DLT. Nothing
+// where the DLT or a step maps a point to the far side of the line at infinity (no camera has
+// those points in front).
+std::optional<Eigen::Matrix3d> LeastSquaresHomography(const std::vector<Eigen::Vector2d>& plane,
+                                                      const std::vector<Eigen::Vector2d>& pixels);
+
+// The points' in-plane coordinates: the first two of plane_basis^T * point.
+std::vector<Eigen::Vector2d> PlaneCoordinates(const std::vector<Eigen::Vector3d>& points,
+                                              const Eigen::Matrix3d& plane_basis);
+
+// The camera that maps the plane by `h` (plane coordinates -> pixels): the focal length (and
+// the aspect when aspect_free) from the two orthonormality constraints with the principal point
+// and skew of `guess` (its focal length where focal_free is false), then the pose. Returns false
+// where the constraints give no positive 1/fx^2, 1/fy^2.
+bool StartFromHomography(const Eigen::Matrix3d& h, const Eigen::Matrix3d& plane_basis,
+                         const Intrinsics& guess, bool focal_free, bool aspect_free,
+                         StartCamera* start);
+
 // Planar scene (>= 4 points): a homography from the plane to the image, then the focal length
 // (and the aspect when aspect_free) from the two orthonormality constraints with the principal
 // point and skew of `guess`, then the pose. `plane_basis` has the plane's in-plane axes as its

@@ -73,6 +73,7 @@ bool UnlikeAnyLens(const Model& model, const ImageSize& size) {
 // LM's damping keeps the first steps in its basin.
 PolishFirst FirstSteps(const Start& start, const Scene& scene) {
   if (start.method == "warm") return PolishFirst::kFromNestedMinimum;
+  if (start.at_minimum) return PolishFirst::kFromClosedForm;
   if (start.method == "dlt" && scene.NumPoints() >= kSecondStartBelowPoints) {
     return PolishFirst::kFromClosedForm;
   }

@@ -222,6 +222,36 @@ Start ClosedFormStart(const Scene& scene, const FitOptions& options,
   return start;
 }
 
+std::optional<Start> PlaneAspectStart(const Scene& scene, const FitOptions& options) {
+  const Model& model = scene.model;
+  bool homography_model = scene.planar && !options.known_intrinsics &&
+                          options.loss == LossType::kNone && model.free[0] && model.free[1] &&
+                          !model.free[2] && !model.free[3] && !model.free[4] &&
+                          model.value[4] == 0.0;
+  for (int slot = 5; slot < kFitIntrinsicsSize; ++slot) {
+    homography_model = homography_model && !model.free[slot] && model.value[slot] == 0.0;
+  }
+  if (!homography_model) return std::nullopt;
+  const std::optional<Eigen::Matrix3d> h =
+      LeastSquaresHomography(PlaneCoordinates(scene.points, scene.plane_basis), scene.pixels);
+  if (!h) return std::nullopt;
+  Start start;
+  if (!StartFromHomography(*h, scene.plane_basis, model.ToIntrinsics(), /*focal_free=*/true,
+                           /*aspect_free=*/true, &start.camera)) {
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "one view of this plane does not determine the aspect: no camera with the "
+                     "principal point given and fx, fy free maps the plane as the homography "
+                     "that fits the points best (its constraints on fx and fy have no solution: "
+                     "the plane is seen tilted about nearly one image axis, where they "
+                     "coincide), so the fit would only grow the focal lengths without end. Fix "
+                     "the aspect (e.g. --model focal), or add points off the plane");
+  }
+  start.method = "homography";
+  start.model = ProjectOntoModel(model, start.camera.intrinsics);
+  start.at_minimum = true;
+  return start;
+}
+
 Start WarmStart(const Scene& scene, const Camera& fitted) {
   Start start;
   start.method = "warm";

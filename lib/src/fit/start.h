@@ -31,6 +31,9 @@ struct Start {
   Model model;         // the scene's model, its free slots from the closed form
   // "pnp-focal-sweep" only: the sweep's other local minima, best first (FocalSweepStart).
   std::vector<StartCamera> other_sweep_minima;
+  // The start is the model's least-squares minimum itself (PlaneAspectStart): the refinement
+  // begins with Gauss-Newton steps.
+  bool at_minimum = false;
 };
 
 // The DLT of one scene's points (Scene::dlt): DltStart's camera or its refusal, once read.
@@ -53,6 +56,18 @@ StartCamera DltStartOf(const Scene& scene);
 // front). start_time: for the traces of the refinements that decide a mirrored DLT (discarded).
 Start ClosedFormStart(const Scene& scene, const FitOptions& options,
                       Clock::time_point start_time);
+
+// On a plane, pose + focal + aspect with the principal point given and neither skew nor
+// distortion has the plane's homography's 8 degrees of freedom, and its cameras map the plane by
+// exactly the homographies whose two orthonormality constraints (fit/closed_form.h,
+// StartFromHomography) give a positive 1/fx^2 and 1/fy^2. So its least-squares minimum is the
+// least-squares homography's camera where that has them (the start returned, at_minimum), and
+// otherwise it has no minimum at finite focal lengths: the refinement would crawl after one
+// that grows without bound (seen: 221 iterations to fx 3210 px, aspect 4.2, then refused; the
+// plane tilted about nearly an image axis, where the two constraints nearly coincide), and
+// this throws SceneError kDegenerate instead. Nothing for any other model or scene, or where the
+// least-squares homography is not found (the closed form then starts as before).
+std::optional<Start> PlaneAspectStart(const Scene& scene, const FitOptions& options);
 
 // The start at a camera already fitted to the same points with a nested model (the model
 // selection's current model, of which the scene's model frees one more group): its pose in the
