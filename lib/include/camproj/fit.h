@@ -16,6 +16,12 @@
 // over fields of view 0.5-175 deg) a homography start for points only nearly coplanar and a DLT
 // start whose best fit has an intrinsic no lens has (pixels 1.5 times as tall as wide or more,
 // the principal point more than an image size from the centre). Details: fit/refine.cc.
+//
+// On a plane, focal and aspect free with the principal point given and neither skew nor
+// distortion is the homography's model: the fit starts at the camera of the least-squares
+// homography, which is its minimum, and is refused (kDegenerate, "does not determine the
+// aspect") where that homography has no such camera: the model then has no minimum at finite
+// focal lengths. Details: fit/start.h, PlaneAspectStart.
 #ifndef CAMPROJ_FIT_H_
 #define CAMPROJ_FIT_H_
 
