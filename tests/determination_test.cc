@@ -153,14 +153,19 @@ double ExpectSameSigmas(const std::vector<double>& from_fit, const std::vector<d
 
 // A fitted rival's sigmas read from its fit's normal equations (the candidate's, as the model
 // selection keeps them) equal those of a pass over the points at its camera: the same quantity
-// in another parameterization, linearized up to one step apart -- a scored candidate's last step,
-// taken without a pass after it, moves the residuals by under 1e-2 of the noise
-// (least_squares.cc, kPredictedStepFraction), and J changes across such a step by far less than
-// 1e-3 of itself. Measured (seed offsets 0, 7, 1000): up to 2.6e-4 relative.
+// in another parameterization, linearized up to one step apart. Where that step was within the
+// polish's convergence test (under 1e-3 of the residuals' sigma; least_squares.cc) the sigmas
+// agree to 1e-3 (measured over seed offsets 0-99000 in steps of 1000: up to 3.3e-4 at 20 points,
+// 6.4e-5 at 100; at least 30 and 21 of the 60 fits compared). Where the polish took its last step on a prediction (up to 1e-2 of the
+// sigma; ChartLinearization::predicted_step_back) they moved by up to 2.4e-3: the determination
+// check then reads the rival's sigmas by a pass over the points (fit/determination.cc), and
+// here they are counted, not compared.
 TEST(DeterminationTest, SigmasFromTheFitsNormalEquationsAreThoseOfAPassOverThePoints) {
   constexpr double kSameLinearization = 1e-3;
   for (const int n : {20, 100}) {
     double worst = 0.0;
+    int predicted = 0;
+    int compared = 0;
     for (uint64_t seed = 1; seed <= 30; ++seed) {
       const SynthScene scene = CleanCloud(500 + seed, n);
       const Correspondences& c = scene.correspondences;
@@ -172,6 +177,11 @@ TEST(DeterminationTest, SigmasFromTheFitsNormalEquationsAreThoseOfAPassOverThePo
         const FitResult fit = internal::FitCandidate(c.points_in_world, c.pixels,
                                                      scene.truth.image_size, model, 0.5, reuse);
         ASSERT_GT(linearization.jtj.size(), 0) << "seed " << seed;
+        if (linearization.predicted_step_back) {
+          ++predicted;
+          continue;
+        }
+        ++compared;
         const std::vector<Eigen::Vector3d> test = FittedAndTestPoints(fit.camera, c.points_in_world);
         worst = std::max(
             worst, ExpectSameSigmas(
@@ -184,7 +194,10 @@ TEST(DeterminationTest, SigmasFromTheFitsNormalEquationsAreThoseOfAPassOverThePo
                            (k1 ? ", k1 free" : "")));
       }
     }
-    std::printf("[ INFO     ] %d points: largest relative difference %.3g\n", n, worst);
+    std::printf("[ INFO     ] %d points: largest relative difference %.3g over %d fits (%d a "
+                "predicted step back, not compared)\n",
+                n, worst, compared, predicted);
+    EXPECT_GE(compared, 10) << n << " points";
   }
 }
 

@@ -288,9 +288,9 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const Model& model = refined.model;
   const int num_params = 6 + model.NumFree();
   if (effort.linearization != nullptr) {
-    *effort.linearization = ChartLinearization{refined.normal.jtj, refined.rotation,
-                                               refined.center,     model,
-                                               scene.centroid,     scene.scale};
+    *effort.linearization = ChartLinearization{
+        refined.normal.jtj, refined.rotation, refined.center, model, scene.centroid, scene.scale,
+        refined.normal_predicted_step_back};
   }
   FitResult result;
   result.iterations = refined.iterations;

@@ -471,8 +471,11 @@ std::vector<FittedRival> FittedRivals(const Selection& selection, const UnitWorl
     const Camera rival_camera =
         InUnitWorld(rival.camera, flip.asDiagonal() * unit_world.origin, unit_world.unit);
     if (rival.same_model && SameMinimum(unit_world.camera, rival_camera, test)) continue;
-    // A fitted rival's uncertainty from its fit's own normal equations: no pass over the points.
-    const bool from_its_fit = rival.linearization != nullptr && !rival.mirrored_world &&
+    // A fitted rival's uncertainty from its fit's own normal equations: no pass over the points
+    // (but where they are a predicted step back: least_squares.cc, kPredictedStepFraction).
+    const bool from_its_fit = rival.linearization != nullptr &&
+                              !rival.linearization->predicted_step_back &&
+                              !rival.mirrored_world &&
                               rival.camera.projection == Projection::kPerspective;
     try {
       fitted.push_back(

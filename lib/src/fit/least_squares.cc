@@ -377,9 +377,11 @@ struct PolishSteps {
   static constexpr double kConvergedFraction = 1e-3;
   static constexpr double kRoundingStepPx = 1e-8;
   // A step taken on a prediction (NextPredictedWithinTest) is at most this fraction of the
-  // residuals' sigma: the normal equations returned are then those one such step back, and a
-  // sigma read from them (a rival's, fit/determination.cc) moves by under 3e-4 of itself
-  // (tests/determination_test.cc).
+  // residuals' sigma: the normal equations returned are then those one such step back
+  // (LeastSquaresOutcome::normal_predicted_step_back), where a sigma read from them moves by up
+  // to 2.4e-3 of itself (k1 free at 20 points, seed offsets 0-99000 of
+  // tests/determination_test.cc), so a rival's uncertainty is then read by a pass over the points
+  // (fit/determination.cc); one step back within the convergence test moves it by under 1e-3.
   static constexpr double kPredictedStepFraction = 1e-2;
 
   double dof;  // 2N - p, at least 1
@@ -424,8 +426,9 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
                        NormalEquations* normal, bool* settled = nullptr,
-                       bool stop_when_converged = false) {
+                       bool stop_when_converged = false, bool* predicted = nullptr) {
   if (settled != nullptr) *settled = false;
+  if (predicted != nullptr) *predicted = false;
   // Where the residuals are not small against the curvature they neglect, Gauss-Newton contracts
   // only linearly (rate q = |next step| / |step|): seen q = 0.37 at 6 points with focal, aspect
   // and principal point free (2 residual degrees of freedom, rms 0.68 px), where 6 steps left fy
@@ -490,6 +493,7 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       *center = new_center;
       model->value = new_intrinsics;
       if (settled != nullptr) *settled = step_px <= kSettledStepPx;
+      if (predicted != nullptr) *predicted = !(step_px <= kSettledStepPx) && !converged();
       return true;
     }
     NormalEquations new_normal;
@@ -539,8 +543,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     outcome.trace.push_back({0, MicrosecondsSince(start_time),
                              std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});
     bool settled = false;
-    const bool polished = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                            &outcome.model, &outcome.normal, &settled, scored);
+    const bool polished =
+        PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center, &outcome.model,
+                          &outcome.normal, &settled, scored, &outcome.normal_predicted_step_back);
     outcome.converged =
         polish_first == PolishFirst::kFromClosedForm && !scored ? settled : polished;
     have_normal = true;
@@ -552,6 +557,7 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   }
   for (int round = 0; round < max_rounds && !outcome.converged; ++round) {
     have_normal = false;
+    outcome.normal_predicted_step_back = false;  // LM's own normal equations are at its answer
     if (options.refiner == Refiner::kCeres) {
       // The same residuals in a ceres::Problem; each round resumes from the last.
       const CeresSummary summary =
@@ -585,8 +591,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                            outcome.model, &outcome.normal);
     }
     if (!have_normal) break;
-    outcome.converged = PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center,
-                                          &outcome.model, &outcome.normal, nullptr, scored);
+    outcome.converged =
+        PolishGaussNewton(points, pixels, &outcome.rotation, &outcome.center, &outcome.model,
+                          &outcome.normal, nullptr, scored, &outcome.normal_predicted_step_back);
   }
   if (!have_normal) outcome.normal = NormalEquations();
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned

@@ -37,6 +37,9 @@ struct LeastSquaresOutcome {
   Eigen::Vector3d center;
   Model model;
   NormalEquations normal;
+  // `normal` is one step back, a step the polish took on its prediction of the next (up to 1e-2
+  // of the residuals' sigma; least_squares.cc, PolishSteps), not within its convergence test.
+  bool normal_predicted_step_back = false;
   int iterations = 0;
   std::string termination;
   std::vector<TraceEntry> trace;

@@ -47,6 +47,10 @@ struct ChartLinearization {
   Model model;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double scale = 1.0;
+  // jtj is one step back from the camera, a step the polish took on a prediction (up to 1e-2 of
+  // the residuals' sigma: LeastSquaresOutcome::normal_predicted_step_back); otherwise at most a
+  // step within its convergence test back.
+  bool predicted_step_back = false;
 };
 
 // The columns of the Jacobian in the camera's local frame (see LocalNormalEquations), split by

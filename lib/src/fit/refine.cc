@@ -213,6 +213,7 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
   refined.center = best.center;
   refined.model = std::move(best.model);
   refined.normal = std::move(best.normal);
+  refined.normal_predicted_step_back = best.normal_predicted_step_back;
   refined.iterations = best.iterations;
   refined.refiner = options.refiner == Refiner::kCeres ? "ceres" : "levenberg-marquardt";
   refined.termination = std::move(best.termination);

@@ -30,6 +30,7 @@ struct RefinedCamera {
   // ComputeNormalEquations at the camera (least squares: possibly one settling step before it);
   // empty when a point is behind the camera, which the assessment refuses.
   NormalEquations normal;
+  bool normal_predicted_step_back = false;  // LeastSquaresOutcome's
   int iterations = 0;
   std::string refiner;      // FitResult::refiner
   std::string termination;  // FitResult::termination
