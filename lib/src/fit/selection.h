@@ -54,7 +54,8 @@ struct Selection {
 
 // From this many points on a perspective fit of the selection keeps its normal equations at its
 // answer (Selection::linearization, Rival::linearization), and the determination check reads a
-// model's uncertainty from them instead of a pass over the points for J in its own
+// model's uncertainty from them (unless they are a predicted step back:
+// ChartLinearization::predicted_step_back) instead of a pass over the points for J in its own
 // parameterization: there keeping them costs less than that pass (bench --stage-cost: 0.5 % more
 // instructions at 6-12 points; for the rivals 2.6 / 6.2 / 8.4 % fewer at 20 / 100 / 1000).
 inline constexpr size_t kLinearizationFromPoints = 20;
