@@ -1256,7 +1256,9 @@ SynthScene PlaneShotAt1280x720(uint64_t seed, int num_points, double noise_px) {
 // refused (RefuseAMinority), and so is a quarter or more left out nearer to the camera's pixels
 // than random pixels would be (RefuseIfTheLeftOutAreNotRandom); both say to check the image
 // size. Refused as a minority: 49 of 100 scenes at seed offsets 0-4000; at that rate none of
-// 20 with probability 0.51^20 = 1.4e-6.
+// 20 with probability 0.51^20 = 1.4e-6. Fewer left out, where the plane's homography fits every
+// point, are refused too (PointsLeftOutOfAPlaneWhoseHomographyFitsThemAllAreRefused): no answer
+// left a point out at seed offsets 0-150000 in steps of 1000.
 TEST(FitAutoTest, AMinorityConsensusIsRefused) {
   int refused_as_minority = 0;
   int trials = 0;
@@ -1282,6 +1284,76 @@ TEST(FitAutoTest, AMinorityConsensusIsRefused) {
   std::printf("[ INFO     ] refused as a minority consensus: %d of %d\n", refused_as_minority,
               trials);
   EXPECT_GE(refused_as_minority, 1);
+}
+
+// Regression (seed offsets 44000-100000 of AMinorityConsensusIsRefused, literal seeds): planes
+// shot at 1280 x 720 and fitted as 1920 x 1080 that LO-RANSAC answered with 5-7 of their 30
+// points left out (below the quarter of RefuseIfTheLeftOutAreNotRandom) and k1 -0.23 to -0.84.
+// Every point fits one homography of the plane within the noise, so none is an outlier: refused,
+// saying so and where the principal point was assumed.
+TEST(FitAutoTest, PointsLeftOutOfAPlaneWhoseHomographyFitsThemAllAreRefused) {
+  int refused_by_the_rule = 0;
+  for (const uint64_t literal_seed : {44018, 49002, 75009, 76004, 79012, 82004, 88009, 95013,
+                                      100016, 100020}) {
+    SynthOptions synth;
+    synth.seed = literal_seed;
+    synth.num_points = 30;
+    synth.noise_px = 0.5;
+    synth.object = SynthObject::kPlane;
+    synth.image_size = {1280, 720};
+    synth.fovy_deg = 50.0;
+    const SynthScene scene = SynthesizeScene(synth);
+    try {
+      const FitResult fit = Auto(scene.correspondences.points_in_world, scene.correspondences.pixels);
+      EXPECT_TRUE(fit.outliers.empty())
+          << "seed " << literal_seed << ": " << fit.outliers.size() << " left out, " << fit.model;
+    } catch (const SceneError& e) {
+      const std::string message = e.what();
+      if (message.find("are no outliers") == std::string::npos) continue;  // another reason
+      ++refused_by_the_rule;
+      EXPECT_EQ(e.reason(), SceneError::Reason::kInconsistent) << message;
+      EXPECT_NE(message.find("check that the image size is the image's"), std::string::npos)
+          << message;
+    }
+  }
+  std::printf("[ INFO     ] refused as no outliers of the plane: %d of 10\n", refused_by_the_rule);
+  // Measured: all 10 (each was answered before the rule).
+  EXPECT_GE(refused_by_the_rule, 5);
+}
+
+// The rule above leaves a plane's real mis-click to the outlier stage: one point of 30 moved
+// 30-150 px fails the homography's gate as it fails the camera's (at 0.5 px noise its drop in
+// the sum of squares is hundreds of sigma^2), so the scene is answered with that point left out
+// (a rate of at most 5 % otherwise over 40 seeds; a scene may still be refused for another
+// reason, but never by this rule).
+TEST(FitAutoTest, AMisclickOnAPlaneIsStillLeftOut) {
+  std::mt19937_64 rng(testing::Seed(31));
+  constexpr int kSeeds = 40;
+  int named = 0;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    SynthOptions synth;
+    synth.seed = testing::Seed(600 + seed);
+    synth.num_points = 30;
+    synth.noise_px = 0.5;
+    synth.object = SynthObject::kPlane;
+    synth.image_size = {1920, 1080};
+    const SynthScene scene = SynthesizeScene(synth);
+    std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
+    const int bad = static_cast<int>(seed % 30);
+    Misclick(&pixels, bad, std::uniform_real_distribution<double>(30.0, 150.0)(rng), rng);
+    AutoFitOptions options;
+    options.fit.principal_point = ParameterMode::Fixed(scene.truth.intrinsics.cx,
+                                                       scene.truth.intrinsics.cy);
+    try {
+      const FitResult fit = Auto(scene.correspondences.points_in_world, pixels, options);
+      named += fit.outliers == std::vector<int>{bad};
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).find("are no outliers"), std::string::npos)
+          << "seed " << seed << ": " << e.what();
+    }
+  }
+  // Measured: 1.4 % of seeds not so answered (17 of 1240 at seed offsets 0-30000).
+  testing::ExpectRate("a mis-click on a plane not left out alone", kSeeds - named, kSeeds, 0.05);
 }
 
 // Eight clicks on a plane shot at 1280 x 720, fitted as 1920 x 1080: a refusal for residuals
