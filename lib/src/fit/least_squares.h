@@ -80,7 +80,7 @@ enum class PolishFirst {
 // after it, so the sum of squares then exceeds the minimum's by about |J delta|^2 of the step
 // after it, under 1e-6 sigma^2, far below any criterion difference read. A camera returned goes
 // on until a step settles under 1e-9 px, saving no pass over the points.
-enum class PolishUntil { kSettled, kConverged };
+enum class PolishUntil { kSettled, kConverged, kSettledHalving };
 
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,

@@ -104,7 +104,8 @@ LeastSquaresOutcome RefineFromStarts(const Scene& scene, const Start& start,
                                      const FitOptions& options, const FitEffort& effort,
                                      Clock::time_point start_time) {
   // A fit not described (a model selection's candidate) is only scored.
-  const PolishUntil until = effort.describe ? PolishUntil::kSettled : PolishUntil::kConverged;
+  const PolishUntil until =
+      effort.describe ? PolishUntil::kSettledHalving : PolishUntil::kConverged;
   LeastSquaresOutcome best = RefineLeastSquares(
       scene.points, scene.pixels, start.camera.rotation, start.camera.center, start.model, options,
       start_time, kMaxLeastSquaresRounds, FirstSteps(start, scene), until);
