@@ -384,6 +384,19 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   return SelectOn(points, pixels, *left_out, size, options, noise);
 }
 
+// Where the fit assumed a plane's principal point (which a plane does not show) at the image's
+// centre: that centre and what to check; empty where the principal point was given.
+std::string AssumedCentre(const ImageSize& size, const AutoFitOptions& options) {
+  if (options.fit.principal_point.kind != ParameterMode::Kind::kDefault ||
+      options.fit.known_intrinsics) {
+    return std::string();
+  }
+  return "it is assumed at the image's centre " +
+         internal::PixelText(Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1)),
+                             options.fit.pixel_origin) +
+         "; check that the image size is the image's, or give --principal-point";
+}
+
 // The refusal of a scene no selection explained, with what the pipeline saw: a mirror if that
 // explains it, else the selection's own refusal or the gate's verdict and the search's outcome.
 [[noreturn]] void Refuse(const std::vector<Eigen::Vector3d>& points,
@@ -417,16 +430,10 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   const bool planar =
       screen.fit ? screen.fit->geometry.scene.planar
                  : internal::PrepareScene(points, pixels, size, options.fit.pixel_origin).scene.planar;
-  const bool centre_assumed = planar &&
-                              options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
-                              !options.fit.known_intrinsics;
+  const std::string assumed = AssumedCentre(size, options);
   const std::string centre =
-      centre_assumed
-          ? ". The points are on a plane, which does not show the principal point: it is "
-            "assumed at the image's centre " +
-                internal::PixelText(Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1)),
-                                    options.fit.pixel_origin) +
-                "; check that the image size is the image's, or give --principal-point"
+      planar && !assumed.empty()
+          ? ". The points are on a plane, which does not show the principal point: " + assumed
           : std::string();
   throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
                                             : SceneError::Reason::kInconsistent,
@@ -634,8 +641,7 @@ class Pipeline {
     const ConsistencyCheck check = internal::CheckConsistency(
         lengths, internal::Repeats(points_, pixels_), kHomographyParameters, noise_, options_);
     if (!check.passed) return;
-    const bool centre_assumed = options_.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
-                                !options_.fit.known_intrinsics;
+    const std::string assumed = AssumedCentre(size_, options_);
     throw SceneError(
         SceneError::Reason::kInconsistent,
         "the " + std::to_string(left_out_.size()) + " of " + std::to_string(points_.size()) +
@@ -644,13 +650,8 @@ class Pipeline {
             "), which no camera of the models tried does (" + gated_->selection.fit.model +
             " fits only the others). The points are on a plane, which does not show the "
             "principal point: " +
-            (centre_assumed
-                 ? "it is assumed at the image's centre " +
-                       internal::PixelText(
-                           Eigen::Vector2d(0.5 * (size_.width - 1), 0.5 * (size_.height - 1)),
-                           options_.fit.pixel_origin) +
-                       "; check that the image size is the image's, or give --principal-point"
-                 : std::string("check the principal point given and the image size")));
+            (assumed.empty() ? std::string("check the principal point given and the image size")
+                             : assumed));
   }
 
   // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at the

@@ -410,6 +410,28 @@ struct PolishSteps {
   }
 };
 
+// The camera `fraction` of the step `delta` (rotation on the chart, centre, free intrinsics in
+// order) away from rotation, center and model's values.
+struct SteppedCamera {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d center;
+  IntrinsicValues intrinsics;
+};
+SteppedCamera Stepped(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                      const Model& model, const ParamVector& delta, double fraction) {
+  SteppedCamera stepped{rotation, center + fraction * delta.segment<3>(3), model.value};
+  const double angle = fraction * delta.head<3>().norm();
+  if (angle > 0.0) {
+    stepped.rotation =
+        Eigen::AngleAxisd(angle, delta.head<3>().normalized()).toRotationMatrix() * rotation;
+  }
+  int next = 6;
+  for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+    if (model.free[slot]) stepped.intrinsics[slot] += fraction * delta(next++);
+  }
+  return stepped;
+}
+
 // Gauss-Newton steps from LM's answer (least squares without a loss only). LM's stopping rules
 // (relative cost change, relative step under damping) can leave it ~1e-8 from the optimum in
 // flat directions; undamped steps with the exact Jacobian take it to rounding level. `normal`
@@ -421,7 +443,9 @@ struct PolishSteps {
 // on a curved valley: there Gauss-Newton steps overshoot and raise the cost.
 // With stop_when_converged (a camera only scored), a step within the convergence test is taken
 // without the pass that would confirm it, and so is one whose successor the steps so far predict
-// within it (below: the pass after it would only find that successor).
+// within it (below: the pass after it would only find that successor); *predicted, if given,
+// says the last was taken on that prediction. With `halve`, a step that raises the cost is
+// shortened instead (below) before the polish gives up.
 bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
                        const std::vector<Eigen::Vector2d>& pixels,
                        Eigen::Matrix3d* rotation, Eigen::Vector3d* center, Model* model,
@@ -465,25 +489,10 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
           SymmetricSolver(ParamMatrix(scale.asDiagonal() * normal->jtj * scale.asDiagonal()))
               .Solve(scale.asDiagonal() * normal->jtr));
     if (!delta.allFinite()) return false;
-    Eigen::Matrix3d new_rotation;
-    Eigen::Vector3d new_center;
-    IntrinsicValues new_intrinsics;
-    // The camera a fraction of the step away.
-    auto step_to = [&](double fraction) {
-      new_rotation = *rotation;
-      const double angle = fraction * delta.head<3>().norm();
-      if (angle > 0.0) {
-        new_rotation =
-            Eigen::AngleAxisd(angle, delta.head<3>().normalized()).toRotationMatrix() * *rotation;
-      }
-      new_center = *center + fraction * delta.segment<3>(3);
-      new_intrinsics = model->value;
-      int next = 6;
-      for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
-        if (model->free[slot]) new_intrinsics[slot] += fraction * delta(next++);
-      }
-    };
-    step_to(1.0);
+    SteppedCamera stepped = Stepped(*rotation, *center, *model, delta, 1.0);
+    Eigen::Matrix3d& new_rotation = stepped.rotation;
+    Eigen::Vector3d& new_center = stepped.center;
+    IntrinsicValues& new_intrinsics = stepped.intrinsics;
     // In Jacobi-scaled units a step's size is the change it makes to the residuals, in px.
     const double step_px = (delta.cwiseQuotient(scale)).cwiseAbs().maxCoeff();
     // The step's joint size: |J delta|, the change it makes to the residual vector, in px.
@@ -515,41 +524,37 @@ bool PolishGaussNewton(const std::vector<Eigen::Vector3d>& points,
       return at.cost <= normal->cost * (1.0 + 1e-12) +
                             cost_rounding_per_root * std::sqrt(normal->cost) + 1e-300;
     };
-    // A fit that settles (not stop_when_converged): where the full step overshoots -- the
-    // residuals' own curvature, which Gauss-Newton neglects, is not small against J^T J (seen at
-    // 6 points with focal, aspect and principal point free: 2 residual degrees of freedom) -- a
-    // shorter step along it still descends (J^T J is positive definite), and the steps after it
-    // go on to the minimum: halved up to kMaxHalvings times. Without it the polish stopped there
-    // within its convergence test, ~1e-4 px from the minimum, and the own LM's and Ceres'
-    // answers differed by 4e-8 of fx (FitTest.CeresRefinerFindsTheSameOptimum at 15 of 100 seed
-    // offsets).
+    // With `halve` (a fit FitCamera returns): where the full step overshoots -- a curved valley,
+    // or residuals whose own curvature Gauss-Newton neglects -- a shorter step along it still
+    // descends (J^T J is positive definite) and the steps after it go on towards the minimum:
+    // halved up to kMaxHalvings times. Without it a noise-free near-planar scene (thickness
+    // 1e-4, focal, aspect and principal point free, condition ~5e5) was refused as "did not
+    // reach the minimum": each overshooting step ended the polish unconverged and LM, restarted,
+    // stopped at once on its relative step tolerance, 20 rounds over (StabilityTest
+    // NearPlanar1em4FullModel at seed offset 65536).
     constexpr int kMaxHalvings = 4;
     double fraction = 1.0;
-    for (int halving = 0; !accepted(new_normal) && halve &&
-                          halving < kMaxHalvings && !(step_px <= kSettledStepPx);
+    for (int halving = 0; !accepted(new_normal) && halve && halving < kMaxHalvings &&
+                          !(step_px <= kSettledStepPx);
          ++halving) {
       fraction *= 0.5;
-      step_to(fraction);
+      stepped = Stepped(*rotation, *center, *model, delta, fraction);
       if (!ComputeNormalEquations(points, pixels, new_rotation, new_center, new_intrinsics,
                                   columns, &new_normal)) {
         return false;
       }
     }
     if (!accepted(new_normal)) return converged();
-    if (fraction < 1.0) {
-      // A shortened step: the next full one is no measure of the rounding floor.
-      *rotation = new_rotation;
-      *center = new_center;
-      model->value = new_intrinsics;
-      *normal = std::move(new_normal);
-      previous_step_px = std::numeric_limits<double>::infinity();
-      steps.previous_px = std::numeric_limits<double>::infinity();
-      continue;
-    }
     *rotation = new_rotation;
     *center = new_center;
     model->value = new_intrinsics;
     *normal = std::move(new_normal);
+    if (fraction < 1.0) {
+      // A shortened step: the next full one is no measure of the rounding floor.
+      previous_step_px = std::numeric_limits<double>::infinity();
+      steps.previous_px = std::numeric_limits<double>::infinity();
+      continue;
+    }
     // A step that stops shrinking has reached the rounding floor.
     if (step_px > 0.5 * previous_step_px) return converged();
     previous_step_px = step_px;
