@@ -24,7 +24,11 @@ EXPORT_FORMATS: Tuple[str, ...]  # "gl", "glm", "opencv-yaml", "colmap", "three"
 
 class SceneError(RuntimeError):
     """The points cannot determine the requested camera; the message says why and what to change
-    (the text `camproj fit` prints after "cannot fit:", exit code 3)."""
+    (exit code 3 of `camproj fit`, which prints ``why`` after "cannot fit:" and ``fix`` after
+    "to fix:" on a line of its own). ``str(error)`` is ``why + ". " + fix`` where ``fix`` is not
+    empty, else ``why``."""
+    why: str  # what the points show
+    fix: str  # what to do about it, standing alone ("" where the refusal says it within `why`)
 
 class TooFewPointsError(SceneError): ...
 class CollinearPointsError(SceneError): ...

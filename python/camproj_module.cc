@@ -242,7 +242,12 @@ PYBIND11_MODULE(camproj, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const SceneError& e) {
-      PyErr_SetString(subclasses.at(e.reason()).ptr(), e.what());
+      // The exception carries the refusal's parts too: .why and .fix (SceneError::fix).
+      const py::object& type = subclasses.at(e.reason());
+      py::object error = type(e.what());
+      error.attr("why") = e.why();
+      error.attr("fix") = e.fix();
+      PyErr_SetObject(type.ptr(), error.ptr());
     } catch (const InputError& e) {
       PyErr_SetString(input_error.ptr(), e.what());
     }

@@ -136,7 +136,9 @@ case $case in
     cp "$data/projector/truth.json" "$work/cam.json"
     printf 'X,Y,Z,u,v\n1,2,3,4,5\n' >"$work/few.csv"
     expect_exit 3 "$bin" fit "$work/few.csv" --image-size 640x480 -o "$work/cam.json"
-    expect_in err "add points"
+    # Why, then what to do on a line of its own.
+    expect_in err "^camproj: cannot fit: 1 points give 2 equations"
+    expect_in err "^camproj: to fix: Add points (at least"
     cmp -s "$data/projector/truth.json" "$work/cam.json" || fail "the old camera file was changed"
     [[ $(ls "$work" | grep -c tmp) -eq 0 ]] || fail "a temporary file was left behind"
     ;;
@@ -173,6 +175,10 @@ case $case in
       fail "camera file for a failed input"
     expect_exit 1 "$bin" fit "$work/in/projector.csv" "$work/in/synthetic.csv" --image-size 1920x1080
     expect_in err "needs -o"
+    # --json: a refusal's line carries the fix apart too.
+    expect_exit 3 "$bin" fit "$work/in/line.csv" "$work/in/projector.csv" --image-size 1920x1080 \
+      -o "$work/json_cams" --json
+    expect_in out '"file":"[^"]*line.csv".*"fix":"Add points off the line"'
     ;;
   fit_object_points)
     # Scene 64 of the click benchmark (clean, 7 points): pose + focal explains the clicks, 35 px

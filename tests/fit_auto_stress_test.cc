@@ -4,7 +4,9 @@
 //
 // The contract, per scene: FitCameraAuto returns a camera or throws SceneError with a reason
 // other than kNumerical ("a bug: please report it"); nothing else (the command line would exit
-// 2). A returned camera
+// 2). A refusal says what to do apart (SceneError::fix, the command line's "to fix:" line): not
+// empty, what() is why() + ". " + fix(), and the fix stands alone (no "that pixel", "near it" or
+// "those points" pointing back into the why). A returned camera
 //   - passed the consistency gate (FitResult::consistency);
 //   - keeps at least half of the points (a minority consensus is refused);
 //   - reports the rms_px a reader of the camera file recomputes: PixelFromWorld over the kept
@@ -584,8 +586,15 @@ Outcome FitScene(const StressScene& s) {
   } catch (const SceneError& e) {
     outcome.result = ReasonName(e.reason());
     outcome.detail = e.what();
+    const std::string fix = e.fix();
     if (e.reason() == SceneError::Reason::kNumerical) {
       outcome.violation = "kNumerical: " + outcome.detail;
+    } else if (fix.empty() || outcome.detail != e.why() + ". " + fix) {
+      outcome.violation = "no fix apart: " + outcome.detail;
+    } else if (fix.find("that pixel") != std::string::npos ||
+               fix.find("near it") != std::string::npos ||
+               fix.find("those points") != std::string::npos) {
+      outcome.violation = "a fix that points back into the why: " + fix;
     }
   } catch (const std::exception& e) {
     outcome.result = "OTHER";

@@ -441,8 +441,8 @@ TEST(FitAutoTest, ACameraThatStandsOnOneUncheckedClickIsRefused) {
   // (no names given), "point 5" for the bare number a points file without ids gives, "c5" as is.
   EXPECT_EQ(std::string(refusal->what()).rfind("point 5 is checked by no other point", 0), 0u)
       << refusal->what();
-  EXPECT_NE(std::string(refusal->what()).find("Add a point near it"), std::string::npos)
-      << refusal->what();
+  // The fix stands alone: it names the point again.
+  EXPECT_EQ(refusal->fix().rfind("Add a point near point 5, ", 0), 0u) << refusal->what();
   for (const char* prefix : {"", "c"}) {
     AutoFitOptions named;
     for (size_t i = 0; i < scene.points.size(); ++i) {
@@ -806,8 +806,7 @@ TEST(FitAutoTest, AMisclickTheFitAbsorbedIsFoundByLeavingEachPointOut) {
   const EmbeddedScene scene = Embed(clicks, vertices);
   const std::optional<SceneError> refusal = RefusalOf(scene);
   if (refusal) {
-    EXPECT_NE(std::string(refusal->what()).find("Fix or drop point 5 ("), std::string::npos)
-        << refusal->what();
+    EXPECT_EQ(refusal->fix().rfind("Fix or drop point 5 (", 0), 0u) << refusal->what();
   }
   AutoFitOptions keep_all;
   keep_all.find_outliers = false;
@@ -936,10 +935,13 @@ TEST(FitAutoTest, OneMisclickAmongEightIsNamed) {
       ++named;
     } catch (const SceneError& e) {
       // A refusal is allowed; a wrong answer is not. It names the mis-click if it says to fix it.
+      // Alone: the fix begins "Fix or drop point N (... puts it), left out ...".
       const std::string what = e.what();
+      const std::string fix = e.fix();
       const std::string name = "point " + std::to_string(bad + 1);
-      if (what.find("Fix or drop " + name + " (") != std::string::npos &&
-          what.find("puts it), ") == std::string::npos) {
+      const size_t list_end = fix.find("), ");
+      if (fix.rfind("Fix or drop " + name + " (", 0) == 0 && list_end != std::string::npos &&
+          fix.compare(list_end, 11, "), left out") == 0) {
         ++named;
       }
       const size_t among = what.find("(among ");
@@ -1371,9 +1373,10 @@ TEST(FitAutoTest, APlaneRefusedForItsResidualsNamesTheAssumedPrincipalPoint) {
       if (e.reason() == SceneError::Reason::kInconsistent ||
           e.reason() == SceneError::Reason::kContaminated) {
         ++refused_for_residuals;
-        EXPECT_NE(std::string(e.what()).find("assumed at the image's centre (960, 540); check "
-                                             "that the image size is the image's"),
-                  std::string::npos)
+        EXPECT_EQ(e.fix().rfind("The principal point is assumed at the image's centre (960, 540): "
+                                "check that the image size is the image's",
+                                0),
+                  0u)
             << "seed " << seed << ": " << e.what();
       }
     }

@@ -158,6 +158,45 @@ INSTANTIATE_TEST_SUITE_P(
 // principal point off the image, strong barrel distortion, the model with k1 and k2 free. The
 // fit from the DLT's principal point ended on the image's other side with k2 bending (RMS 8 px,
 // fx 5 % off), noise-free; the restarts beyond the image's edges (refine.cc) find the truth.
+TEST(SceneErrorTest, WhatIsWhyThenFixAndCopiesKeepTheParts) {
+  const SceneError apart(SceneError::Reason::kDegenerate, "the points do not say", "Add points");
+  EXPECT_STREQ(apart.what(), "the points do not say. Add points");
+  EXPECT_EQ(apart.why(), "the points do not say");
+  EXPECT_EQ(apart.fix(), "Add points");
+  SceneError copy(SceneError::Reason::kTooFewPoints, "x");
+  copy = apart;
+  EXPECT_EQ(copy.reason(), SceneError::Reason::kDegenerate);
+  EXPECT_EQ(copy.why(), "the points do not say");
+  EXPECT_EQ(copy.fix(), "Add points");
+  // One text: the advice is within the reason, and there is no fix apart.
+  const SceneError one(SceneError::Reason::kDegenerate, "the points do not say: add points");
+  EXPECT_EQ(one.why(), one.what());
+  EXPECT_EQ(one.fix(), "");
+}
+
+// What FitCamera refuses says what to do apart (SceneError::fix), for each kind of refusal it
+// makes on well-formed input here.
+TEST(SceneErrorTest, FitCameraRefusalsSayWhatToDoApart) {
+  const std::vector<Eigen::Vector2d> pixels = {{100, 200}, {137, 211}, {174, 244}, {211, 299},
+                                               {248, 376}, {285, 475}, {322, 596}, {359, 739}};
+  auto fix_of = [&](const std::vector<Eigen::Vector3d>& points) {
+    try {
+      FitCamera(points, std::vector<Eigen::Vector2d>(pixels.begin(),
+                                                     pixels.begin() + points.size()),
+                {640, 480}, FitOptions{});
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()), e.why() + ". " + e.fix());
+      return e.fix();
+    }
+    ADD_FAILURE() << "answered";
+    return std::string();
+  };
+  EXPECT_EQ(fix_of({{0, 0, -2}, {1, 0, -2}, {0, 1, -2}}).rfind("Add points (at least", 0), 0u);
+  std::vector<Eigen::Vector3d> line;
+  for (int t = 0; t < 8; ++t) line.emplace_back(t, 2 * t, -2 - t);
+  EXPECT_EQ(fix_of(line), "Add points off the line");
+}
+
 TEST(FitTest, DistortionWithThePrincipalPointOffTheImage) {
   struct Lens {
     ImageSize size;

@@ -190,6 +190,7 @@ struct BatchRow {
   std::string output;         // the camera file written for it (when ok)
   std::string status = "ok";  // ok | refused | bad input
   std::string detail;         // model and RMS, or the reason
+  std::string fix;            // a refusal's SceneError::fix (also at the end of detail)
   int exit_code = kExitOk;
 };
 
@@ -224,6 +225,7 @@ std::string JsonLine(const BatchRow& row) {
                          {"status", row.status},
                          {"exit_code", row.exit_code},
                          {"detail", row.detail}};
+  if (!row.fix.empty()) line["fix"] = row.fix;
   line["camera_file"] = row.exit_code == kExitOk ? nlohmann::json(row.output) : nlohmann::json();
   // Invalid UTF-8 in a file name or message is replaced, not thrown.
   return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -264,6 +266,7 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
       } catch (const SceneError& e) {
         row.status = "refused";
         row.detail = e.what();
+        row.fix = e.fix();
         row.exit_code = kExitScene;
       } catch (const std::exception& e) {
         row.status = "bad input";

@@ -54,7 +54,10 @@ int main(int argc, char** argv) {
     std::cerr << "camproj: usage: " << camproj::TerminalSafe(e.what()) << "\n(see camproj --help)\n";
     return kExitUsage;
   } catch (const camproj::SceneError& e) {
-    std::cerr << "camproj: cannot fit: " << camproj::TerminalSafe(e.what()) << '\n';
+    // What to do on a line of its own, where the refusal says it apart from why.
+    std::cerr << "camproj: cannot fit: " << camproj::TerminalSafe(e.why()) << '\n';
+    const std::string fix = e.fix();
+    if (!fix.empty()) std::cerr << "camproj: to fix: " << camproj::TerminalSafe(fix) << '\n';
     return kExitScene;
   } catch (const std::exception& e) {
     // InputError (a file), std::invalid_argument (a value the library refused), or anything

@@ -522,7 +522,8 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
                          " views give " + std::to_string(2 * num_points) +
                          " equations for " + std::to_string(num_parameters) +
                          " unknowns (6 per view and " + std::to_string(free_intrinsics) +
-                         " intrinsics): add views or points, or fix intrinsics");
+                         " intrinsics)",
+                     "Add views or points, or fix intrinsics");
   }
   // A plane's homography gives two constraints on K (Zhang): planar views alone determine at
   // most twice their number of K's entries, whatever distortion adds in theory.
@@ -534,8 +535,9 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
                          (planar_views == 1 ? " determines" : "s determine") + " at most " +
                          std::to_string(2 * planar_views) + " of the camera matrix's " +
                          std::to_string(free_k_entries) +
-                         " free entries (a plane gives two constraints): add views of the "
-                         "board at other tilts, or fix the principal point and the aspect");
+                         " free entries (a plane gives two constraints)",
+                     "Add views of the board at other tilts, or fix the principal point and the "
+                     "aspect");
   }
 }
 
@@ -574,7 +576,9 @@ std::optional<Calibration> CalibrateWithout(const std::vector<CalibrationView>& 
   if (refused.empty()) return std::nullopt;
   if (refused.size() == views.size()) {
     const RefusedView& first = refused.front().second;
-    throw SceneError(SceneError::Reason::kDegenerate, first.name + ": " + first.reason);
+    throw SceneError(SceneError::Reason::kDegenerate,
+                     "no view can be used; " + first.name + ": " + first.reason,
+                     "Check the views' correspondences, or add views");
   }
   return CalibrateRest(views, refused, options);
 }
@@ -651,7 +655,8 @@ struct JointProblem {
     for (size_t i = 0; i < free_slots.size(); ++i) k(free_slots[i]) = free_k[i];
     if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
       throw SceneError(SceneError::Reason::kNumerical,
-                       "the joint refinement failed: " + summary.message);
+                       "the joint refinement failed: " + summary.message,
+                       internal::kReportNumericalFailure);
     }
     return summary;
   }
@@ -682,7 +687,8 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
       if (!(point_in_cam.z() > 0.0)) {
         throw SceneError(SceneError::Reason::kPointsBehindCamera,
                          view.name + ": point " + std::to_string(j + 1) +
-                             " is behind the calibrated camera");
+                             " is behind the calibrated camera",
+                         "Check that view's correspondences (ids, order)");
       }
       internal::ResidualOfCamPoint(joint.k.data(), point_in_cam, views[i].pixels[j], residual,
                                    nullptr, nullptr);
@@ -850,8 +856,9 @@ void AddUncertainty(JointProblem& joint, double sum_squares, const CalibrateOpti
   if (!covariance.Compute(blocks, &joint.problem)) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the views do not determine every free intrinsic (the covariance is "
-                     "singular): add views at other angles, or fix the principal point, the "
-                     "aspect or the distortion");
+                     "singular)",
+                     "Add views at other angles, or fix the principal point, the aspect or the "
+                     "distortion");
   }
   const int num_free = static_cast<int>(joint.free_slots.size());
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> free_c(num_free, num_free);
@@ -1160,8 +1167,8 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   if (!start) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the views do not determine the intrinsics in closed form (planar boards "
-                     "need at least 2-3 views at different tilts; a 3D view at least 6 points): "
-                     "add views at other angles, or fix the principal point and the aspect");
+                     "need at least 2-3 views at different tilts; a 3D view at least 6 points)",
+                     "Add views at other angles, or fix the principal point and the aspect");
   }
   // Views without a start pose are left out by name and the rest calibrated.
   std::vector<internal::StartCamera> starts(views.size());

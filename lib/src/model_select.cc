@@ -117,8 +117,8 @@ void MirrorDiagnosis(const std::vector<Eigen::Vector3d>& points,
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "no camera explains these points, but with one world axis flipped they fit "
                      "one (" + screen.summary + "): the points are seen as through a mirror, "
-                     "i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of "
-                     "every point, and again in anything you render) and refit");
+                     "i.e. the world frame is left-handed",
+                     internal::kFlipAnAxis);
   }
 }
 
@@ -181,8 +181,8 @@ std::optional<internal::Rival> MirrorTest(const internal::Selection& selection, 
                        "the points fit a camera better with one world axis flipped (rms " +
                            Px(reversed->rms_px) + " against " + Px(rms_px) +
                            "): they are seen as through a mirror, i.e. the world frame is "
-                           "left-handed. Flip one world axis (e.g. negate Z of every point, and "
-                           "again in anything you render) and refit");
+                           "left-handed",
+                       internal::kFlipAnAxis);
     }
     consider(reversed->camera, selection.options, reversed->rms_px);
   }
@@ -296,8 +296,8 @@ FitResult Assess(Gated gated, const std::vector<int>& left_out, const std::strin
   if (!gated.check.passed) {
     throw SceneError(SceneError::Reason::kInconsistent,
                      "no camera explains these points: " + gated.check.summary +
-                         ". Largest residuals: " + WorstPoints(gated.residuals_px, left_out, names) +
-                         ". Check those points" +
+                         ". Largest residuals: " + WorstPoints(gated.residuals_px, left_out, names),
+                     std::string("Check the points with the largest residuals") +
                          (noise.given ? std::string()
                                       : "; if your points are this noisy, give --sigma PX"));
   }
@@ -384,17 +384,17 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   return SelectOn(points, pixels, *left_out, size, options, noise);
 }
 
-// Where the fit assumed a plane's principal point (which a plane does not show) at the image's
-// centre: that centre and what to check; empty where the principal point was given.
-std::string AssumedCentre(const ImageSize& size, const AutoFitOptions& options) {
+// What to check on a plane, which does not show the principal point: where the fit assumed it
+// (at the image's centre) unless it was given.
+std::string PlanePrincipalPointAdvice(const ImageSize& size, const AutoFitOptions& options) {
   if (options.fit.principal_point.kind != ParameterMode::Kind::kDefault ||
       options.fit.known_intrinsics) {
-    return std::string();
+    return "Check the principal point given and the image size";
   }
-  return "it is assumed at the image's centre " +
+  return "The principal point is assumed at the image's centre " +
          internal::PixelText(Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1)),
                              options.fit.pixel_origin) +
-         "; check that the image size is the image's, or give --principal-point";
+         ": check that the image size is the image's, or give --principal-point";
 }
 
 // The refusal of a scene no selection explained, with what the pipeline saw: a mirror if that
@@ -412,9 +412,9 @@ std::string AssumedCentre(const ImageSize& size, const AutoFitOptions& options) 
   std::string text =
       problem.empty() ? "the points do not fit one camera (" + screen.summary + ")" : problem;
   if (!options.find_outliers) {
-    throw SceneError(SceneError::Reason::kInconsistent,
-                     text + ". Check those points, or drop --keep-all to let the fit find "
-                            "and leave out the points that disagree");
+    throw SceneError(SceneError::Reason::kInconsistent, text,
+                     "Check the points with the largest residuals, or drop --keep-all to let the "
+                     "fit find and leave out the points that disagree");
   }
   if (search && !search->found) text += "; and " + search->why_not;
   if (no_outlier_shows) {
@@ -430,14 +430,20 @@ std::string AssumedCentre(const ImageSize& size, const AutoFitOptions& options) 
   const bool planar =
       screen.fit ? screen.fit->geometry.scene.planar
                  : internal::PrepareScene(points, pixels, size, options.fit.pixel_origin).scene.planar;
-  const std::string assumed = AssumedCentre(size, options);
-  const std::string centre =
-      planar && !assumed.empty()
-          ? ". The points are on a plane, which does not show the principal point: " + assumed
-          : std::string();
+  const bool assumed = planar &&
+                       options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
+                       !options.fit.known_intrinsics;
   throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
                                             : SceneError::Reason::kInconsistent,
-                   text + centre + ". Check the correspondences (ids, order, mis-clicks) and refit" +
+                   text + (assumed ? ". The points are on a plane, which does not show the "
+                                     "principal point"
+                                   : ""),
+                   (assumed ? PlanePrincipalPointAdvice(size, options) + ". " : std::string()) +
+                       (search && !search->found && search->too_few_points
+                            ? "Add points (with more, the one that disagrees can be found and "
+                              "left out), or check the correspondences (ids, order, mis-clicks) "
+                              "and refit"
+                            : "Check the correspondences (ids, order, mis-clicks) and refit") +
                        (noise.given ? std::string()
                                     : "; if your points are this noisy, give --sigma PX"));
 }
@@ -573,9 +579,9 @@ class Pipeline {
         "the camera of the largest consensus " + method_ + " found (" +
             gated_->selection.fit.model + ") leaves out " + std::to_string(left_out_.size()) +
             " of the " + std::to_string(points_.size()) +
-            " points, more than half: so few agreeing points do not say which camera it is. "
-            "Check the image size (a wrong --image-size moves every point alike) and the "
-            "correspondences (ids, order)");
+            " points, more than half: so few agreeing points do not say which camera it is",
+        "Check the image size (a wrong --image-size moves every point alike) and the "
+        "correspondences (ids, order)");
   }
 
   // Points left out by LO-RANSAC are outliers where they could be random pixels; a quarter or
@@ -607,9 +613,9 @@ class Pipeline {
             " points the outlier stage leaves out lie nearer to where the camera (" +
             gated_->selection.fit.model + ") puts them than random pixels would (" +
             std::to_string(near) + " within " + internal::Px(radius_px) +
-            "): they look like a systematic error, not outliers. Check the image size (a wrong "
-            "--image-size moves every point alike), whether the points belong to one rigid "
-            "object, and the correspondences (ids, order)");
+            "): they look like a systematic error, not outliers",
+        "Check the image size (a wrong --image-size moves every point alike), whether the "
+        "points belong to one rigid object, and the correspondences (ids, order)");
   }
 
   // Points left out of a plane are outliers only where the plane's least-squares homography --
@@ -641,7 +647,6 @@ class Pipeline {
     const ConsistencyCheck check = internal::CheckConsistency(
         lengths, internal::Repeats(points_, pixels_), kHomographyParameters, noise_, options_);
     if (!check.passed) return;
-    const std::string assumed = AssumedCentre(size_, options_);
     throw SceneError(
         SceneError::Reason::kInconsistent,
         "the " + std::to_string(left_out_.size()) + " of " + std::to_string(points_.size()) +
@@ -649,9 +654,8 @@ class Pipeline {
             "homography of their plane within the noise (rms " + Px(check.rms_px) +
             "), which no camera of the models tried does (" + gated_->selection.fit.model +
             " fits only the others). The points are on a plane, which does not show the "
-            "principal point: " +
-            (assumed.empty() ? std::string("check the principal point given and the image size")
-                             : assumed));
+            "principal point",
+        PlanePrincipalPointAdvice(size_, options_));
   }
 
   // RANSAC's threshold is the widest the noise tolerance allows: re-read the consensus at the
@@ -706,7 +710,7 @@ void RequireRepresentableCamera(const Camera& camera) {
     RequireFiniteViews(camera);
   } catch (const std::invalid_argument& e) {
     const SceneError refusal = internal::TooLargeForDouble();
-    throw SceneError(refusal.reason(), std::string(refusal.what()) + " (" + e.what() + ")");
+    throw SceneError(refusal.reason(), refusal.why() + " (" + e.what() + ")", refusal.fix());
   }
 }
 
@@ -763,10 +767,8 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
     // Well-formed input never reaches here by design; if it does, it is still a refusal of
     // these values (exit 3), named as what it is.
     throw SceneError(SceneError::Reason::kNumerical,
-                     std::string("a numerical failure on these values (") + e.what() +
-                         "): please report it with the points file; meanwhile, extreme "
-                         "coordinates (subtract an offset, change units) or fixing intrinsics "
-                         "may avoid it");
+                     std::string("a numerical failure on these values (") + e.what() + ")",
+                     internal::kReportNumericalFailure);
   }
 }
 

@@ -12,6 +12,14 @@ from conftest import assert_same_json, load_json, run_cli
 
 DATA = os.environ.get("CAMPROJ_DATA_DIR", "/nonexistent")
 
+
+def cli_refusal(error):
+    """What `camproj fit` prints for the refusal `error`: why, then what to do on its own line;
+    the two make up the message (str(error) == why + ". " + fix)."""
+    assert str(error) == (f"{error.why}. {error.fix}" if error.fix else error.why)
+    fix_line = f"camproj: to fix: {error.fix}\n" if error.fix else ""
+    return f"camproj: cannot fit: {error.why}\n" + fix_line
+
 # (file under data/, image size, CLI options, the same as fit() keywords)
 CASES = [
     ("projector/points.csv", (1920, 1080), [], {}),
@@ -61,7 +69,7 @@ def test_same_camera_or_refusal_as_the_cli(cli, data_dir, name, size, cli_option
     except camproj.SceneError as error:
         assert done.returncode == 3, f"Python refused ({error}), the CLI exited {done.returncode}"
         assert type(error) is not camproj.SceneError  # a subclass naming the reason
-        assert done.stderr == f"camproj: cannot fit: {error}\n"
+        assert done.stderr == cli_refusal(error)
         return
     assert done.returncode == 0, f"the CLI exited {done.returncode}: {done.stderr}"
     assert_same_json(load_json(camera.to_json()), load_json(done.stdout))
@@ -152,7 +160,7 @@ def test_refusals_are_scene_error_subclasses_with_the_cli_message(cli, tmp_path,
     csv.write_text(camproj.points_to_csv(points, pixels))
     done = run_cli(cli, "fit", csv, "--image-size", "640x480")
     assert done.returncode == 3
-    assert done.stderr == f"camproj: cannot fit: {raised.value}\n"
+    assert done.stderr == cli_refusal(raised.value)
 
 
 def test_mirrored_world_is_refused(data_dir):

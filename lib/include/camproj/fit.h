@@ -144,7 +144,11 @@ struct FitOptions {
   void Check() const;
 };
 
-// A refusal: the data cannot determine the requested camera. what() says why and what to do.
+// A refusal: the data cannot determine the requested camera. what() says why and what to do:
+// why() is what the points show, fix() what to do about it (the imperative advice that stands
+// alone: it names the points, pixels and options it refers to), and what() is "why. fix". The
+// command line prints the fix on a line of its own. A refusal whose advice is part of its
+// reason (the one-string constructor) has an empty fix() and why() == what().
 class SceneError : public std::runtime_error {
  public:
   enum class Reason {
@@ -166,11 +170,22 @@ class SceneError : public std::runtime_error {
     kNumerical,     // a numerical failure on these values (a bug: please report it)
   };
   SceneError(Reason reason, const std::string& message)
-      : std::runtime_error(message), reason_(reason) {}
+      : std::runtime_error(message), reason_(reason), why_length_(message.size()) {}
+  // `why` and `fix` as above; `fix` must not be empty.
+  SceneError(Reason reason, const std::string& why, const std::string& fix)
+      : std::runtime_error(why + ". " + fix), reason_(reason), why_length_(why.size()) {}
   Reason reason() const { return reason_; }
+  std::string why() const { return std::string(what(), why_length_); }
+  std::string fix() const {
+    const std::string message = what();
+    return why_length_ + 2 <= message.size() ? message.substr(why_length_ + 2) : std::string();
+  }
 
  private:
   Reason reason_;
+  // what()'s first why_length_ characters are the why; a fix follows after ". ". (An offset
+  // rather than two more strings: copying the exception cannot throw.)
+  size_t why_length_;
 };
 
 // One accepted LM iterate (entry 0 is the closed-form start; without a robust loss the last entry

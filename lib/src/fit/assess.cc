@@ -71,14 +71,14 @@ std::string ModelName(const Model& model) {
     }
   }
   const std::string fix =
-      intrinsic >= 0 ? "fix " + names[intrinsic] + " (the free intrinsic that moves most along "
-                                                    "it, e.g. with --model or a value)"
-                     : "fix intrinsics";
+      intrinsic >= 0 ? "Fix " + names[intrinsic] + " (the free intrinsic that moves most along "
+                                                    "that direction, e.g. with --model or a value)"
+                     : "Fix intrinsics";
   throw SceneError(SceneError::Reason::kDegenerate,
                    Concat("the points do not determine ", involved,
                           " (singular normal equations, reciprocal condition ",
-                          std::max(scaled_normal.rcond, 0.0), "): ", fix,
-                          ", or add points that spread further in depth and across the image"));
+                          std::max(scaled_normal.rcond, 0.0), ")"),
+                   fix + ", or add points that spread further in depth and across the image");
 }
 
 // The covariance in user units with its sigmas (fields of view included) and strong
@@ -327,7 +327,8 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
                      Concat(behind, " of ", n, behind == 1 ? " points is" : " points are",
                             " behind the fitted camera: the "
                             "correspondences are inconsistent (mismatched or mis-clicked "
-                            "points); check them or use a robust loss"));
+                            "points)"),
+                     "Check them or use a robust loss");
   }
   result.rms_px = std::sqrt(sum_squares / n);
   // A fit not described is scored by its sum of squares: its median is read nowhere (the default

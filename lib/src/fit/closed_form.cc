@@ -306,8 +306,8 @@ StartCamera DltStart(const std::vector<Eigen::Vector3d>& points,
     throw SceneError(SceneError::Reason::kPointsBehindCamera,
                      "the correspondences fit no camera that has every point in front of it (" +
                          std::to_string(behind) + " of " + std::to_string(points.size()) +
-                         " points behind the best linear camera): check the point order and "
-                         "look for mismatched or mis-clicked points");
+                         " points behind the best linear camera)",
+                     "Check the point order and look for mismatched or mis-clicked points");
   }
   return *start;
 }

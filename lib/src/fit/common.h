@@ -20,6 +20,16 @@
 namespace camproj {
 namespace internal {
 
+// The fix of every refusal that finds the world frame left-handed (SceneError::fix).
+inline constexpr char kFlipAnAxis[] =
+    "Flip one world axis (e.g. negate Z of every point, and again in anything you render) and "
+    "refit";
+
+// The fix of a refusal for a numerical failure (SceneError::Reason::kNumerical).
+inline constexpr char kReportNumericalFailure[] =
+    "Please report it with the points file; meanwhile, extreme coordinates (subtract an offset, "
+    "change units) or fixing intrinsics may avoid it";
+
 // The perspective fitter's clock: FitResult::time_ms and the trace's elapsed times count from
 // FitCamera's start.
 using Clock = std::chrono::steady_clock;

@@ -71,8 +71,8 @@ void AffineRq(const Eigen::Matrix<double, 2, 3>& a, Eigen::Matrix2d* k2, Eigen::
 
 SceneError NoAffineCamera() {
   return SceneError(SceneError::Reason::kDegenerate,
-                    "no affine camera fits these points (their image is degenerate): check the "
-                    "correspondences");
+                    "no affine camera fits these points (their image is degenerate)",
+                    "Check the correspondences");
 }
 
 // The orthographic family's linear part, shared by FitOrthographic and AffineSumSquaresPx2: the
@@ -96,7 +96,8 @@ AffineScene PrepareAffine(const std::vector<Eigen::Vector3d>& points_in_world,
     throw SceneError(SceneError::Reason::kTooFewPoints,
                      Concat(n, " points give ", 2 * n, " equations; the orthographic model has ",
                             num_params, " unknowns and its linear start needs 4 points off a "
-                            "plane: add points"));
+                            "plane"),
+                     "Add points");
   }
   AffineScene scene;
   scene.shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
@@ -121,13 +122,13 @@ AffineScene PrepareAffine(const std::vector<Eigen::Vector3d>& points_in_world,
   const Eigen::Vector3d extents = shape.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
   if (!(scale > 0.0) || extents(1) <= kOrthoCollinearRatio * extents(2)) {
     throw SceneError(SceneError::Reason::kCollinearPoints,
-                     "the 3D points are collinear (or coincide): add points off the line");
+                     "the 3D points are collinear (or coincide)", "Add points off the line");
   }
   if (extents(0) <= kOrthoPlanarRatio * extents(1)) {
     throw SceneError(SceneError::Reason::kPlanarUnderdetermined,
                      "the points are coplanar: a plane seen orthographically has two mirror-image "
-                     "poses (the sign of its tilt is not in the image); add points off the plane "
-                     "or fit a perspective camera");
+                     "poses (the sign of its tilt is not in the image)",
+                     "Add points off the plane or fit a perspective camera");
   }
   CheckOffset(points_in_world, scale, scene.pixels);
 
@@ -232,7 +233,8 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
     ceres::Solve(solver_options, &problem, &summary);
     if (summary.termination_type == ceres::FAILURE) {
       throw SceneError(SceneError::Reason::kDegenerate,
-                       "the orthographic refinement failed: " + summary.message);
+                       "the orthographic refinement failed: " + summary.message,
+                       "Check the correspondences");
     }
     result.iterations = static_cast<int>(summary.iterations.size()) - 1;
     result.refiner = "ceres";
@@ -253,8 +255,8 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   if (sign_y < 0.0 && !skew_free && k[2] != 0.0) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the orthographic camera that fits these points has its image's y axis "
-                     "turned over, which the given skew does not allow: free the skew or check "
-                     "the correspondences");
+                     "turned over, which the given skew does not allow",
+                     "Free the skew or check the correspondences");
   }
   rotation = Eigen::Vector3d(sign_x, sign_y, sign_x * sign_y).asDiagonal() * rotation;
   k = {sign_x * k[0], sign_x * sign_y * k[1], sign_y * k[2]};
@@ -360,7 +362,8 @@ FitResult FitOrthographic(const std::vector<Eigen::Vector3d>& points_in_world,
   if (!(rcond > kOrthoSingularRcond)) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("the points do not determine the orthographic camera (singular "
-                            "normal equations, reciprocal condition ", rcond, ")"));
+                            "normal equations, reciprocal condition ", rcond, ")"),
+                     "Add points spread across the image, or fix the aspect and skew");
   }
   result.jacobian_condition = scaled_normal.JacobianCondition();
   const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - p, &result);

@@ -134,6 +134,7 @@ OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
   OutlierSearch search;
   if (models.empty()) {
     search.why_not = "too few points to tell which disagree";
+    search.too_few_points = true;
     return search;
   }
   const int p = NumParameters(models.front());
@@ -146,8 +147,9 @@ OutlierSearch Exhaustive(const std::vector<Eigen::Vector3d>& points,
       search.why_not = "with a point left out, the " + std::to_string(n - k) + " others could not "
                        "show that they fit (" + std::to_string(2 * (n - k)) + " equations for " +
                        std::to_string(p) + " unknowns, fewer than " + std::to_string(needed) +
-                       " to spare): add points";
+                       " to spare)";
       if (k == 2) search.why_not = "no single point explains the disagreement, and " + search.why_not;
+      search.too_few_points = true;
       return search;
     }
     std::vector<std::vector<int>> explaining;

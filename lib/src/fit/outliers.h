@@ -27,6 +27,7 @@ struct OutlierSearch {
   std::vector<int> outliers;  // sorted indices into the caller's points
   std::string method;         // "leave-one-out", "leave-two-out", "lo-ransac"
   std::string why_not;        // when !found: what the search saw, in words (names points)
+  bool too_few_points = false;  // when !found: more points would let the search decide
 };
 
 // The screen: every point fitted with the simplest model that can show a mis-click -- pose +

@@ -131,7 +131,8 @@ std::vector<int> RansacConsensus(const Scene& scene, const FitOptions& options) 
     throw SceneError(SceneError::Reason::kTooFewPoints,
                      Concat("RANSAC draws samples of ", sample_size, " points",
                             known ? " (known intrinsics)" : scene.planar_start ? " (a plane)" : "",
-                            "; got ", scene.NumPoints(), ": drop --ransac, or add points"));
+                            "; got ", scene.NumPoints()),
+                     "Drop --ransac, or add points");
   }
   const std::vector<int> inliers = RansacInliers(scene.points, scene.pixels, scene.model, known,
                                                  scene.planar_start, scene.plane_basis, options);
@@ -141,7 +142,8 @@ std::vector<int> RansacConsensus(const Scene& scene, const FitOptions& options) 
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("RANSAC found no camera that ", minimum,
                             " or more points agree on within ", options.ransac_threshold_px,
-                            " px: check the correspondences or raise the threshold"));
+                            " px"),
+                     "Check the correspondences or raise the threshold");
   }
   return inliers;
 }

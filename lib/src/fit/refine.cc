@@ -192,22 +192,21 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
     if (best.normal.jtj.size() > 0 && best.model.value[1] <= 0.0) {
       throw SceneError(SceneError::Reason::kMirroredWorld,
                        "the best camera has a negative aspect (fy < 0): the points are seen as "
-                       "through a mirror, i.e. the world frame is left-handed. Flip one world "
-                       "axis (e.g. negate Z of every point, and again in anything you render) "
-                       "and refit");
+                       "through a mirror, i.e. the world frame is left-handed",
+                       kFlipAnAxis);
     }
     throw SceneError(SceneError::Reason::kPointsBehindCamera,
                      "the refined camera has points behind it (or a negative focal length): "
-                     "the correspondences are inconsistent (mismatched or mis-clicked points); "
-                     "check them or use --ransac");
+                     "the correspondences are inconsistent (mismatched or mis-clicked points)",
+                     "Check them or use --ransac");
   }
   if (!best.converged) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("the refinement did not reach the minimum in ", best.iterations,
                             " iterations: the points barely determine the model (a nearly flat, "
                             "curved valley of cameras that fit about equally well; ",
-                            best.termination, "). Fix intrinsics (e.g. --model focal), or add "
-                            "points spread further in depth"));
+                            best.termination, ")"),
+                     "Fix intrinsics (e.g. --model focal), or add points spread further in depth");
   }
   RefinedCamera refined;
   refined.rotation = best.rotation;
@@ -239,14 +238,15 @@ RefinedCamera RefineRobust(const Scene& scene, const Start& start, const FitOpti
                         &refined.rotation, &refined.center, &refined.model, &refined.trace);
   if (summary.termination_type == ceres::FAILURE) {
     throw SceneError(SceneError::Reason::kDegenerate,
-                     "the refinement failed: " + summary.termination + ": check the correspondences");
+                     "the refinement failed: " + summary.termination, "Check the correspondences");
   }
   if (summary.termination_type == ceres::NO_CONVERGENCE) {
     // As for least squares: never a camera short of the minimum.
     throw SceneError(SceneError::Reason::kDegenerate,
                      Concat("the robust refinement did not converge in ", options.max_iterations,
                             " iterations (", summary.termination, "): the points barely determine "
-                            "the model; fix intrinsics, add points, or raise --max-iterations"));
+                            "the model"),
+                     "Fix intrinsics, add points, or raise --max-iterations");
   }
   refined.iterations = summary.iterations;
   refined.refiner = Concat("ceres, ", options.loss == LossType::kHuber ? "huber" : "cauchy",

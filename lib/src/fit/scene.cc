@@ -70,8 +70,8 @@ Eigen::JacobiSVD<Eigen::Matrix3d> SvdOfRows(const Eigen::MatrixXd& centred) {
 SceneError TooLargeForDouble() {
   return SceneError(SceneError::Reason::kNonFiniteInput,
                     "the 3D points' coordinates are too large for double precision (their sum or "
-                    "differences overflow): divide every coordinate by a common factor (change "
-                    "units) and refit");
+                    "differences overflow)",
+                    "Divide every coordinate by a common factor (change units) and refit");
 }
 
 void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
@@ -92,8 +92,9 @@ void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double sca
                " times as far from the origin as from each other: double precision rounds their "
                "positions relative to each other by ", rounding, " of their spread, which moves "
                "their pixels by about ", rounding_px, " px, and so would the camera written with "
-               "these coordinates. Subtract a common offset from every point (e.g. the first "
-               "point), refit, and use the camera with the offset subtracted"));
+               "these coordinates"),
+        "Subtract a common offset from every point (e.g. the first point), refit, and use the "
+        "camera with the offset subtracted");
   }
 }
 
@@ -106,8 +107,8 @@ void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
     if (!points_in_world[i].allFinite() || !observed_pixels[i].allFinite()) {
       throw SceneError(SceneError::Reason::kNonFiniteInput,
                        Concat("point ", i, " is not finite (X = ", points_in_world[i].transpose(),
-                              ", pixel = ", observed_pixels[i].transpose(),
-                              "): remove or fix it"));
+                              ", pixel = ", observed_pixels[i].transpose(), ")"),
+                       Concat("Remove or fix point ", i));
     }
   }
 }
@@ -151,7 +152,8 @@ SceneGeometry PrepareScene(const std::vector<Eigen::Vector3d>& points_in_world,
     geometry.refusal = SceneError(
         SceneError::Reason::kCollinearPoints,
         "the 3D points are collinear (or coincide): a line does not determine a camera's "
-        "rotation about it; add points off the line");
+        "rotation about it",
+        "Add points off the line");
     return geometry;
   }
   // The distinct points, counted on sorted indices (4 bytes a point, not a copy of 24).
@@ -199,8 +201,9 @@ Scene ValidateScene(SceneGeometry geometry, const FitOptions& options) {
                      Concat(n, " points", count < n ? Concat(" (", count, " distinct)") : "",
                             " give ", 2 * count, " equations, but the model has ",
                             num_params, " unknowns (pose 6 + ", model.NumFree(),
-                            " free intrinsics) and a unique pose needs 4 points: add points (at "
-                            "least ", std::max(4, (num_params + 1) / 2), ") or fix intrinsics"));
+                            " free intrinsics) and a unique pose needs 4 points"),
+                     Concat("Add points (at least ", std::max(4, (num_params + 1) / 2),
+                            ") or fix intrinsics"));
   };
   // In the order of the checks of one scene: the count, the coordinates' range, the shape, the
   // distinct count, the offset, what a plane determines.
@@ -213,8 +216,9 @@ Scene ValidateScene(SceneGeometry geometry, const FitOptions& options) {
         SceneError::Reason::kPlanarUnderdetermined,
         "the points are coplanar: one view of a plane determines at most 2 of focal, aspect, "
         "principal point (2) and skew, but " + FreeLinearNames(model) +
-            " are free. Fix the principal point (at the image centre by default) and the "
-            "aspect (square pixels), or add points off the plane");
+            " are free",
+        "Fix the principal point (at the image centre by default) and the aspect (square "
+        "pixels), or add points off the plane");
   }
   Scene scene = std::move(geometry.scene);
   scene.model = std::move(model);

@@ -98,13 +98,19 @@ ParameterMode& ModeOf(FitOptions& options, int group) {
 struct Evaluation {
   std::optional<FitResult> fit;
   FitOptions options;   // the model
-  std::string refusal;  // the refusal's message
-  SceneError::Reason reason = SceneError::Reason::kDegenerate;
+  // Where not fitted, why: the fit's SceneError, or kNumerical for any other failure.
+  std::optional<SceneError> refusal;
   double sum_squares = 0.0;
   int num_params = 0;
   // The fit's normal equations at its answer (perspective fits; null otherwise).
   std::shared_ptr<const ChartLinearization> linearization = nullptr;
 };
+
+// An evaluation's refusal in words and its reason (kDegenerate where it has none).
+std::string RefusalOf(const Evaluation& e) { return e.refusal ? e.refusal->what() : ""; }
+SceneError::Reason ReasonOf(const Evaluation& e) {
+  return e.refusal ? e.refusal->reason() : SceneError::Reason::kDegenerate;
+}
 
 // `consistent_at_px`: the noise at which the candidate's fit may skip its restarts
 // (fit/candidate.h).
@@ -126,11 +132,11 @@ Evaluation Evaluate(const std::vector<Eigen::Vector3d>& points,
     e.num_params = static_cast<int>(e.fit->free_parameters.size());
     e.linearization = Filled(std::move(linearization));
   } catch (const SceneError& error) {
-    e.refusal = error.what();
-    e.reason = error.reason();
+    e.refusal = error;
   } catch (const std::exception& error) {
-    e.refusal = std::string("numerical failure (") + error.what() + ")";
-    e.reason = SceneError::Reason::kNumerical;
+    e.refusal = SceneError(SceneError::Reason::kNumerical,
+                           std::string("numerical failure (") + error.what() + ")",
+                           kReportNumericalFailure);
   }
   return e;
 }
@@ -372,7 +378,7 @@ Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::strin
   if (ladder.final.fit) ladder.start_method = ladder.final.fit->start_method;
   ladder.final_index = Record(ladder.final, base_name,
                               ladder.final.fit ? "simplest model"
-                                               : "not determined: " + ladder.final.refusal);
+                                               : "not determined: " + RefusalOf(ladder.final));
   auto in_groups = [&](int g) { return std::find(groups.begin(), groups.end(), g) != groups.end(); };
   for (;;) {
     const std::string current_name = ladder.final.fit ? ladder.final.fit->model : base_name;
@@ -413,7 +419,7 @@ Ladder ModelSelector::RunLadder(const FitOptions& base_options, const std::strin
           FitModel(trial_options, ladder.final.fit ? &ladder.final.fit->camera : nullptr);
       if (!trial.fit) {
         ladder.why_left_out[g] = "left out: not determined (the fit with it is refused: " +
-                                 trial.refusal + ")";
+                                 RefusalOf(trial) + ")";
         Record(trial, name, "not determined: refused");
         continue;
       }
@@ -561,8 +567,8 @@ void ModelSelector::RefuseMirroredIfPerspectiveFits(const FitOptions& base,
                      "the points fit a perspective camera only with one world axis flipped "
                      "(rms " + Fixed(e.fit->rms_px) + " px; the best camera of this world is "
                      "orthographic with rms " + Fixed(chosen.final.fit->rms_px) + " px): they "
-                     "are seen as through a mirror, i.e. the world frame is left-handed. Flip one world axis (e.g. negate Z of every "
-                     "point, and again in anything you render) and refit");
+                     "are seen as through a mirror, i.e. the world frame is left-handed",
+                     kFlipAnAxis);
   }
 }
 
@@ -635,9 +641,9 @@ Selection ModelSelector::Run() {
   const Evaluation base_fit = FitModel(base);
   const bool orthographic_allowed =
       options_.allow_orthographic && OrthographicIsPossible(base) &&
-      (base_fit.fit || base_fit.reason == SceneError::Reason::kDegenerate ||
-       base_fit.reason == SceneError::Reason::kAmbiguous ||
-       (base_fit.reason == SceneError::Reason::kPointsBehindCamera && AffineExplains(base)));
+      (base_fit.fit || ReasonOf(base_fit) == SceneError::Reason::kDegenerate ||
+       ReasonOf(base_fit) == SceneError::Reason::kAmbiguous ||
+       (ReasonOf(base_fit) == SceneError::Reason::kPointsBehindCamera && AffineExplains(base)));
   sigma_ = Noise(base, candidates, base_fit, orthographic_allowed);
 
   // Every model of the ladder is judged at the selection's noise (its sigmas then follow).
@@ -656,8 +662,10 @@ Selection ModelSelector::Run() {
   }
   if (!chosen.final.fit) {
     // The simplest model's refusal says what to fix.
-    throw SceneError(base_fit.fit ? chosen.final.reason : base_fit.reason,
-                     base_fit.fit ? chosen.final.refusal : base_fit.refusal);
+    const Evaluation& refused = base_fit.fit ? chosen.final : base_fit;
+    throw refused.refusal ? *refused.refusal
+                          : SceneError(SceneError::Reason::kNumerical, "no model was fitted",
+                                       kReportNumericalFailure);
   }
   if (orthographic_chosen && base.projection == Projection::kPerspective) {
     RefuseMirroredIfPerspectiveFits(base, chosen);

@@ -75,13 +75,13 @@ StartCamera ProperStartOrRefuse(const std::vector<Eigen::Vector3d>& points,
       throw SceneError(SceneError::Reason::kAmbiguous,
                        "the points fit a camera seen through a mirror (a left-handed world frame) "
                        "somewhat better than a proper one (" + fits + "): too few points or too "
-                       "much noise to tell. Add points spread in depth, or check the world "
-                       "frame's handedness");
+                       "much noise to tell",
+                       "Add points spread in depth, or check the world frame's handedness");
     }
     throw SceneError(SceneError::Reason::kMirroredWorld,
                      "the points are seen as through a mirror: the world frame is left-handed (" +
-                         fits + "). Flip one world axis (e.g. negate Z of every point, and again "
-                         "in anything you render) and refit");
+                         fits + ")",
+                     kFlipAnAxis);
   }
   return proper;
 }
@@ -99,14 +99,15 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
   if (options.known_intrinsics) {
     if (!PnpStart(points, pixels, guess, &start)) {
       throw SceneError(SceneError::Reason::kDegenerate,
-                       "SQPnP found no pose for the known intrinsics: check the correspondences "
-                       "and the intrinsics' pixel convention");
+                       "SQPnP found no pose for the known intrinsics",
+                       "Check the correspondences and the intrinsics' pixel convention");
     }
     *method = "pnp";
   } else if (scene.planar_start) {
     if (n < 4) {
       throw SceneError(SceneError::Reason::kTooFewPoints,
-                       Concat("a planar scene needs at least 4 points, got ", n));
+                       Concat("a planar scene needs at least 4 points, got ", n),
+                       "Add points (at least 4)");
     }
     Intrinsics plane_guess = guess;
     const bool focal_free = start_model.free[0];
@@ -126,8 +127,8 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
     } else {
       throw SceneError(SceneError::Reason::kDegenerate,
                        "the plane's homography does not determine the focal length (the plane "
-                       "is seen nearly head-on, or the points are mismatched): fix the focal "
-                       "length (--focal / --fovy) or add points off the plane");
+                       "is seen nearly head-on, or the points are mismatched)",
+                       "Fix the focal length (--focal / --fovy) or add points off the plane");
     }
   } else if (n >= 6) {
     start = DltStartOf(scene);
@@ -156,14 +157,14 @@ StartCamera SolveClosedForm(const Scene& scene, const FitOptions& options,
                         : PnpStart(points, pixels, guess, &start);
     if (!ok) {
       throw SceneError(SceneError::Reason::kDegenerate,
-                       "no camera found for these few points: check the correspondences");
+                       "no camera found for these few points", "Check the correspondences");
     }
     *method = start_model.free[0] ? "pnp-focal-sweep" : "pnp";
   } else {
     throw SceneError(SceneError::Reason::kTooFewPoints,
                      Concat("the linear start (DLT) needs 6 non-coplanar points to free ",
-                            FreeLinearNames(start_model), "; got ", n,
-                            ": add points or fix all but the focal length"));
+                            FreeLinearNames(start_model), "; got ", n),
+                     "Add points or fix all but the focal length");
   }
   return start;
 }
@@ -243,8 +244,8 @@ std::optional<Start> PlaneAspectStart(const Scene& scene, const FitOptions& opti
                      "principal point given and fx, fy free maps the plane as the homography "
                      "that fits the points best (its constraints on fx and fy have no solution: "
                      "the plane is seen tilted about nearly one image axis, where they "
-                     "coincide), so the fit would only grow the focal lengths without end. Fix "
-                     "the aspect (e.g. --model focal), or add points off the plane");
+                     "coincide), so the fit would only grow the focal lengths without end",
+                     "Fix the aspect (e.g. --model focal), or add points off the plane");
   }
   start.method = "homography";
   start.model = ProjectOntoModel(model, start.camera.intrinsics);

@@ -16,12 +16,13 @@ namespace internal {
 
 namespace {
 
-// The advice that ends a refusal: "Add <what>", or with points left out by the outlier stage
-// "Fix or drop <them> (left out as disagreeing ...); add <what>".
+// A refusal's fix (SceneError::fix): "Add <what>", or with points left out by the outlier stage
+// "Fix or drop <them>, left out as disagreeing ...; then add <what>".
 std::string LeftOutThenAdd(const std::string& left_out, const std::string& what) {
   return (left_out.empty() ? std::string("Add ")
-                           : "Fix or drop " + left_out + " (left out as disagreeing with the "
-                                                         "rest by far more than the noise); add ") +
+                           : "Fix or drop " + left_out +
+                                 ", left out as disagreeing with the rest by far more than the "
+                                 "noise; then add ") +
          what;
 }
 
@@ -49,24 +50,28 @@ std::string LeftOutText(const std::vector<Eigen::Vector2d>& residuals,
 void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& model,
                           const std::string& left_out, PixelOrigin pixel_origin) {
   if (check.passed) return;
-  const std::string add_points =
-      "points where the image has none (toward that pixel) and spread in depth, or fix the "
-      "intrinsics you know (--model, or their values)";
-  const std::string advice = LeftOutThenAdd(left_out, add_points);
+  // The advice names the pixel where the camera is least determined (the fix stands alone).
+  auto advice = [&](const Eigen::Vector2d& pixel) {
+    return LeftOutThenAdd(left_out, "points where the image has none (toward pixel " +
+                                        PixelText(pixel, pixel_origin) +
+                                        ") and spread in depth, or fix the intrinsics you know "
+                                        "(--model, or their values)");
+  };
   if (check.rival == kMirroredReadingName && check.rival_shift_px > check.bound_px) {
     throw SceneError(SceneError::Reason::kAmbiguous,
                      "the points fit about as well with one world axis flipped, and the two "
                      "readings put the scene up to " + Px(check.rival_shift_px) +
                          " apart (bound " + Px(check.bound_px) +
                          ", --max-uncertainty): the points cannot tell whether the world frame "
-                         "is right- or left-handed. If it may be left-handed, flip one world axis "
-                         "(e.g. negate Z of every point) and refit; otherwise add points spread "
-                         "in depth");
+                         "is right- or left-handed",
+                     "If it may be left-handed, flip one world axis (e.g. negate Z of every "
+                     "point) and refit; otherwise add points spread in depth");
   }
   if (check.max_sigma_px > check.bound_px) {
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the points do not determine the camera well enough: it is " +
-                         check.summary + " (--max-uncertainty). " + advice);
+                         check.summary + " (--max-uncertainty)",
+                     advice(check.worst_pixel));
   }
   if (check.rival_shift_px <= check.bound_px) {
     throw SceneError(
@@ -78,7 +83,8 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
              ? "put the scene " + Px(check.averaged_sigma_px) + " apart (1 sigma)"
              : std::string("disagree: one puts a point of the scene behind its camera")) +
         " near pixel " + PixelText(check.averaged_worst_pixel, pixel_origin) +
-        " (bound " + Px(check.bound_px) + ", --max-uncertainty). " + advice);
+        " (bound " + Px(check.bound_px) + ", --max-uncertainty)",
+        advice(check.averaged_worst_pixel));
   }
   // "both fit about as well, but they put the scene up to 8.88 px apart near pixel (445, 673)
   // (bound 5 px, --max-uncertainty). "
@@ -89,20 +95,21 @@ void RefuseIfUndetermined(const DeterminationCheck& check, const std::string& mo
            : "") +
       ", but they put the scene up to " + Px(check.rival_shift_px) + " apart near pixel " +
       PixelText(check.rival_worst_pixel, pixel_origin) + " (bound " +
-      Px(check.bound_px) + ", --max-uncertainty). ";
+      Px(check.bound_px) + ", --max-uncertainty)";
   if (check.rival_frees_lens_shift) {
     throw SceneError(
         SceneError::Reason::kAmbiguous,
         "the points cannot tell where the principal point is: " + model +
             " leaves it at the image centre and " + check.rival + " frees it; " + parted +
-            "A few points cannot tell a projector's lens shift from a longer focal length and a "
-            "tilt. If the principal point is at the image centre (a camera, or a projector "
-            "without lens shift), give --fix principal-point; if you know where it is, "
-            "--principal-point CX,CY. " + advice);
+            ". A few points cannot tell a projector's lens shift from a longer focal length and "
+            "a tilt",
+        "If the principal point is at the image centre (a camera, or a projector without lens "
+        "shift), give --fix principal-point; if you know where it is, --principal-point CX,CY. " +
+            advice(check.rival_worst_pixel));
   }
   throw SceneError(SceneError::Reason::kAmbiguous,
-                   "the points cannot tell " + model + " from " + check.rival + ": " + parted +
-                       advice);
+                   "the points cannot tell " + model + " from " + check.rival + ": " + parted,
+                   advice(check.rival_worst_pixel));
 }
 
 void RefuseIfPerspectiveShows(const PerspectiveTest& test, const std::string& left_out) {
@@ -115,11 +122,11 @@ void RefuseIfPerspectiveShows(const PerspectiveTest& test, const std::string& le
           g3(test.sum_squares_px2) + " px^2 squared residuals, " + g3(test.statistic) +
           " times the noise's square (" + Px(test.sigma_px) + " with it free; at most " +
           g3(test.bound) + " where the depth spread is too small against the distance to "
-          "show perspective), and no perspective model was determined by them or fitted better. " +
-          LeftOutThenAdd(left_out,
-                         "points spread in depth and across the image, or give the intrinsics "
-                         "you know (e.g. --principal-point for a projector's lens shift), so "
-                         "that a perspective camera can be fitted"));
+          "show perspective), and no perspective model was determined by them or fitted better",
+      LeftOutThenAdd(left_out,
+                     "points spread in depth and across the image, or give the intrinsics you "
+                     "know (e.g. --principal-point for a projector's lens shift), so that a "
+                     "perspective camera can be fitted"));
 }
 
 // No edge: within the chosen fit's kLinearityLevel region (its linearity check, fit/assess.cc) a
@@ -137,10 +144,10 @@ void RefuseIfRegionUnbounded(const FitResult& fit, const std::string& left_out) 
       "the points do not determine the camera: within its " + level +
           " % confidence region, along " +
           along + ", a camera sees some of them from behind or fits them as well, so how far "
-          "it is off beyond them cannot be told. " +
-          LeftOutThenAdd(left_out,
-                         "points where the image has none and spread in depth, or give the "
-                         "intrinsics you know (--model, or their values)"));
+          "it is off beyond them cannot be told",
+      LeftOutThenAdd(left_out,
+                     "points where the image has none and spread in depth, or give the "
+                     "intrinsics you know (--model, or their values)"));
 }
 
 PointReliability WordReliability(PointReliability least, const std::vector<int>& left_out,
@@ -187,9 +194,10 @@ void RefuseIfUnchecked(const PointReliability& least, const std::vector<std::str
                    PointName(names[least.point]) + " is checked by no other point" +
                        ": the camera follows it along " + DirectionText(least.direction) +
                        ", and a mis-click of it anywhere in the image would leave less than the "
-                       "noise (" + Px(sigma_px) + ") in its residual. " +
-                       LeftOutThenAdd(left_out, "a point near it, or fix intrinsics you know "
-                                                "(e.g. --fix principal-point)"));
+                       "noise (" + Px(sigma_px) + ") in its residual",
+                   LeftOutThenAdd(left_out, "a point near " + PointName(names[least.point]) +
+                                                ", or fix intrinsics you know (e.g. --fix "
+                                                "principal-point)"));
 }
 
 }  // namespace internal
