@@ -224,7 +224,7 @@ std::vector<internal::Rival> OtherMinima(const internal::Selection& selection,
   }
   for (const internal::Reading& reading :
        internal::FitFromEdgePrincipalPoints(kept_points, kept_pixels, size, selection.options,
-                                            selection.fit.camera.intrinsics)) {
+                                            selection.fit.camera, selection.fit.rms_px)) {
     internal::Rival rival{internal::kOtherMinimumName, selection.options, reading.camera,
                           CriterionOf(selection, selection.options, reading.rms_px,
                                       kept_points.size())};

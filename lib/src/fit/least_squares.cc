@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,6 +46,21 @@ class ChartProblem {
               Model* model) const {
     *model = model_;
     Unpack(u, rotation, center, &model->value);
+  }
+
+  // The camera (rotation, center, every slot's value) on this chart: rotation = exp(omega)
+  // start_rotation with |omega| <= pi.
+  ParamVector PackCamera(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& center,
+                         const IntrinsicValues& intrinsics) const {
+    ParamVector u(6 + model_.NumFree());
+    const Eigen::AngleAxisd turn(rotation * start_rotation_.transpose());
+    u.head<3>() = turn.angle() * turn.axis();
+    u.segment<3>(3) = center;
+    int next = 6;
+    for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
+      if (model_.free[slot]) u(next++) = intrinsics[slot];
+    }
+    return u;
   }
 
   // The normal equations at u on the chart; `local` receives them before the change of variables
@@ -166,6 +182,7 @@ enum class LmStatus {
   kMaxIterations,
   kCostChangeTooSmall,
   kTargetOutOfReach,
+  kAtKnownMinimum,
 };
 
 std::string LmStatusText(LmStatus status) {
@@ -176,6 +193,8 @@ std::string LmStatusText(LmStatus status) {
     case LmStatus::kCostChangeTooSmall: return "CONVERGENCE: cost change below tolerance";
     case LmStatus::kTargetOutOfReach:
       return "NO_CONVERGENCE: the linear model's minimum is far above the cost asked for";
+    case LmStatus::kAtKnownMinimum:
+      return "CONVERGENCE: in the quadratic neighbourhood of the minimum already found";
     case LmStatus::kMaxIterations: break;
   }
   return "NO_CONVERGENCE: maximum number of iterations reached";
@@ -188,6 +207,25 @@ struct LmSummary {
   bool local_at_solution = false;
   NormalEquations local;
 };
+
+// A KnownMinimum on a ChartProblem's chart: its parameters there, its cost and the squared radius
+// of its neighbourhood (px^2).
+struct KnownOnChart {
+  ParamVector u;
+  double cost = 0.0;
+  double radius_px2 = 0.0;
+};
+
+KnownOnChart OnChart(const KnownMinimum& known, const ChartProblem& problem) {
+  KnownOnChart on;
+  on.u = problem.PackCamera(known.rotation, known.center, known.intrinsics);
+  on.cost = known.cost;
+  const double dof =
+      std::max(1.0, 2.0 * problem.NumPoints() - static_cast<double>(on.u.size()));
+  on.radius_px2 = KnownMinimum::kSameBasinFraction * KnownMinimum::kSameBasinFraction *
+                  known.cost / dof;
+  return on;
+}
 
 // Levenberg-Marquardt exactly as ceres::TinySolver (Ceres 2.1) runs it -- Jacobi scaling fixed at
 // the start, the same damping and trust-region updates, stopping rules and defaults -- but on
@@ -206,10 +244,14 @@ struct LmSummary {
 //
 // With a finite `out_of_reach_px2`, LM also stops (kTargetOutOfReach) at an iterate where the
 // Gauss-Newton model's minimum, twice (cost - g^T (J^T J)^-1 g / 2), is above it.
+//
+// With `known` (KnownMinimum in least_squares.h, on this problem's chart), LM also stops
+// (kAtKnownMinimum) at an iterate within its radius of the known minimum whose Gauss-Newton
+// model's minimum is not below the known cost.
 LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptions& options,
                                      Clock::time_point start_time, bool geodesic,
-                                     double out_of_reach_px2, ParamVector* u,
-                                     std::vector<TraceEntry>* trace) {
+                                     double out_of_reach_px2, const KnownOnChart* known,
+                                     ParamVector* u, std::vector<TraceEntry>* trace) {
   // Transtrum and Sethna's defaults: the finite-difference step along v and the largest
   // acceptable |a| / |v| (times 2).
   constexpr double kGeodesicStep = 0.1;
@@ -262,6 +304,16 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
     // which tells nothing.
     return decrease >= 0.0 && std::isfinite(decrease) && 2.0 * (cost - decrease) > out_of_reach_px2;
   };
+  // Whether the current iterate (its unscaled normal equations `at`) is in the known minimum's
+  // neighbourhood with no lower minimum in its Gauss-Newton model's reach.
+  auto at_known_minimum = [&](const NormalEquations& at) {
+    if (known == nullptr) return false;
+    const ParamVector d = *u - known->u;
+    if (!(d.dot(at.jtj * d) <= known->radius_px2)) return false;
+    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
+    return decrease >= 0.0 && std::isfinite(decrease) &&
+           2.0 * (cost - decrease) >= known->cost * (1.0 - kLowerByRounding);
+  };
 
   NormalEquations chart;
   // The summary with the last accepted local normal equations (every return below).
@@ -283,6 +335,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   }
   if (out_of_reach()) {
     summary.status = LmStatus::kTargetOutOfReach;
+    return finish();
+  }
+  if (at_known_minimum(chart)) {
+    summary.status = LmStatus::kAtKnownMinimum;
     return finish();
   }
   double damping = 1.0 / kInitialTrustRegionRadius;
@@ -348,6 +404,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       }
       if (out_of_reach()) {
         summary.status = LmStatus::kTargetOutOfReach;
+        break;
+      }
+      if (at_known_minimum(chart)) {
+        summary.status = LmStatus::kAtKnownMinimum;
         break;
       }
       const double t = 2.0 * rho - 1.0;
@@ -571,7 +631,8 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        const Eigen::Vector3d& start_center, const Model& model,
                                        const FitOptions& options, Clock::time_point start_time,
                                        int max_rounds, PolishFirst polish_first,
-                                       PolishUntil until, double out_of_reach_px2) {
+                                       PolishUntil until, double out_of_reach_px2,
+                                       const KnownMinimum* known) {
   const bool scored = until == PolishUntil::kConverged;
   LeastSquaresOutcome outcome;
   outcome.rotation = start_rotation;
@@ -613,10 +674,13 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
     } else {
       const ChartProblem problem(points, pixels, outcome.rotation, outcome.model);
       ParamVector u = problem.Pack(outcome.center);
+      std::optional<KnownOnChart> known_on_chart;
+      if (known != nullptr) known_on_chart = OnChart(*known, problem);
       // The first round is TinySolver's LM; where its answer is short of the minimum (a curved
       // valley), the next rounds add geodesic acceleration.
-      const LmSummary summary = MinimizeLevenbergMarquardt(problem, options, start_time, round > 0,
-                                                           out_of_reach_px2, &u, &outcome.trace);
+      const LmSummary summary = MinimizeLevenbergMarquardt(
+          problem, options, start_time, round > 0, out_of_reach_px2,
+          known_on_chart ? &*known_on_chart : nullptr, &u, &outcome.trace);
       problem.Unpack(u, &outcome.rotation, &outcome.center, &outcome.model);
       outcome.iterations += summary.iterations;
       outcome.termination = LmStatusText(summary.status);
@@ -630,6 +694,11 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
       // Not a minimum, and no polish can take it to the cost asked for: the caller reads only
       // that it is above it.
       if (have_normal && summary.status == LmStatus::kTargetOutOfReach) break;
+      // Only the known minimum again: the caller keeps that one.
+      if (summary.status == LmStatus::kAtKnownMinimum) {
+        outcome.at_known_minimum = true;
+        break;
+      }
     }
     if (!have_normal) {
       have_normal = ComputeNormalEquations(points, pixels, outcome.rotation, outcome.center,
@@ -644,8 +713,9 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
   if (!have_normal) outcome.normal = NormalEquations();
   // A negative aspect is a mirror image (y flipped) and a negative focal length a camera turned
   // half a turn: neither is an answer (the caller refuses).
-  outcome.ok = outcome.normal.jtj.size() > 0 && std::isfinite(outcome.normal.cost) &&
-               outcome.model.value[0] > 0.0 && outcome.model.value[1] > 0.0;
+  outcome.ok = !outcome.at_known_minimum && outcome.normal.jtj.size() > 0 &&
+               std::isfinite(outcome.normal.cost) && outcome.model.value[0] > 0.0 &&
+               outcome.model.value[1] > 0.0;
   // The polish's result closes the trace, so it ends at the reported RMS.
   outcome.trace.push_back({static_cast<int>(outcome.trace.size()), MicrosecondsSince(start_time),
                            std::sqrt(outcome.normal.cost / static_cast<double>(points.size()))});

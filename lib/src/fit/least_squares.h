@@ -40,6 +40,8 @@ struct LeastSquaresOutcome {
   // `normal` is one step back, a step the polish took on its prediction of the next (up to 1e-2
   // of the residuals' sigma; least_squares.cc, PolishSteps), not within its convergence test.
   bool normal_predicted_step_back = false;
+  // LM stopped at the known minimum's neighbourhood (KnownMinimum): not a minimum of its own.
+  bool at_known_minimum = false;
   int iterations = 0;
   std::string termination;
   std::vector<TraceEntry> trace;
@@ -85,6 +87,31 @@ enum class PolishFirst {
 // the click benchmark halving there changed 1 status and 2 reasons in 2200 scenes).
 enum class PolishUntil { kSettled, kConverged, kSettledHalving };
 
+// A refinement's cost lower than another's by at most this fraction is the same (rounding): the
+// refinement stage keeps the first of two such (fit/refine.cc).
+inline constexpr double kLowerByRounding = 1e-9;
+
+// A minimum already found from another start (its camera, and the sum of squares there in px^2),
+// for a refinement that matters only where it ends lower than that minimum (a restart of the
+// refinement stage, fit/refine.cc, whose caller keeps the lower cost). The own LM stops where its
+// iterate is within kSameBasinFraction of the known minimum's residual sigma of it, in the joint
+// sense (|J delta| over the points, J the iterate's Jacobian: sqrt(delta^T J^T J delta) <=
+// kSameBasinFraction sqrt(cost / max(1, 2N - p))), and its Gauss-Newton model's minimum is not
+// below the known cost (by more than the caller's 1e-9 relative): there the cost is quadratic to
+// a part in ~1e4 of the noise's square (the linearity check's curvature shows only at sigmas), so
+// LM would converge to the known minimum itself. The outcome is then not ok, and neither polish
+// nor further round follows. Not with Refiner::kCeres. (Where the known minimum settled a part in
+// 1e8 above the bottom of a valley flat to its rounding, the restart would have settled lower by
+// more than kLowerByRounding at the same minimum, within 1e-4 px of it, and replaced it: 4 of
+// 46 727 restarts stopped, tests/known_minimum_test.cc. The known one is kept there.)
+struct KnownMinimum {
+  static constexpr double kSameBasinFraction = 0.1;
+  Eigen::Matrix3d rotation;  // point_in_cam = rotation * (point - center)
+  Eigen::Vector3d center;
+  IntrinsicValues intrinsics;  // every slot's value (Model::value)
+  double cost = 0.0;           // sum of squared residuals, px^2
+};
+
 LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector2d>& pixels,
                                        const Eigen::Matrix3d& start_rotation,
@@ -94,7 +121,8 @@ LeastSquaresOutcome RefineLeastSquares(const std::vector<Eigen::Vector3d>& point
                                        PolishFirst polish_first = PolishFirst::kNo,
                                        PolishUntil until = PolishUntil::kSettled,
                                        double out_of_reach_px2 =
-                                           std::numeric_limits<double>::infinity());
+                                           std::numeric_limits<double>::infinity(),
+                                       const KnownMinimum* known = nullptr);
 
 }  // namespace internal
 }  // namespace camproj

@@ -23,13 +23,16 @@ namespace internal {
 inline constexpr char kOtherMinimumName[] = "the same model at another of its minima";
 
 // `model` (principal point free) fitted by LM (one round of at most 20 iterations) from an SQPnP
-// pose with `intrinsics` but the principal point at each midpoint of the image's edges: the
-// proper cameras found with every point in front, each with its RMS.
+// pose with `chosen`'s intrinsics but the principal point at each midpoint of the image's edges:
+// the proper cameras found with every point in front, each with its RMS. `chosen` is `model`'s
+// fit of the same points, with `chosen_rms_px`: a refit that comes back to it stops in its
+// neighbourhood and is not returned (least_squares.h, KnownMinimum), as the determination check
+// would drop it as the same minimum again.
 std::vector<Reading> FitFromEdgePrincipalPoints(const std::vector<Eigen::Vector3d>& points_in_world,
                                                 const std::vector<Eigen::Vector2d>& observed_pixels,
                                                 const ImageSize& image_size,
-                                                const FitOptions& model,
-                                                const Intrinsics& intrinsics);
+                                                const FitOptions& model, const Camera& chosen,
+                                                double chosen_rms_px);
 
 }  // namespace internal
 }  // namespace camproj

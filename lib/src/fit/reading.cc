@@ -17,10 +17,12 @@ Model ModelAt(const Model& model, const Intrinsics& intrinsics) {
 
 std::optional<Reading> RefineReading(const Scene& scene, const StartCamera& start,
                                      const Model& start_model, const FitOptions& options,
-                                     const Camera& like, double out_of_reach_px2) {
+                                     const Camera& like, double out_of_reach_px2,
+                                     const KnownMinimum* known) {
   const LeastSquaresOutcome outcome = RefineLeastSquares(
       scene.points, scene.pixels, start.rotation, start.center, start_model, options,
-      Clock::now(), /*max_rounds=*/1, PolishFirst::kNo, PolishUntil::kSettled, out_of_reach_px2);
+      Clock::now(), /*max_rounds=*/1, PolishFirst::kNo, PolishUntil::kSettled, out_of_reach_px2,
+      known);
   if (!outcome.ok) return std::nullopt;
   Reading reading;
   reading.camera = like;

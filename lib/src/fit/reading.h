@@ -11,6 +11,7 @@
 #include "camproj/fit.h"
 #include "camproj/intrinsics.h"
 #include "fit/closed_form.h"
+#include "fit/least_squares.h"
 #include "fit/model.h"
 #include "fit/scene.h"
 
@@ -28,11 +29,13 @@ Model ModelAt(const Model& model, const Intrinsics& intrinsics);
 // LM (one round of options.max_iterations) in `scene`'s normalized world from `start`: the
 // camera as `like` (projection, image size, depth range) with the refined pose and intrinsics,
 // and its RMS; nothing if a point ends behind it or its focal length or aspect is not positive.
-// `out_of_reach_px2`: RefineLeastSquares' (fit/least_squares.h).
+// `out_of_reach_px2`, `known`: RefineLeastSquares' (fit/least_squares.h); nothing either where it
+// stops at the known minimum.
 std::optional<Reading> RefineReading(
     const Scene& scene, const StartCamera& start, const Model& start_model,
     const FitOptions& options, const Camera& like,
-    double out_of_reach_px2 = std::numeric_limits<double>::infinity());
+    double out_of_reach_px2 = std::numeric_limits<double>::infinity(),
+    const KnownMinimum* known = nullptr);
 
 }  // namespace internal
 }  // namespace camproj
