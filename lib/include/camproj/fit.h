@@ -15,7 +15,9 @@
 // sweep start from each other valley of its RMS; and from every valley of the focal sweep (SQPnP
 // over fields of view 0.5-175 deg) a homography start for points only nearly coplanar and a DLT
 // start whose best fit has an intrinsic no lens has (pixels 1.5 times as tall as wide or more,
-// the principal point more than an image size from the centre). Details: fit/refine.cc.
+// the principal point more than an image size from the centre). A restart that comes back to the
+// lowest minimum found so far stops in its quadratic neighbourhood instead of converging to it
+// again (fit/least_squares.h, KnownMinimum). Details: fit/refine.cc.
 //
 // On a plane, focal and aspect free with the principal point given and neither skew nor
 // distortion is the homography's model: the fit starts at the camera of the least-squares
