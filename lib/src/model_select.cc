@@ -384,13 +384,17 @@ Gated ForcedRansac(const std::vector<Eigen::Vector3d>& points,
   return SelectOn(points, pixels, *left_out, size, options, noise);
 }
 
+// Whether the fit assumes the principal point at the image's centre (nor given nor known): a
+// plane does not show it.
+bool PrincipalPointAssumed(const AutoFitOptions& options) {
+  return options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
+         !options.fit.known_intrinsics;
+}
+
 // What to check on a plane, which does not show the principal point: where the fit assumed it
 // (at the image's centre) unless it was given.
 std::string PlanePrincipalPointAdvice(const ImageSize& size, const AutoFitOptions& options) {
-  if (options.fit.principal_point.kind != ParameterMode::Kind::kDefault ||
-      options.fit.known_intrinsics) {
-    return "Check the principal point given and the image size";
-  }
+  if (!PrincipalPointAssumed(options)) return "Check the principal point given and the image size";
   return "The principal point is assumed at the image's centre " +
          internal::PixelText(Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1)),
                              options.fit.pixel_origin) +
@@ -430,9 +434,7 @@ std::string PlanePrincipalPointAdvice(const ImageSize& size, const AutoFitOption
   const bool planar =
       screen.fit ? screen.fit->geometry.scene.planar
                  : internal::PrepareScene(points, pixels, size, options.fit.pixel_origin).scene.planar;
-  const bool assumed = planar &&
-                       options.fit.principal_point.kind == ParameterMode::Kind::kDefault &&
-                       !options.fit.known_intrinsics;
+  const bool assumed = planar && PrincipalPointAssumed(options);
   throw SceneError(search && !search->found ? SceneError::Reason::kContaminated
                                             : SceneError::Reason::kInconsistent,
                    text + (assumed ? ". The points are on a plane, which does not show the "

@@ -328,7 +328,7 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
                             " behind the fitted camera: the "
                             "correspondences are inconsistent (mismatched or mis-clicked "
                             "points)"),
-                     "Check them or use a robust loss");
+                     "Check the correspondences or use a robust loss");
   }
   result.rms_px = std::sqrt(sum_squares / n);
   // A fit not described is scored by its sum of squares: its median is read nowhere (the default

@@ -32,7 +32,8 @@ constexpr int kSecondStartBelowPoints = 20;
 
 // `other` replaces `*best` if it is a camera at a lower cost (by more than rounding).
 void KeepTheLower(LeastSquaresOutcome other, LeastSquaresOutcome* best) {
-  if (other.ok && (!best->ok || other.normal.cost < best->normal.cost * (1.0 - kLowerByRounding))) {
+  if (other.ok &&
+      (!best->ok || other.normal.cost < best->normal.cost * (1.0 - kLowerByRounding))) {
     *best = std::move(other);
   }
 }
@@ -214,7 +215,7 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
     throw SceneError(SceneError::Reason::kPointsBehindCamera,
                      "the refined camera has points behind it (or a negative focal length): "
                      "the correspondences are inconsistent (mismatched or mis-clicked points)",
-                     "Check them or use --ransac");
+                     "Check the correspondences or use --ransac");
   }
   if (!best.converged) {
     throw SceneError(SceneError::Reason::kDegenerate,
