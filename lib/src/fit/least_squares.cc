@@ -296,23 +296,26 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
                       std::sqrt(chart.cost / problem.NumPoints())});
   };
 
+  // The Gauss-Newton model's minimum at the current iterate, a sum of squares (twice
+  // cost - g^T (J^T J)^-1 g / 2); NaN where the solve is singular: J^T J is positive
+  // semi-definite, so a negative or non-finite decrease tells nothing.
+  auto gauss_newton_minimum_px2 = [&]() {
+    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
+    return decrease >= 0.0 && std::isfinite(decrease)
+               ? 2.0 * (cost - decrease)
+               : std::numeric_limits<double>::quiet_NaN();
+  };
   // Whether even the Gauss-Newton model's minimum at the current iterate is out of reach.
   auto out_of_reach = [&]() {
-    if (!std::isfinite(out_of_reach_px2)) return false;
-    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
-    // J^T J is positive semi-definite: a negative or non-finite decrease is a singular solve,
-    // which tells nothing.
-    return decrease >= 0.0 && std::isfinite(decrease) && 2.0 * (cost - decrease) > out_of_reach_px2;
+    return std::isfinite(out_of_reach_px2) && gauss_newton_minimum_px2() > out_of_reach_px2;
   };
   // Whether the current iterate (its unscaled normal equations `at`) is in the known minimum's
   // neighbourhood with no lower minimum in its Gauss-Newton model's reach.
   auto at_known_minimum = [&](const NormalEquations& at) {
     if (known == nullptr) return false;
     const ParamVector d = *u - known->u;
-    if (!(d.dot(at.jtj * d) <= known->radius_px2)) return false;
-    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
-    return decrease >= 0.0 && std::isfinite(decrease) &&
-           2.0 * (cost - decrease) >= known->cost * (1.0 - kLowerByRounding);
+    return d.dot(at.jtj * d) <= known->radius_px2 &&
+           gauss_newton_minimum_px2() >= known->cost * (1.0 - kLowerByRounding);
   };
 
   NormalEquations chart;
