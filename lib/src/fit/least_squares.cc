@@ -318,6 +318,18 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
            gauss_newton_minimum_px2() >= known->cost * (1.0 - kLowerByRounding);
   };
 
+  // The stopping rules read at every accepted iterate (`at`: its unscaled normal equations),
+  // in TinySolver's order, then the caller's two.
+  auto stop_at = [&](const NormalEquations& at) -> std::optional<LmStatus> {
+    if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
+      return LmStatus::kGradientTooSmall;
+    }
+    if (cost < cost_threshold) return LmStatus::kCostTooSmall;
+    if (out_of_reach()) return LmStatus::kTargetOutOfReach;
+    if (at_known_minimum(at)) return LmStatus::kAtKnownMinimum;
+    return std::nullopt;
+  };
+
   NormalEquations chart;
   // The summary with the last accepted local normal equations (every return below).
   auto finish = [&]() -> LmSummary {
@@ -328,20 +340,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   // A point behind the start: nothing to minimize (the polish refuses it too).
   if (!problem.Linearize(*u, &chart, trial_local)) return summary;
   accept(*u, chart);
-  if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
-    summary.status = LmStatus::kGradientTooSmall;
-    return finish();
-  }
-  if (cost < cost_threshold) {
-    summary.status = LmStatus::kCostTooSmall;
-    return finish();
-  }
-  if (out_of_reach()) {
-    summary.status = LmStatus::kTargetOutOfReach;
-    return finish();
-  }
-  if (at_known_minimum(chart)) {
-    summary.status = LmStatus::kAtKnownMinimum;
+  if (const std::optional<LmStatus> stop = stop_at(chart)) {
+    summary.status = *stop;
     return finish();
   }
   double damping = 1.0 / kInitialTrustRegionRadius;
@@ -397,20 +397,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
         summary.status = LmStatus::kCostChangeTooSmall;
         break;
       }
-      if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
-        summary.status = LmStatus::kGradientTooSmall;
-        break;
-      }
-      if (cost < cost_threshold) {
-        summary.status = LmStatus::kCostTooSmall;
-        break;
-      }
-      if (out_of_reach()) {
-        summary.status = LmStatus::kTargetOutOfReach;
-        break;
-      }
-      if (at_known_minimum(chart)) {
-        summary.status = LmStatus::kAtKnownMinimum;
+      if (const std::optional<LmStatus> stop = stop_at(chart)) {
+        summary.status = *stop;
         break;
       }
       const double t = 2.0 * rho - 1.0;
