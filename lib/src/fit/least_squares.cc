@@ -227,6 +227,63 @@ KnownOnChart OnChart(const KnownMinimum& known, const ChartProblem& problem) {
   return on;
 }
 
+// TinySolver's trust region, as the damping of J^T J's diagonal (Ceres 2.1, tiny_solver.h).
+class Damping {
+ public:
+  // jtj with its diagonal raised by the damping (each entry clamped first, as TinySolver does).
+  ParamMatrix Regularized(const ParamMatrix& jtj) const {
+    constexpr double kMinDiagonal = 1e-6;
+    constexpr double kMaxDiagonal = 1e32;
+    ParamMatrix regularized = jtj;
+    for (int i = 0; i < regularized.rows(); ++i) {
+      const double lm_diagonal =
+          std::sqrt(damping_ * std::min(std::max(jtj(i, i), kMinDiagonal), kMaxDiagonal));
+      regularized(i, i) += lm_diagonal * lm_diagonal;
+    }
+    return regularized;
+  }
+  // After a rejected step: the trust region shrinks, faster each time in a row.
+  void Reject() {
+    damping_ *= factor_;
+    factor_ *= 2.0;
+  }
+  // After an accepted step whose actual reduction was `rho` times the predicted one.
+  void Accept(double rho) {
+    const double t = 2.0 * rho - 1.0;
+    damping_ *= std::max(1.0 / 3.0, 1.0 - t * t * t);
+    factor_ = 2.0;
+  }
+
+ private:
+  static constexpr double kInitialTrustRegionRadius = 1e4;
+  double damping_ = 1.0 / kInitialTrustRegionRadius;
+  double factor_ = 2.0;
+};
+
+// Transtrum and Sethna's geodesic acceleration (2012, cited at
+// JacobianTransposeSecondDerivative) of the Jacobi-scaled LM step `*lm_step` at u (`*step` =
+// scaling * lm_step on the chart; `solver` factors the damped scaled J^T J): a = -(J^T J +
+// damping)^-1 J^T r''(v), taken as lm_step + a / 2 (both updated) when |a| <= kGeodesicAlpha
+// |lm_step| / 2. False where a is larger or not finite: the step is then to be rejected. Where
+// r'' cannot be formed (a point behind the camera along v), the step stays as it is.
+bool AddGeodesicAcceleration(const ChartProblem& problem, const ParamVector& u,
+                             const SymmetricSolver& solver, const ParamVector& scaling,
+                             ParamVector* lm_step, ParamVector* step) {
+  // Transtrum and Sethna's defaults: the finite-difference step along v and the largest
+  // acceptable |a| / |v| (times 2).
+  constexpr double kGeodesicStep = 0.1;
+  constexpr double kGeodesicAlpha = 0.75;
+  ParamVector second;
+  if (!problem.JacobianTransposeSecondDerivative(u, *step, kGeodesicStep, &second)) return true;
+  const ParamVector acceleration = -solver.Solve(scaling.asDiagonal() * second);
+  if (!acceleration.allFinite() || 2.0 * acceleration.norm() > kGeodesicAlpha * lm_step->norm()) {
+    return false;
+  }
+  *lm_step += 0.5 * acceleration;
+  *step = scaling.asDiagonal() * *lm_step;
+  return true;
+}
+
 // Levenberg-Marquardt exactly as ceres::TinySolver (Ceres 2.1) runs it -- Jacobi scaling fixed at
 // the start, the same damping and trust-region updates, stopping rules and defaults -- but on
 // normal equations accumulated point by point: TinySolver forms the 2N x p Jacobian and multiplies
@@ -236,11 +293,10 @@ KnownOnChart OnChart(const KnownMinimum& known, const ChartProblem& problem) {
 // that puts a point behind the camera is rejected and the damping raised (TinySolver ignores the
 // failed evaluation and compares stale residuals). Each accepted iterate is recorded in the trace.
 //
-// With `geodesic`, each step also gets Transtrum and Sethna's geodesic acceleration (2012, cited
-// at JacobianTransposeSecondDerivative): the second-order correction a = -(J^T J + damping)^-1
-// J^T r''(v) to the step v, taken as v + a / 2 when |a| <= kGeodesicAlpha |v| / 2 (else the
-// step is rejected and the damping raised). It follows a curved valley to second order where
-// plain LM steps leave it after a tiny fraction of its length (the cost rises across it).
+// With `geodesic`, each step also gets Transtrum and Sethna's geodesic acceleration
+// (AddGeodesicAcceleration; a step whose acceleration is too large is rejected). It follows a
+// curved valley to second order where plain LM steps leave it after a tiny fraction of its
+// length (the cost rises across it).
 //
 // With a finite `out_of_reach_px2`, LM also stops (kTargetOutOfReach) at an iterate where the
 // Gauss-Newton model's minimum, twice (cost - g^T (J^T J)^-1 g / 2), is above it.
@@ -252,15 +308,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
                                      Clock::time_point start_time, bool geodesic,
                                      double out_of_reach_px2, const KnownOnChart* known,
                                      ParamVector* u, std::vector<TraceEntry>* trace) {
-  // Transtrum and Sethna's defaults: the finite-difference step along v and the largest
-  // acceptable |a| / |v| (times 2).
-  constexpr double kGeodesicStep = 0.1;
-  constexpr double kGeodesicAlpha = 0.75;
-  // TinySolver's defaults where FitOptions has no say.
+  // TinySolver's default where FitOptions has no say.
   const double cost_threshold = std::numeric_limits<double>::epsilon();
-  constexpr double kInitialTrustRegionRadius = 1e4;
-  constexpr double kMinDiagonal = 1e-6;
-  constexpr double kMaxDiagonal = 1e32;
   const int max_iterations = std::max(1, options.max_iterations + 1);
 
   LmSummary summary;
@@ -344,16 +393,9 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
     summary.status = *stop;
     return finish();
   }
-  double damping = 1.0 / kInitialTrustRegionRadius;
-  double damping_factor = 2.0;
+  Damping damping;
   for (summary.iterations = 1; summary.iterations < max_iterations; ++summary.iterations) {
-    ParamMatrix regularized = jtj;
-    for (int i = 0; i < regularized.rows(); ++i) {
-      const double lm_diagonal =
-          std::sqrt(damping * std::min(std::max(jtj(i, i), kMinDiagonal), kMaxDiagonal));
-      regularized(i, i) += lm_diagonal * lm_diagonal;
-    }
-    const SymmetricSolver solver(regularized);
+    const SymmetricSolver solver(damping.Regularized(jtj));
     ParamVector lm_step = solver.Solve(gradient);
     ParamVector step = scaling.asDiagonal() * lm_step;
     // Adding parameter_tolerance to |u| keeps the test meaningful near u = 0.
@@ -361,28 +403,16 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       summary.status = LmStatus::kRelativeStepTooSmall;
       break;
     }
-    ParamVector velocity = lm_step;
-    if (geodesic) {
-      ParamVector second;
-      if (problem.JacobianTransposeSecondDerivative(*u, step, kGeodesicStep, &second)) {
-        const ParamVector acceleration = -solver.Solve(scaling.asDiagonal() * second);
-        if (!acceleration.allFinite() ||
-            2.0 * acceleration.norm() > kGeodesicAlpha * lm_step.norm()) {
-          damping *= damping_factor;
-          damping_factor *= 2.0;
-          continue;
-        }
-        velocity = lm_step;
-        lm_step += 0.5 * acceleration;
-        step = scaling.asDiagonal() * lm_step;
-      }
+    const ParamVector velocity = lm_step;
+    if (geodesic && !AddGeodesicAcceleration(problem, *u, solver, scaling, &lm_step, &step)) {
+      damping.Reject();
+      continue;
     }
     const ParamVector candidate = *u + step;
     if (!problem.Linearize(candidate, &chart, trial_local)) {
       // A point behind the camera: no cost to compare. Shrink the trust region as for a
       // rejected step.
-      damping *= damping_factor;
-      damping_factor *= 2.0;
+      damping.Reject();
       continue;
     }
     const double cost_change = 2.0 * cost - chart.cost;
@@ -401,16 +431,13 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
         summary.status = *stop;
         break;
       }
-      const double t = 2.0 * rho - 1.0;
-      damping *= std::max(1.0 / 3.0, 1.0 - t * t * t);
-      damping_factor = 2.0;
+      damping.Accept(rho);
     } else {
       if (std::abs(cost_change) < function_tolerance) {
         summary.status = LmStatus::kCostChangeTooSmall;
         break;
       }
-      damping *= damping_factor;
-      damping_factor *= 2.0;
+      damping.Reject();
     }
   }
   return finish();
