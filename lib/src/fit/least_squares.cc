@@ -284,6 +284,62 @@ bool AddGeodesicAcceleration(const ChartProblem& problem, const ParamVector& u,
   return true;
 }
 
+// An accepted iterate of LM in TinySolver's Jacobi-scaled variables: J_s = J D with
+// D = diag(1 / (1 + |column of J|)) at the start, jtj = J_s^T J_s, gradient = -J_s^T r;
+// cost = r^T r / 2.
+struct ScaledIterate {
+  ParamVector scaling;  // D's diagonal; empty until the first iterate sets it
+  ParamMatrix jtj;
+  ParamVector gradient;
+  double cost = 0.0;
+
+  // The iterate whose normal equations on the chart are `chart`.
+  void Set(const NormalEquations& chart) {
+    if (scaling.size() == 0) {
+      scaling = (1.0 + chart.jtj.diagonal().array().sqrt()).inverse().matrix();
+    }
+    jtj = scaling.asDiagonal() * chart.jtj * scaling.asDiagonal();
+    gradient = -(scaling.asDiagonal() * chart.jtr);
+    cost = chart.cost / 2.0;
+  }
+
+  // The Gauss-Newton model's minimum here, a sum of squares (twice cost - g^T (J^T J)^-1 g / 2);
+  // NaN where the solve is singular: J^T J is positive semi-definite, so a negative or
+  // non-finite decrease tells nothing.
+  double GaussNewtonMinimumPx2() const {
+    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
+    return decrease >= 0.0 && std::isfinite(decrease)
+               ? 2.0 * (cost - decrease)
+               : std::numeric_limits<double>::quiet_NaN();
+  }
+};
+
+// The stopping rules LM reads at every accepted iterate (`u`, `iterate`; `at`: its unscaled
+// normal equations), in TinySolver's order, then the caller's two (MinimizeLevenbergMarquardt):
+// even the Gauss-Newton model's minimum out of reach, or the iterate in the known minimum's
+// neighbourhood with no lower minimum in its Gauss-Newton model's reach.
+std::optional<LmStatus> StopAt(const ScaledIterate& iterate, const NormalEquations& at,
+                               const ParamVector& u, const FitOptions& options,
+                               double out_of_reach_px2, const KnownOnChart* known) {
+  // TinySolver's default where FitOptions has no say.
+  const double cost_threshold = std::numeric_limits<double>::epsilon();
+  if (iterate.gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
+    return LmStatus::kGradientTooSmall;
+  }
+  if (iterate.cost < cost_threshold) return LmStatus::kCostTooSmall;
+  if (std::isfinite(out_of_reach_px2) && iterate.GaussNewtonMinimumPx2() > out_of_reach_px2) {
+    return LmStatus::kTargetOutOfReach;
+  }
+  if (known != nullptr) {
+    const ParamVector d = u - known->u;
+    if (d.dot(at.jtj * d) <= known->radius_px2 &&
+        iterate.GaussNewtonMinimumPx2() >= known->cost * (1.0 - kLowerByRounding)) {
+      return LmStatus::kAtKnownMinimum;
+    }
+  }
+  return std::nullopt;
+}
+
 // Levenberg-Marquardt exactly as ceres::TinySolver (Ceres 2.1) runs it -- Jacobi scaling fixed at
 // the start, the same damping and trust-region updates, stopping rules and defaults -- but on
 // normal equations accumulated point by point: TinySolver forms the 2N x p Jacobian and multiplies
@@ -308,17 +364,10 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
                                      Clock::time_point start_time, bool geodesic,
                                      double out_of_reach_px2, const KnownOnChart* known,
                                      ParamVector* u, std::vector<TraceEntry>* trace) {
-  // TinySolver's default where FitOptions has no say.
-  const double cost_threshold = std::numeric_limits<double>::epsilon();
   const int max_iterations = std::max(1, options.max_iterations + 1);
 
   LmSummary summary;
-  // The Jacobi-scaled system at u: J_s = J D with D = diag(1 / (1 + |column of J|)) at the start,
-  // jtj = J_s^T J_s, gradient = -J_s^T r; cost = r^T r / 2.
-  ParamVector scaling;
-  ParamMatrix jtj;
-  ParamVector gradient;
-  double cost = 0.0;
+  ScaledIterate iterate;
   double function_tolerance = 0.0;
   // The local normal equations of the trial and of the last accepted iterate, by pointer: an
   // accepted trial's become the accepted ones without a copy (summary.local is set once, at the
@@ -330,53 +379,16 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   // local ones.
   auto accept = [&](const ParamVector& at, const NormalEquations& chart) {
     *u = at;
-    if (scaling.size() == 0) {
-      scaling = (1.0 + chart.jtj.diagonal().array().sqrt()).inverse().matrix();
+    if (iterate.scaling.size() == 0) {
       // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
       function_tolerance = options.function_tolerance * std::max(chart.cost, 1e-300);
     }
-    jtj = scaling.asDiagonal() * chart.jtj * scaling.asDiagonal();
-    gradient = -(scaling.asDiagonal() * chart.jtr);
-    cost = chart.cost / 2.0;
+    iterate.Set(chart);
     accepted_local = trial_local;
     trial_local = accepted_local == &locals[0] ? &locals[1] : &locals[0];
     summary.local_at_solution = true;
     trace->push_back({static_cast<int>(trace->size()), MicrosecondsSince(start_time),
                       std::sqrt(chart.cost / problem.NumPoints())});
-  };
-
-  // The Gauss-Newton model's minimum at the current iterate, a sum of squares (twice
-  // cost - g^T (J^T J)^-1 g / 2); NaN where the solve is singular: J^T J is positive
-  // semi-definite, so a negative or non-finite decrease tells nothing.
-  auto gauss_newton_minimum_px2 = [&]() {
-    const double decrease = 0.5 * gradient.dot(SymmetricSolver(jtj).Solve(gradient));
-    return decrease >= 0.0 && std::isfinite(decrease)
-               ? 2.0 * (cost - decrease)
-               : std::numeric_limits<double>::quiet_NaN();
-  };
-  // Whether even the Gauss-Newton model's minimum at the current iterate is out of reach.
-  auto out_of_reach = [&]() {
-    return std::isfinite(out_of_reach_px2) && gauss_newton_minimum_px2() > out_of_reach_px2;
-  };
-  // Whether the current iterate (its unscaled normal equations `at`) is in the known minimum's
-  // neighbourhood with no lower minimum in its Gauss-Newton model's reach.
-  auto at_known_minimum = [&](const NormalEquations& at) {
-    if (known == nullptr) return false;
-    const ParamVector d = *u - known->u;
-    return d.dot(at.jtj * d) <= known->radius_px2 &&
-           gauss_newton_minimum_px2() >= known->cost * (1.0 - kLowerByRounding);
-  };
-
-  // The stopping rules read at every accepted iterate (`at`: its unscaled normal equations),
-  // in TinySolver's order, then the caller's two.
-  auto stop_at = [&](const NormalEquations& at) -> std::optional<LmStatus> {
-    if (gradient.cwiseAbs().maxCoeff() < options.gradient_tolerance) {
-      return LmStatus::kGradientTooSmall;
-    }
-    if (cost < cost_threshold) return LmStatus::kCostTooSmall;
-    if (out_of_reach()) return LmStatus::kTargetOutOfReach;
-    if (at_known_minimum(at)) return LmStatus::kAtKnownMinimum;
-    return std::nullopt;
   };
 
   NormalEquations chart;
@@ -389,22 +401,24 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   // A point behind the start: nothing to minimize (the polish refuses it too).
   if (!problem.Linearize(*u, &chart, trial_local)) return summary;
   accept(*u, chart);
-  if (const std::optional<LmStatus> stop = stop_at(chart)) {
+  if (const std::optional<LmStatus> stop =
+          StopAt(iterate, chart, *u, options, out_of_reach_px2, known)) {
     summary.status = *stop;
     return finish();
   }
   Damping damping;
   for (summary.iterations = 1; summary.iterations < max_iterations; ++summary.iterations) {
-    const SymmetricSolver solver(damping.Regularized(jtj));
-    ParamVector lm_step = solver.Solve(gradient);
-    ParamVector step = scaling.asDiagonal() * lm_step;
+    const SymmetricSolver solver(damping.Regularized(iterate.jtj));
+    ParamVector lm_step = solver.Solve(iterate.gradient);
+    ParamVector step = iterate.scaling.asDiagonal() * lm_step;
     // Adding parameter_tolerance to |u| keeps the test meaningful near u = 0.
     if (step.norm() < options.parameter_tolerance * (u->norm() + options.parameter_tolerance)) {
       summary.status = LmStatus::kRelativeStepTooSmall;
       break;
     }
     const ParamVector velocity = lm_step;
-    if (geodesic && !AddGeodesicAcceleration(problem, *u, solver, scaling, &lm_step, &step)) {
+    if (geodesic &&
+        !AddGeodesicAcceleration(problem, *u, solver, iterate.scaling, &lm_step, &step)) {
       damping.Reject();
       continue;
     }
@@ -415,10 +429,11 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
       damping.Reject();
       continue;
     }
-    const double cost_change = 2.0 * cost - chart.cost;
+    const double cost_change = 2.0 * iterate.cost - chart.cost;
     // With the acceleration, the reduction the linear model predicts for the velocity (the
     // acceleration's own is second order, which the linear model does not see).
-    const double model_cost_change = velocity.dot(2.0 * gradient - jtj * velocity);
+    const double model_cost_change =
+        velocity.dot(2.0 * iterate.gradient - iterate.jtj * velocity);
     // rho: the actual reduction over the reduction the linear model predicts.
     const double rho = cost_change / model_cost_change;
     if (rho > 0.0) {
@@ -427,7 +442,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
         summary.status = LmStatus::kCostChangeTooSmall;
         break;
       }
-      if (const std::optional<LmStatus> stop = stop_at(chart)) {
+      if (const std::optional<LmStatus> stop =
+              StopAt(iterate, chart, *u, options, out_of_reach_px2, known)) {
         summary.status = *stop;
         break;
       }
