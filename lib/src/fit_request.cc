@@ -91,17 +91,10 @@ double LossScale(const std::string& text) {
   return value;
 }
 
-}  // namespace
-
-FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
-  size.Check();
-  FitRequest request;
-  // Every fit runs the default path (outlier stage, consistency gate), a forced model as a
-  // ladder of one; only a robust loss, which the selection cannot compare, runs FitCamera alone.
-  request.automatic = args.loss == "none";
-  const bool forced = args.model != "auto";
-  FitOptions& options = request.auto_options.fit;
-  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+// --model: the listed intrinsics free, the rest at their defaults (fixed there, so that the
+// automatic path does not free them); "auto" leaves options as they are.
+void SetModel(const FitArguments& args, const ImageSize& size, FitOptions* options_out) {
+  FitOptions& options = *options_out;
   const std::string orthographic = "orthographic";
   if (args.model.rfind(orthographic, 0) == 0) {
     // "orthographic[+aspect][+skew]": the scale (focal) is always free.
@@ -132,16 +125,20 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
     }
     for (const std::string& name : ModelNames(args.model)) *ModeOf(options, name) = ParameterMode::Free();
   }
-  if (args.criterion != "aic" && args.criterion != "bic") {
-    throw std::invalid_argument("--criterion: expected aic or bic, got \"" + args.criterion + "\"");
-  }
-  request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
+}
+
+// --free, --fix and the intrinsics' values (--focal, --fovy, --aspect, --principal-point, --skew,
+// --k1, --k2, --intrinsics) over the model's modes. `automatic`: the default path (a --fix then
+// fixes at the default value, as the ladder would).
+void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool automatic,
+                        FitOptions* options_out) {
+  FitOptions& options = *options_out;
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {
     if (name == "focal") {
       throw std::invalid_argument("--fix focal needs a value: use --focal PX or --fovy DEG");
     }
-    *ModeOf(options, name) = request.automatic ? DefaultValueOf(name, size, options.pixel_origin)
+    *ModeOf(options, name) = automatic ? DefaultValueOf(name, size, options.pixel_origin)
                                                : ParameterMode::Default();
   }
   if (args.aspect > 0.0) options.aspect = ParameterMode::Fixed(args.aspect);
@@ -166,6 +163,11 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
     options.known_intrinsics =
         ConvertPixelOrigin(*args.known_intrinsics, PixelOrigin::kCenter, options.pixel_origin);
   }
+}
+
+// The refinement: --loss, --refiner, --ransac, --sigma, --near, --far.
+void SetSolver(const FitArguments& args, FitOptions* options_out) {
+  FitOptions& options = *options_out;
   if (args.loss != "none") {
     const size_t colon = args.loss.find(':');
     const std::string kind = args.loss.substr(0, colon);
@@ -187,6 +189,10 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
   if (args.sigma > 0.0) options.pixel_sigma = args.sigma;
   if (args.z_near > 0.0) options.z_near = args.z_near;
   if (args.z_far > 0.0) options.z_far = args.z_far;
+}
+
+// --bounds or --bounds-mesh (the box near and far cover) and --origin.
+void SetRegionAndOrigin(const FitArguments& args, const FitOptions& options, FitRequest* request) {
   if (args.bounds_in_world && !args.mesh_vertices_in_world.empty()) {
     throw std::invalid_argument("give --bounds or --bounds-mesh, not both");
   }
@@ -203,7 +209,7 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
       throw std::invalid_argument(std::string(option) +
                                   " sets near and far: give it or both --near and --far, not all three");
     }
-    request.bounds_in_world = box;
+    request->bounds_in_world = box;
   }
   if (args.world_origin && args.auto_world_origin) {
     throw std::invalid_argument("--origin: give auto or X,Y,Z, not both");
@@ -214,8 +220,29 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
                         "--origin: coordinates must be finite, got ", (*args.world_origin)[axis]);
     }
   }
-  request.world_origin = args.world_origin;
-  request.auto_world_origin = args.auto_world_origin;
+  request->world_origin = args.world_origin;
+  request->auto_world_origin = args.auto_world_origin;
+}
+
+}  // namespace
+
+FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
+  size.Check();
+  FitRequest request;
+  // Every fit runs the default path (outlier stage, consistency gate), a forced model as a
+  // ladder of one; only a robust loss, which the selection cannot compare, runs FitCamera alone.
+  request.automatic = args.loss == "none";
+  const bool forced = args.model != "auto";
+  FitOptions& options = request.auto_options.fit;
+  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+  SetModel(args, size, &options);
+  if (args.criterion != "aic" && args.criterion != "bic") {
+    throw std::invalid_argument("--criterion: expected aic or bic, got \"" + args.criterion + "\"");
+  }
+  request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
+  SetIntrinsicValues(args, size, request.automatic, &options);
+  SetSolver(args, &options);
+  SetRegionAndOrigin(args, options, &request);
   options.max_iterations = args.max_iterations;
   if (!forced && options.loss != LossType::kNone) {
     throw std::invalid_argument(
