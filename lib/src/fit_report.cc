@@ -84,8 +84,28 @@ std::string LinearityText(const LinearityCheck& check) {
                             "intrinsics make them hold";
 }
 
-std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {
-  std::ostringstream out;
+namespace {
+
+// A point's id, or its 1-based row where the file has none.
+std::string PointName(const std::vector<std::string>& ids, int i) {
+  return i < static_cast<int>(ids.size()) ? ids[i] : std::to_string(i + 1);
+}
+
+// The points used (outliers are listed apart), the largest residual first.
+std::vector<int> WorstFirst(const FitResult& fit) {
+  const int n = static_cast<int>(fit.residuals_px.size());
+  std::vector<int> order;
+  for (int i = 0; i < n; ++i) {
+    if (!std::binary_search(fit.outliers.begin(), fit.outliers.end(), i)) order.push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return fit.residuals_px[a].norm() > fit.residuals_px[b].norm();
+  });
+  return order;
+}
+
+// The model, the models tried and the fixed intrinsics.
+void WriteModel(const FitResult& fit, std::ostream& out) {
   const int n = static_cast<int>(fit.residuals_px.size());
   out << "model: " << fit.model << ", " << fit.free_parameters.size()
       << " free parameters (pose";
@@ -109,6 +129,10 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   for (const FixedParameter& p : fit.fixed_parameters) {
     out << "  fixed " << p.name << " = " << p.value << " (" << p.why << ")\n";
   }
+}
+
+// The parameters' sigmas and strong correlations.
+void WriteUncertainty(const FitResult& fit, std::ostream& out) {
   if (fit.covariance_available) {
     std::string source = fit.pixel_sigma_estimated ? "estimated from the residuals" : "given";
     if (fit.consistency.checked && fit.pixel_sigma_estimated) {
@@ -133,6 +157,10 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   } else {
     out << "parameters: no uncertainty (as many equations as unknowns and no --sigma given)\n";
   }
+}
+
+// The camera: intrinsics, look-at, the GL view (ortho, perspective or frustum), near and far.
+void WriteCamera(const FitResult& fit, std::ostream& out) {
   const Intrinsics& k = fit.camera.intrinsics;
   out << "intrinsics: fx " << Format("%.6g", k.fx) << " fy " << Format("%.6g", k.fy) << " cx "
       << Format("%.6g", k.cx) << " cy " << Format("%.6g", k.cy);
@@ -164,26 +192,20 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
   }
   out << "near " << Format("%.6g", fit.camera.z_near) << ", far " << Format("%.6g", fit.camera.z_far)
       << " (GL depth range)\n";
+}
+
+// The residuals and the points left out.
+void WriteResiduals(const FitResult& fit, const std::vector<std::string>& ids, std::ostream& out) {
+  const int n = static_cast<int>(fit.residuals_px.size());
   out << "residuals: rms " << Format("%.3f", fit.rms_px) << " px, median "
       << Format("%.3f", fit.median_px) << " px, max " << Format("%.3f", fit.max_px) << " px\n";
-  // The worst among the points used (outliers are listed above).
-  std::vector<int> order;
-  for (int i = 0; i < n; ++i) {
-    if (!std::binary_search(fit.outliers.begin(), fit.outliers.end(), i)) order.push_back(i);
-  }
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return fit.residuals_px[a].norm() > fit.residuals_px[b].norm();
-  });
-  auto name = [&](int i) {
-    return i < static_cast<int>(ids.size()) ? ids[i] : std::to_string(i + 1);
-  };
   if (!fit.left_out.empty()) {
     out << "left out of the fit (found by " << fit.outlier_method << "): " << fit.left_out.size()
         << " of " << n << " points\n";
     constexpr size_t kListed = 20;
     for (size_t j = 0; j < std::min(kListed, fit.left_out.size()); ++j) {
       const LeftOutPoint& p = fit.left_out[j];
-      out << "  " << name(p.index) << " is "
+      out << "  " << PointName(ids, p.index) << " is "
           << (std::isfinite(p.residual_px)
                   ? Format("%.3g", p.residual_px) + " px from where the camera puts it"
                   : std::string("behind the camera (it has no pixel there)"));
@@ -200,17 +222,28 @@ std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>&
     }
   } else if (!fit.outliers.empty()) {
     out << "outliers (RANSAC, left out of the fit): " << fit.outliers.size() << ":";
-    for (const int i : fit.outliers) out << " " << name(i);
+    for (const int i : fit.outliers) out << " " << PointName(ids, i);
     out << "\n";
   }
+}
+
+}  // namespace
+
+std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids, int worst) {
+  std::ostringstream out;
+  WriteModel(fit, out);
+  WriteUncertainty(fit, out);
+  WriteCamera(fit, out);
+  WriteResiduals(fit, ids, out);
   if (fit.consistency.checked) out << "check: " << fit.consistency.summary << "\n";
   if (fit.determination.checked) out << "determination: " << fit.determination.summary << "\n";
   if (fit.reliability.checked) out << "reliability: " << fit.reliability.summary << "\n";
   if (fit.linearity.checked) out << "linearity: " << LinearityText(fit.linearity) << "\n";
   out << "worst points:";
+  const std::vector<int> order = WorstFirst(fit);
   for (int i = 0; i < std::min(worst, static_cast<int>(order.size())); ++i) {
     const int index = order[i];
-    out << " " << (index < static_cast<int>(ids.size()) ? ids[index] : std::to_string(index + 1))
+    out << " " << PointName(ids, index)
         << " (" << Format("%.2f", fit.residuals_px[index].norm()) << " px)";
   }
   out << "\n";
