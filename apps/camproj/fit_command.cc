@@ -306,6 +306,178 @@ int FitBatch(const std::vector<std::string>& inputs, const ImageSize& size,
   return exit_code;
 }
 
+// The options naming the inputs and outputs.
+void AddInputOutputOptions(CLI::App* app, FitArgs* args) {
+  app->add_option("POINTS", args->points_paths,
+                  "correspondences CSV; several files or a folder of *.csv fit them all in "
+                  "parallel (-o names the output folder)")->required();
+  app->add_option("--jobs", args->jobs, "parallel fits in batch mode (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--image-size", args->image_size, "image size WIDTHxHEIGHT in pixels")->required();
+  app->add_option("-o,--output", args->output_path, "write the camera file here");
+  app->add_flag("--json", args->json,
+                "print the camera file to stdout instead of the summary; in batch mode one JSON "
+                "object per input and line (file, status, exit_code, detail, camera_file)");
+  app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
+  app->add_option("--report", args->report_path,
+                  "also write plots of the fit, drawn by camproj: .svg (residual per point, "
+                  "residuals over the image, the models tried with their criterion) or .html "
+                  "(the same with the summary)");
+}
+
+// The camera model: which intrinsics are free, or their values.
+void AddModelOptions(CLI::App* app, FitArgs* args) {
+  app->add_option("--model", args->fit.model,
+                  "auto (default): the simplest model the data support; or the free intrinsics "
+                  "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
+                  "pose: none (with --intrinsics or fixed values); orthographic[+aspect][+skew]: "
+                  "a parallel projection (scale in px per world unit)");
+  app->add_option("--criterion", args->fit.criterion,
+                  "model selection criterion: bic (default) or aic")
+      ->check(CLI::IsMember({"aic", "bic"}));
+  app->add_option("--free", args->fit.free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
+      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
+  app->add_option("--fix", args->fit.fix, "hold these at their defaults (aspect 1, principal point at "
+                                      "the image centre, skew 0, k 0)")
+      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
+  app->add_option("--focal", args->fit.focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
+  app->add_option("--fovy", args->fit.fovy_deg, "fix the focal length by the vertical field of view (degrees)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--aspect", args->fit.aspect, "fix fy/fx")->check(CLI::PositiveNumber);
+  app->add_option("--principal-point", args->principal_point, "fix cx,cy (px)");
+  app->add_option("--skew", args->fit.skew, "fix the skew (px)");
+  app->add_option("--k1", args->fit.k1, "fix k1");
+  app->add_option("--k2", args->fit.k2, "fix k2");
+  app->add_option("--intrinsics,--shared-intrinsics", args->intrinsics_path,
+                  "known intrinsics (a camera file, a calibration from `camproj calibrate`, or "
+                  "{\"intrinsics\": {...}}): fit the pose only");
+  app->add_option("--pixel-origin", args->fit.pixel_origin,
+                  "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
+                  "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
+}
+
+// The refinement, the outlier stage and the checks an answer must pass.
+void AddRefinementOptions(CLI::App* app, FitArgs* args) {
+  app->add_option("--loss", args->fit.loss, "none, huber:SCALE or cauchy:SCALE (px)");
+  app->add_option("--refiner", args->fit.refiner,
+                  "least-squares engine: lm (the project's own Levenberg-Marquardt, default) or "
+                  "ceres (ceres::Solver on the same residuals); either ends with the same "
+                  "Gauss-Newton polish, at the same optimum");
+  app->add_option("--ransac", args->fit.ransac_px,
+                  "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
+                  "instead of the automatic outlier stage; they are left out and listed")
+      ->check(CLI::PositiveNumber);
+  app->add_flag("--keep-all", args->fit.keep_all,
+                "keep every point: no automatic outlier stage (a scene with mis-clicks is then "
+                "refused by the consistency check, naming the worst points)");
+  app->add_option("--sigma", args->fit.sigma,
+                  "pixel noise per axis (px): the model selection, the consistency check and the "
+                  "uncertainties use it; default: a 1 px prior for clicked points, combined with "
+                  "the residuals")->check(CLI::PositiveNumber);
+  app->add_option("--max-uncertainty", args->fit.max_uncertainty,
+                  "refuse a camera the points determine more loosely than this (px, 1 sigma over "
+                  "the box the points span; default 5)")->check(CLI::PositiveNumber);
+  app->add_option("--object-points", args->object_points_path,
+                  "CSV with X,Y,Z of the object's other points (e.g. the model's vertices): the "
+                  "camera must be determined to --max-uncertainty there too, where they are in "
+                  "the image (u,v columns are ignored)");
+}
+
+// The GL view: near, far, world origin; and the iteration budget.
+void AddViewOptions(CLI::App* app, FitArgs* args) {
+  app->add_option("--near", args->fit.z_near, "near plane of the GL matrices (default: tight)")
+      ->check(CLI::PositiveNumber);
+  app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
+  app->add_option("--bounds", args->bounds,
+                  "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
+                  "its 8 corners' depths + 10 %) instead of the fitted points only");
+  app->add_option("--bounds-mesh", args->bounds_mesh_path,
+                  "an OBJ or PLY file of the model: near and far cover its vertices' bounding "
+                  "box, as --bounds, and the camera is judged at its vertices, as "
+                  "--object-points (unless given)");
+  app->add_option("--origin", args->origin,
+                  "auto or X,Y,Z: record a world origin in the camera file, so that GL exports' "
+                  "view matrix takes vertices relative to it (float32 precision for large, e.g. "
+                  "UTM, coordinates; docs/exports.md); auto: the fitted points' centroid rounded "
+                  "to a power of ten of their extent");
+  app->add_option("--max-iterations", args->fit.max_iterations, "refinement iterations")
+      ->check(CLI::NonNegativeNumber);
+}
+
+// The notes after the summary: near and far, the region judged, the world origin or float32.
+void PrintNotes(const FitRequest& request, const FitResult& fit) {
+  std::cout << "note: " << NearFarNote(request, fit);
+  if (const std::string judged = JudgedRegionNote(request, fit); !judged.empty()) {
+    std::cout << "note: " << judged;
+  }
+  if (fit.camera.world_origin) {
+    const Eigen::Vector3d& o = *fit.camera.world_origin;
+    std::ostringstream line;
+    line << std::setprecision(17) << "note: world origin " << o.x() << ',' << o.y() << ','
+         << o.z()
+         << (request.auto_world_origin ? " (--origin auto: the fitted points' centroid, rounded)"
+                                       : " (--origin)")
+         << ": GL exports' view matrix takes point_in_world minus it\n";
+    std::cout << line.str();
+  } else if (const double error = Float32PixelError(fit.camera, std::nullopt, fit.camera.z_near);
+             error > kFloat32ErrorWarningPx) {
+    std::printf("note: the world coordinates are too large for float32: GL exports would draw "
+                "points ~%.2g px off at the near plane; fit with --origin auto (docs/exports.md)\n",
+                error);
+  }
+}
+
+// One points file: fits it, writes the camera file and the report asked for, prints the summary
+// (or the camera file with --json) and the trace.
+int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest& request,
+               const FitArgs& args) {
+  const auto begin = std::chrono::steady_clock::now();
+  if (!args.output_path.empty()) {
+    RequireOutputIsNotAnInput(args.output_path, {input, args.intrinsics_path,
+                                                 args.object_points_path, args.bounds_mesh_path});
+  }
+  if (!args.report_path.empty()) {
+    try {
+      FitReportFormatOfPath(args.report_path);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--report: ") + e.what());
+    }
+    RequireOutputIsNotAnInput(args.report_path,
+                              {input, args.intrinsics_path, args.object_points_path,
+                               args.bounds_mesh_path, args.output_path});
+  }
+  const auto [data, fit] = FitFile(input, size, request);
+  const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
+  if (!args.output_path.empty()) WriteFileAtomically(args.output_path, text);
+  if (!args.report_path.empty()) {
+    std::vector<Eigen::Vector2d> observed = data.pixels;
+    for (auto& p : observed) {
+      p = ConvertPixelOrigin(p, request.options().pixel_origin, PixelOrigin::kCenter);
+    }
+    WriteFileAtomically(
+        args.report_path,
+        FitReportFormatOfPath(args.report_path) == "svg"
+            ? FitReportSvg(fit, observed, data.ids)
+            : FitReportHtml(fit, observed, data.ids, FitSummaryText(fit, data.ids),
+                            "camproj fit " + input));
+  }
+  if (args.json) {
+    std::cout << text;
+  } else {
+    std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
+    PrintNotes(request, fit);
+    if (!args.output_path.empty()) std::cout << "wrote " << TerminalSafe(args.output_path) << "\n";
+    // The summary's time is the fit's; reading and writing the files add to it.
+    const double wall_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin)
+            .count();
+    std::printf("wall time: %.3f ms (reading %zu points, fitting, writing)\n", wall_ms,
+                data.pixels.size());
+  }
+  if (args.trace) std::cout << FitTraceText(fit);
+  return kExitOk;
+}
+
 }  // namespace
 
 Command AddFitCommand(CLI::App& root) {
@@ -337,89 +509,10 @@ Command AddFitCommand(CLI::App& root) {
       "  camproj fit points.csv --image-size 1920x1080 --model focal+aspect+principal-point --loss huber:2\n"
       "  camproj fit points.csv --image-size 1920x1080 --intrinsics known.json\n"
       "  camproj fit clicks.csv --image-size 1920x1080 --object-points model_vertices.csv");
-  app->add_option("POINTS", args->points_paths,
-                  "correspondences CSV; several files or a folder of *.csv fit them all in "
-                  "parallel (-o names the output folder)")->required();
-  app->add_option("--jobs", args->jobs, "parallel fits in batch mode (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  app->add_option("--image-size", args->image_size, "image size WIDTHxHEIGHT in pixels")->required();
-  app->add_option("-o,--output", args->output_path, "write the camera file here");
-  app->add_flag("--json", args->json,
-                "print the camera file to stdout instead of the summary; in batch mode one JSON "
-                "object per input and line (file, status, exit_code, detail, camera_file)");
-  app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
-  app->add_option("--report", args->report_path,
-                  "also write plots of the fit, drawn by camproj: .svg (residual per point, "
-                  "residuals over the image, the models tried with their criterion) or .html "
-                  "(the same with the summary)");
-  app->add_option("--model", args->fit.model,
-                  "auto (default): the simplest model the data support; or the free intrinsics "
-                  "joined by '+', e.g. focal+principal-point, focal+aspect+principal-point+k1; "
-                  "pose: none (with --intrinsics or fixed values); orthographic[+aspect][+skew]: "
-                  "a parallel projection (scale in px per world unit)");
-  app->add_option("--criterion", args->fit.criterion,
-                  "model selection criterion: bic (default) or aic")
-      ->check(CLI::IsMember({"aic", "bic"}));
-  app->add_option("--free", args->fit.free, "estimate these: focal,aspect,principal-point,skew,k1,k2")
-      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
-  app->add_option("--fix", args->fit.fix, "hold these at their defaults (aspect 1, principal point at "
-                                      "the image centre, skew 0, k 0)")
-      ->delimiter(',')->check(CLI::IsMember(kParameterNames));
-  app->add_option("--focal", args->fit.focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
-  app->add_option("--fovy", args->fit.fovy_deg, "fix the focal length by the vertical field of view (degrees)")
-      ->check(CLI::PositiveNumber);
-  app->add_option("--aspect", args->fit.aspect, "fix fy/fx")->check(CLI::PositiveNumber);
-  app->add_option("--principal-point", args->principal_point, "fix cx,cy (px)");
-  app->add_option("--skew", args->fit.skew, "fix the skew (px)");
-  app->add_option("--k1", args->fit.k1, "fix k1");
-  app->add_option("--k2", args->fit.k2, "fix k2");
-  app->add_option("--intrinsics,--shared-intrinsics", args->intrinsics_path,
-                  "known intrinsics (a camera file, a calibration from `camproj calibrate`, or "
-                  "{\"intrinsics\": {...}}): fit the pose only");
-  app->add_option("--pixel-origin", args->fit.pixel_origin,
-                  "center: (0,0) is the centre of the top-left pixel (OpenCV); corner: its corner "
-                  "(COLMAP)")->check(CLI::IsMember({"center", "corner"}));
-  app->add_option("--loss", args->fit.loss, "none, huber:SCALE or cauchy:SCALE (px)");
-  app->add_option("--refiner", args->fit.refiner,
-                  "least-squares engine: lm (the project's own Levenberg-Marquardt, default) or "
-                  "ceres (ceres::Solver on the same residuals); either ends with the same "
-                  "Gauss-Newton polish, at the same optimum");
-  app->add_option("--ransac", args->fit.ransac_px,
-                  "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
-                  "instead of the automatic outlier stage; they are left out and listed")
-      ->check(CLI::PositiveNumber);
-  app->add_flag("--keep-all", args->fit.keep_all,
-                "keep every point: no automatic outlier stage (a scene with mis-clicks is then "
-                "refused by the consistency check, naming the worst points)");
-  app->add_option("--sigma", args->fit.sigma,
-                  "pixel noise per axis (px): the model selection, the consistency check and the "
-                  "uncertainties use it; default: a 1 px prior for clicked points, combined with "
-                  "the residuals")->check(CLI::PositiveNumber);
-  app->add_option("--max-uncertainty", args->fit.max_uncertainty,
-                  "refuse a camera the points determine more loosely than this (px, 1 sigma over "
-                  "the box the points span; default 5)")->check(CLI::PositiveNumber);
-  app->add_option("--object-points", args->object_points_path,
-                  "CSV with X,Y,Z of the object's other points (e.g. the model's vertices): the "
-                  "camera must be determined to --max-uncertainty there too, where they are in "
-                  "the image (u,v columns are ignored)");
-  app->add_option("--near", args->fit.z_near, "near plane of the GL matrices (default: tight)")
-      ->check(CLI::PositiveNumber);
-  app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
-  app->add_option("--bounds", args->bounds,
-                  "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
-                  "its 8 corners' depths + 10 %) instead of the fitted points only");
-  app->add_option("--bounds-mesh", args->bounds_mesh_path,
-                  "an OBJ or PLY file of the model: near and far cover its vertices' bounding "
-                  "box, as --bounds, and the camera is judged at its vertices, as "
-                  "--object-points (unless given)");
-  app->add_option("--origin", args->origin,
-                  "auto or X,Y,Z: record a world origin in the camera file, so that GL exports' "
-                  "view matrix takes vertices relative to it (float32 precision for large, e.g. "
-                  "UTM, coordinates; docs/exports.md); auto: the fitted points' centroid rounded "
-                  "to a power of ten of their extent");
-  app->add_option("--max-iterations", args->fit.max_iterations, "refinement iterations")
-      ->check(CLI::NonNegativeNumber);
-
+  AddInputOutputOptions(app, args.get());
+  AddModelOptions(app, args.get());
+  AddRefinementOptions(app, args.get());
+  AddViewOptions(app, args.get());
   return {app, [args]() {
             const ImageSize size = ParseImageSize(args->image_size, "--image-size");
             const FitRequest request = RequestFrom(*args, size);
@@ -431,73 +524,7 @@ Command AddFitCommand(CLI::App& root) {
               }
               return FitBatch(inputs, size, request, *args);
             }
-            const auto begin = std::chrono::steady_clock::now();
-            if (!args->output_path.empty()) {
-              RequireOutputIsNotAnInput(args->output_path,
-                                        {inputs.front(), args->intrinsics_path,
-                                         args->object_points_path, args->bounds_mesh_path});
-            }
-            if (!args->report_path.empty()) {
-              try {
-                FitReportFormatOfPath(args->report_path);
-              } catch (const std::invalid_argument& e) {
-                throw UsageError(std::string("--report: ") + e.what());
-              }
-              RequireOutputIsNotAnInput(args->report_path,
-                                        {inputs.front(), args->intrinsics_path,
-                                         args->object_points_path, args->bounds_mesh_path,
-                                         args->output_path});
-            }
-            const auto [data, fit] = FitFile(inputs.front(), size, request);
-            const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
-            if (!args->output_path.empty()) WriteFileAtomically(args->output_path, text);
-            if (!args->report_path.empty()) {
-              std::vector<Eigen::Vector2d> observed = data.pixels;
-              for (auto& p : observed) {
-                p = ConvertPixelOrigin(p, request.options().pixel_origin, PixelOrigin::kCenter);
-              }
-              WriteFileAtomically(
-                  args->report_path,
-                  FitReportFormatOfPath(args->report_path) == "svg"
-                      ? FitReportSvg(fit, observed, data.ids)
-                      : FitReportHtml(fit, observed, data.ids, FitSummaryText(fit, data.ids),
-                                      "camproj fit " + inputs.front()));
-            }
-            if (args->json) {
-              std::cout << text;
-            } else {
-              std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
-              std::cout << "note: " << NearFarNote(request, fit);
-              if (const std::string judged = JudgedRegionNote(request, fit); !judged.empty()) {
-                std::cout << "note: " << judged;
-              }
-              if (fit.camera.world_origin) {
-                const Eigen::Vector3d& o = *fit.camera.world_origin;
-                std::ostringstream line;
-                line << std::setprecision(17) << "note: world origin " << o.x() << ',' << o.y()
-                     << ',' << o.z()
-                     << (request.auto_world_origin ? " (--origin auto: the fitted points' "
-                                                     "centroid, rounded)"
-                                                   : " (--origin)")
-                     << ": GL exports' view matrix takes point_in_world minus it\n";
-                std::cout << line.str();
-              } else if (const double error = Float32PixelError(fit.camera, std::nullopt,
-                                                                fit.camera.z_near);
-                         error > kFloat32ErrorWarningPx) {
-                std::printf("note: the world coordinates are too large for float32: GL exports "
-                            "would draw points ~%.2g px off at the near plane; fit with --origin "
-                            "auto (docs/exports.md)\n",
-                            error);
-              }
-              if (!args->output_path.empty()) std::cout << "wrote " << TerminalSafe(args->output_path) << "\n";
-              // The summary's time is the fit's; reading and writing the files add to it.
-              const double wall_ms = std::chrono::duration<double, std::milli>(
-                                         std::chrono::steady_clock::now() - begin).count();
-              std::printf("wall time: %.3f ms (reading %zu points, fitting, writing)\n", wall_ms,
-                          data.pixels.size());
-            }
-            if (args->trace) std::cout << FitTraceText(fit);
-            return kExitOk;
+            return FitOneFile(inputs.front(), size, request, *args);
           }};
 }
 
