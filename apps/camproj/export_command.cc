@@ -47,6 +47,197 @@ std::string ExtensionOf(const std::string& path) {
   return extension;
 }
 
+// The camera to export: read (a camera file, or one view of a calibration) with --near, --far,
+// --infinite-far and --origin applied.
+Camera CameraToExport(const ExportArgs& args) {
+  Camera camera = args.view.empty() ? ReadCameraFile(args.camera_path)
+                                     : ReadCalibrationView(args.camera_path, args.view);
+  if (args.z_near > 0.0) camera.z_near = args.z_near;
+  if (args.z_far > 0.0) camera.z_far = args.z_far;
+  if (args.infinite_far) {
+    if (args.z_far > 0.0) throw UsageError("give --far or --infinite-far, not both");
+    camera.z_far = kInfinity;
+  }
+  if (!(camera.z_far > camera.z_near)) {
+    throw UsageError("far must be greater than near");
+  }
+  if (args.origin == "none") {
+    camera.world_origin.reset();
+  } else if (args.origin == "auto") {
+    camera.world_origin = AutoOriginOfCamera(camera);
+  } else if (!args.origin.empty()) {
+    const std::vector<double> o =
+        ParseNumbers(args.origin, 3, "--origin (auto, none or X,Y,Z)");
+    camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
+    bool finite = false;
+    try {
+      finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
+    } catch (const std::invalid_argument&) {
+    }
+    if (!finite) {
+      throw UsageError("--origin: " + args.origin +
+                       " is too far from the camera: the view matrix relative to it "
+                       "overflows a double");
+    }
+  }
+  return camera;
+}
+
+// An stmap's output must be an image file; no output may be the input.
+void CheckOutput(const ExportArgs& args, bool stmap) {
+  if (stmap) {
+    if (args.output_path.empty()) {
+      throw UsageError("--to " + args.to + " writes an image file: give -o MAP.tif, "
+                       "MAP.tiff or MAP.exr");
+    }
+    const std::string extension = ExtensionOf(args.output_path);
+    if (extension != ".tif" && extension != ".tiff" && extension != ".exr") {
+      throw UsageError("--to " + args.to + ": the output " + args.output_path +
+                       " must end in .tif, .tiff or .exr (32-bit float RGBA)");
+    }
+  }
+  if (!args.output_path.empty()) {
+    RequireOutputIsNotAnInput(args.output_path, {args.camera_path});
+  }
+}
+
+// --to stmap or undistort-stmap: the map to -o, the render target's size and matrices to stdout.
+void ExportStMap(const Camera& camera, const ExportArgs& args, const ExportOptions& options) {
+  const LensMapDirection direction = args.to == "stmap"
+                                         ? LensMapDirection::kDistort
+                                         : LensMapDirection::kUndistort;
+  std::string text;
+  std::string bytes;
+  try {
+    text = LensRenderTargetText(camera, direction, options.depth);
+    bytes = EncodeStMap(LensStMap(camera, direction), ExtensionOf(args.output_path));
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.camera_path + ": cannot export as " + args.to + ": " +
+                     e.what());
+  }
+  WriteFileAtomically(args.output_path, bytes);
+  std::cout << text;
+}
+
+// Depth-precision advice (docs/exports.md) on stderr, so stdout stays the export.
+void PrintDepthAdvice(const Camera& camera, ExportFormat format, const ExportOptions& options,
+                      bool quiet) {
+  if (camera.projection == Projection::kOrthographic && !quiet) {
+    // Orthographic depth is linear: the same step everywhere.
+    std::cerr << "camproj: note: orthographic depth is linear in distance: the 24-bit "
+                 "step is (far - near) / 2^24 = "
+              << (camera.z_far - camera.z_near) / 16777216.0 << " world units\n";
+  } else {
+    const DepthAdvice advice = AdviseDepth(
+        camera.z_near, camera.z_far, options.depth,
+        format == ExportFormat::kThree ? DepthAdviceTarget::kThreeJs
+                                       : DepthAdviceTarget::kOpenGl);
+    for (const std::string& warning : advice.warnings) {
+      std::cerr << "camproj: warning: " << warning << '\n';
+    }
+    if (!quiet) {
+      std::istringstream table(advice.table + advice.advice);
+      for (std::string line; std::getline(table, line);) {
+        std::cerr << "camproj: note: " << line << '\n';
+      }
+    }
+  }
+}
+
+// Float32 precision of the vertices and the view matrix (world_origin.h): the error expected at
+// the near plane, where it is largest, with and without the world origin; a warning when it is
+// above kFloat32ErrorWarningPx without one.
+void PrintFloat32Precision(const Camera& camera, bool quiet) {
+  const double without =
+      Float32PixelError(camera, std::nullopt, camera.z_near);
+  const std::optional<Eigen::Vector3d> origin =
+      camera.world_origin ? camera.world_origin : AutoOriginOfCamera(camera);
+  const double with = Float32PixelError(camera, origin, camera.z_near);
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "float32 vertices and view matrix: expected error at the near plane "
+                "(depth %.6g) %.2g px without a world origin, %.2g px with %s "
+                "%.17g,%.17g,%.17g",
+                camera.z_near, without, with,
+                camera.world_origin ? "the world origin" : "--origin auto =",
+                origin->x(), origin->y(), origin->z());
+  if (!camera.world_origin && without > kFloat32ErrorWarningPx) {
+    std::cerr << "camproj: warning: " << line
+              << ": the coordinates are too large for float32; export with --origin "
+                 "auto (or fit with --origin auto) and give vertices relative to it "
+                 "(docs/exports.md)\n";
+  } else if (!quiet) {
+    std::cerr << "camproj: note: " << line << '\n';
+  }
+}
+
+// Warns that a pinhole-only export (`to`) drops the lens: the matrix is not this camera.
+void WarnPinholeOnly(const Camera& camera, const std::string& to) {
+  const Intrinsics& k = camera.intrinsics;
+  char line[768];
+  std::snprintf(line, sizeof line,
+                "camproj: warning: k1 = %.6g, k2 = %.6g%s: the %s export's projection "
+                "matrix is the pinhole part only and puts points up to %.3g px (worst "
+                "image corner) from where the lens images them; %s; opencv-yaml, "
+                "colmap and json keep the lens (docs/exports.md)\n",
+                k.k1, k.k2,
+                k.HasBeyondTwoRadial()
+                    ? (", p1 = " + ShortestDouble(k.p1) + ", p2 = " +
+                       ShortestDouble(k.p2) + ", k3 = " + ShortestDouble(k.k3)).c_str()
+                    : "",
+                to.c_str(), PinholeErrorAtWorstCornerPx(camera),
+                k.HasBeyondTwoRadial()
+                    ? "the GL lens exports (glsl, stmap, distortion-mesh) render k1, "
+                      "k2 only"
+                    : "to render the lens export glsl (per vertex), stmap or "
+                      "distortion-mesh (post-process warp)");
+  std::cerr << line;
+}
+
+// The export asked for, to -o or stdout, with its notes and warnings on stderr.
+int RunExport(const ExportArgs& args) {
+  const Camera camera = CameraToExport(args);
+  const bool stmap = args.to == "stmap" || args.to == "undistort-stmap";
+  CheckOutput(args, stmap);
+  ExportOptions options;
+  options.mesh_step_px = args.mesh_step_px;
+  options.depth.clip_depth = ClipDepthFromString(args.depth);
+  options.depth.reversed_z = args.reversed_z;
+  options.row_major = args.row_major;
+  options.pixel_origin = PixelOriginFromString(args.pixel_origin);
+  if (stmap) {
+    ExportStMap(camera, args, options);
+    return kExitOk;
+  }
+  const ExportFormat format = ExportFormatFromString(args.to);
+  const bool gl_like = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
+                       format == ExportFormat::kThree || format == ExportFormat::kGlsl;
+  // The exports whose projection matrix drops k1, k2 (glsl renders them).
+  const bool pinhole_only = format == ExportFormat::kGl ||
+                            format == ExportFormat::kGlm ||
+                            format == ExportFormat::kThree;
+  if (gl_like) {
+    PrintDepthAdvice(camera, format, options, args.quiet);
+    PrintFloat32Precision(camera, args.quiet);
+  }
+  if (pinhole_only && camera.intrinsics.HasDistortion()) WarnPinholeOnly(camera, args.to);
+  const bool obj = format == ExportFormat::kDistortionMesh &&
+                   ExtensionOf(args.output_path) == ".obj";
+  std::string text;
+  try {
+    text = obj ? LensDistortionMeshObj(camera, options.mesh_step_px, options.depth)
+               : ExportCamera(camera, format, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.camera_path + ": cannot export as " + args.to + ": " + e.what());
+  }
+  if (args.output_path.empty()) {
+    std::cout << text;
+  } else {
+    WriteFileAtomically(args.output_path, text);
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 Command AddExportCommand(CLI::App& root) {
@@ -101,167 +292,7 @@ Command AddExportCommand(CLI::App& root) {
   app->add_flag("--quiet", args->quiet,
                 "gl, glm, glsl, three: no depth-precision notes on stderr (warnings still "
                 "printed)");
-  return {app, [args]() {
-            Camera camera = args->view.empty() ? ReadCameraFile(args->camera_path)
-                                               : ReadCalibrationView(args->camera_path, args->view);
-            if (args->z_near > 0.0) camera.z_near = args->z_near;
-            if (args->z_far > 0.0) camera.z_far = args->z_far;
-            if (args->infinite_far) {
-              if (args->z_far > 0.0) throw UsageError("give --far or --infinite-far, not both");
-              camera.z_far = kInfinity;
-            }
-            if (!(camera.z_far > camera.z_near)) {
-              throw UsageError("far must be greater than near");
-            }
-            if (args->origin == "none") {
-              camera.world_origin.reset();
-            } else if (args->origin == "auto") {
-              camera.world_origin = AutoOriginOfCamera(camera);
-            } else if (!args->origin.empty()) {
-              const std::vector<double> o =
-                  ParseNumbers(args->origin, 3, "--origin (auto, none or X,Y,Z)");
-              camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
-              bool finite = false;
-              try {
-                finite = GlEyeFromOriginWorld(camera.cam_from_world, *camera.world_origin).allFinite();
-              } catch (const std::invalid_argument&) {
-              }
-              if (!finite) {
-                throw UsageError("--origin: " + args->origin +
-                                 " is too far from the camera: the view matrix relative to it "
-                                 "overflows a double");
-              }
-            }
-            const bool stmap = args->to == "stmap" || args->to == "undistort-stmap";
-            if (stmap) {
-              if (args->output_path.empty()) {
-                throw UsageError("--to " + args->to + " writes an image file: give -o MAP.tif, "
-                                 "MAP.tiff or MAP.exr");
-              }
-              const std::string extension = ExtensionOf(args->output_path);
-              if (extension != ".tif" && extension != ".tiff" && extension != ".exr") {
-                throw UsageError("--to " + args->to + ": the output " + args->output_path +
-                                 " must end in .tif, .tiff or .exr (32-bit float RGBA)");
-              }
-            }
-            if (!args->output_path.empty()) {
-              RequireOutputIsNotAnInput(args->output_path, {args->camera_path});
-            }
-            ExportOptions options;
-            options.mesh_step_px = args->mesh_step_px;
-            options.depth.clip_depth = ClipDepthFromString(args->depth);
-            options.depth.reversed_z = args->reversed_z;
-            options.row_major = args->row_major;
-            options.pixel_origin = PixelOriginFromString(args->pixel_origin);
-            if (stmap) {
-              const LensMapDirection direction = args->to == "stmap"
-                                                     ? LensMapDirection::kDistort
-                                                     : LensMapDirection::kUndistort;
-              std::string text;
-              std::string bytes;
-              try {
-                text = LensRenderTargetText(camera, direction, options.depth);
-                bytes = EncodeStMap(LensStMap(camera, direction), ExtensionOf(args->output_path));
-              } catch (const std::invalid_argument& e) {
-                throw InputError(args->camera_path + ": cannot export as " + args->to + ": " +
-                                 e.what());
-              }
-              WriteFileAtomically(args->output_path, bytes);
-              std::cout << text;
-              return kExitOk;
-            }
-            const ExportFormat format = ExportFormatFromString(args->to);
-            // Depth-precision advice (docs/exports.md) on stderr, so stdout stays the export.
-            const bool gl_like = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
-                                 format == ExportFormat::kThree || format == ExportFormat::kGlsl;
-            // The exports whose projection matrix drops k1, k2 (glsl renders them).
-            const bool pinhole_only = format == ExportFormat::kGl ||
-                                      format == ExportFormat::kGlm ||
-                                      format == ExportFormat::kThree;
-            if (gl_like && camera.projection == Projection::kOrthographic && !args->quiet) {
-              // Orthographic depth is linear: the same step everywhere.
-              std::cerr << "camproj: note: orthographic depth is linear in distance: the 24-bit "
-                           "step is (far - near) / 2^24 = "
-                        << (camera.z_far - camera.z_near) / 16777216.0 << " world units\n";
-            } else if (gl_like) {
-              const DepthAdvice advice = AdviseDepth(
-                  camera.z_near, camera.z_far, options.depth,
-                  format == ExportFormat::kThree ? DepthAdviceTarget::kThreeJs
-                                                 : DepthAdviceTarget::kOpenGl);
-              for (const std::string& warning : advice.warnings) {
-                std::cerr << "camproj: warning: " << warning << '\n';
-              }
-              if (!args->quiet) {
-                std::istringstream table(advice.table + advice.advice);
-                for (std::string line; std::getline(table, line);) {
-                  std::cerr << "camproj: note: " << line << '\n';
-                }
-              }
-            }
-            if (gl_like) {
-              // Float32 precision of the vertices and the view matrix (world_origin.h): the
-              // error expected at the near plane, where it is largest, with and without the
-              // world origin; a warning when it is above kFloat32ErrorWarningPx without one.
-              const double without =
-                  Float32PixelError(camera, std::nullopt, camera.z_near);
-              const std::optional<Eigen::Vector3d> origin =
-                  camera.world_origin ? camera.world_origin : AutoOriginOfCamera(camera);
-              const double with = Float32PixelError(camera, origin, camera.z_near);
-              char line[512];
-              std::snprintf(line, sizeof line,
-                            "float32 vertices and view matrix: expected error at the near plane "
-                            "(depth %.6g) %.2g px without a world origin, %.2g px with %s "
-                            "%.17g,%.17g,%.17g",
-                            camera.z_near, without, with,
-                            camera.world_origin ? "the world origin" : "--origin auto =",
-                            origin->x(), origin->y(), origin->z());
-              if (!camera.world_origin && without > kFloat32ErrorWarningPx) {
-                std::cerr << "camproj: warning: " << line
-                          << ": the coordinates are too large for float32; export with --origin "
-                             "auto (or fit with --origin auto) and give vertices relative to it "
-                             "(docs/exports.md)\n";
-              } else if (!args->quiet) {
-                std::cerr << "camproj: note: " << line << '\n';
-              }
-            }
-            if (pinhole_only && camera.intrinsics.HasDistortion()) {
-              // Not only in the export's comment: the matrix is not this camera.
-              const Intrinsics& k = camera.intrinsics;
-              char line[768];
-              std::snprintf(line, sizeof line,
-                            "camproj: warning: k1 = %.6g, k2 = %.6g%s: the %s export's projection "
-                            "matrix is the pinhole part only and puts points up to %.3g px (worst "
-                            "image corner) from where the lens images them; %s; opencv-yaml, "
-                            "colmap and json keep the lens (docs/exports.md)\n",
-                            k.k1, k.k2,
-                            k.HasBeyondTwoRadial()
-                                ? (", p1 = " + ShortestDouble(k.p1) + ", p2 = " +
-                                   ShortestDouble(k.p2) + ", k3 = " + ShortestDouble(k.k3)).c_str()
-                                : "",
-                            args->to.c_str(), PinholeErrorAtWorstCornerPx(camera),
-                            k.HasBeyondTwoRadial()
-                                ? "the GL lens exports (glsl, stmap, distortion-mesh) render k1, "
-                                  "k2 only"
-                                : "to render the lens export glsl (per vertex), stmap or "
-                                  "distortion-mesh (post-process warp)");
-              std::cerr << line;
-            }
-            const bool obj = format == ExportFormat::kDistortionMesh &&
-                             ExtensionOf(args->output_path) == ".obj";
-            std::string text;
-            try {
-              text = obj ? LensDistortionMeshObj(camera, options.mesh_step_px, options.depth)
-                         : ExportCamera(camera, format, options);
-            } catch (const std::invalid_argument& e) {
-              throw InputError(args->camera_path + ": cannot export as " + args->to + ": " + e.what());
-            }
-            if (args->output_path.empty()) {
-              std::cout << text;
-            } else {
-              WriteFileAtomically(args->output_path, text);
-            }
-            return kExitOk;
-          }};
+  return {app, [args]() { return RunExport(*args); }};
 }
 
 }  // namespace camproj::cli
