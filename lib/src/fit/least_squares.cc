@@ -368,7 +368,6 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
 
   LmSummary summary;
   ScaledIterate iterate;
-  double function_tolerance = 0.0;
   // The local normal equations of the trial and of the last accepted iterate, by pointer: an
   // accepted trial's become the accepted ones without a copy (summary.local is set once, at the
   // end).
@@ -379,10 +378,6 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   // local ones.
   auto accept = [&](const ParamVector& at, const NormalEquations& chart) {
     *u = at;
-    if (iterate.scaling.size() == 0) {
-      // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
-      function_tolerance = options.function_tolerance * std::max(chart.cost, 1e-300);
-    }
     iterate.Set(chart);
     accepted_local = trial_local;
     trial_local = accepted_local == &locals[0] ? &locals[1] : &locals[0];
@@ -400,6 +395,8 @@ LmSummary MinimizeLevenbergMarquardt(const ChartProblem& problem, const FitOptio
   summary.iterations = 0;
   // A point behind the start: nothing to minimize (the polish refuses it too).
   if (!problem.Linearize(*u, &chart, trial_local)) return summary;
+  // TinySolver's function tolerance is absolute (on twice the cost): scale it by the start's.
+  const double function_tolerance = options.function_tolerance * std::max(chart.cost, 1e-300);
   accept(*u, chart);
   if (const std::optional<LmStatus> stop =
           StopAt(iterate, chart, *u, options, out_of_reach_px2, known)) {
