@@ -66,8 +66,7 @@ Camera CameraToExport(const ExportArgs& args) {
   } else if (args.origin == "auto") {
     camera.world_origin = AutoOriginOfCamera(camera);
   } else if (!args.origin.empty()) {
-    const std::vector<double> o =
-        ParseNumbers(args.origin, 3, "--origin (auto, none or X,Y,Z)");
+    const std::vector<double> o = ParseNumbers(args.origin, 3, "--origin (auto, none or X,Y,Z)");
     camera.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
     bool finite = false;
     try {
@@ -103,17 +102,15 @@ void CheckOutput(const ExportArgs& args, bool stmap) {
 
 // --to stmap or undistort-stmap: the map to -o, the render target's size and matrices to stdout.
 void ExportStMap(const Camera& camera, const ExportArgs& args, const ExportOptions& options) {
-  const LensMapDirection direction = args.to == "stmap"
-                                         ? LensMapDirection::kDistort
-                                         : LensMapDirection::kUndistort;
+  const LensMapDirection direction =
+      args.to == "stmap" ? LensMapDirection::kDistort : LensMapDirection::kUndistort;
   std::string text;
   std::string bytes;
   try {
     text = LensRenderTargetText(camera, direction, options.depth);
     bytes = EncodeStMap(LensStMap(camera, direction), ExtensionOf(args.output_path));
   } catch (const std::invalid_argument& e) {
-    throw InputError(args.camera_path + ": cannot export as " + args.to + ": " +
-                     e.what());
+    throw InputError(args.camera_path + ": cannot export as " + args.to + ": " + e.what());
   }
   WriteFileAtomically(args.output_path, bytes);
   std::cout << text;
@@ -148,8 +145,7 @@ void PrintDepthAdvice(const Camera& camera, ExportFormat format, const ExportOpt
 // the near plane, where it is largest, with and without the world origin; a warning when it is
 // above kFloat32ErrorWarningPx without one.
 void PrintFloat32Precision(const Camera& camera, bool quiet) {
-  const double without =
-      Float32PixelError(camera, std::nullopt, camera.z_near);
+  const double without = Float32PixelError(camera, std::nullopt, camera.z_near);
   const std::optional<Eigen::Vector3d> origin =
       camera.world_origin ? camera.world_origin : AutoOriginOfCamera(camera);
   const double with = Float32PixelError(camera, origin, camera.z_near);
@@ -213,16 +209,15 @@ int RunExport(const ExportArgs& args) {
   const bool gl_like = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
                        format == ExportFormat::kThree || format == ExportFormat::kGlsl;
   // The exports whose projection matrix drops k1, k2 (glsl renders them).
-  const bool pinhole_only = format == ExportFormat::kGl ||
-                            format == ExportFormat::kGlm ||
+  const bool pinhole_only = format == ExportFormat::kGl || format == ExportFormat::kGlm ||
                             format == ExportFormat::kThree;
   if (gl_like) {
     PrintDepthAdvice(camera, format, options, args.quiet);
     PrintFloat32Precision(camera, args.quiet);
   }
   if (pinhole_only && camera.intrinsics.HasDistortion()) WarnPinholeOnly(camera, args.to);
-  const bool obj = format == ExportFormat::kDistortionMesh &&
-                   ExtensionOf(args.output_path) == ".obj";
+  const bool obj =
+      format == ExportFormat::kDistortionMesh && ExtensionOf(args.output_path) == ".obj";
   std::string text;
   try {
     text = obj ? LensDistortionMeshObj(camera, options.mesh_step_px, options.depth)

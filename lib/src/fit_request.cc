@@ -91,8 +91,8 @@ double LossScale(const std::string& text) {
   return value;
 }
 
-// --model: the listed intrinsics free, the rest at their defaults (fixed there, so that the
-// automatic path does not free them); "auto" leaves options as they are.
+// --model: an orthographic camera, or the listed intrinsics free; "auto" leaves options as they
+// are.
 void SetModel(const FitArguments& args, const ImageSize& size, FitOptions* options_out) {
   FitOptions& options = *options_out;
   const std::string orthographic = "orthographic";
