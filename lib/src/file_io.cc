@@ -2,6 +2,7 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -32,16 +33,31 @@ struct PendingTemporary {
   char path[PATH_MAX] = {};
 };
 PendingTemporary pending_temporaries[kMaxPendingTemporaries];
-// Set by the handler before it removes the registered temporaries: a thread that names a
-// temporary after that point removes it itself (AbandonIfDying), so none is created behind the
-// handler's back.
+// Set by the handler before it removes the registered temporaries: a thread that enters a
+// CreationWindow after that point creates nothing, and one inside a window removes what it
+// created itself (AbandonIfDying), so none is created behind the handler's back.
 std::atomic<bool> dying{false};
-// Threads between registering a temporary's name and AbandonIfDying (CreationWindow): the
-// handler waits for them before it removes the registered temporaries. Otherwise a thread could
-// create its file just after the handler's unlink and the process die before that thread's
-// AbandonIfDying (seen: a SIGTERM at the start of a 2-thread batch under the sanitizers left a
-// .camproj-*.tmp).
+// Threads inside a CreationWindow (from before a temporary's name is registered until
+// AbandonIfDying has run on it): the handler waits for them before it removes the registered
+// temporaries. Otherwise a thread could create its file just after the handler's unlink and the
+// process die before that thread's AbandonIfDying (seen: a SIGTERM at the start of a 2-thread
+// batch under the sanitizers left a .camproj-*.tmp).
 std::atomic<int> creating{0};
+
+// The signals InstallTemporaryFileCleanup handles.
+sigset_t HandledSignals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&signals, signal_number);
+  return signals;
+}
+
+// Once the handler has started: waits for the process to die of the signal (the handler's
+// thread raises it), doing nothing a user could see meanwhile.
+void WaitForDeathIfDying() {
+  if (!dying) return;
+  for (;;) pause();
+}
 
 // Called after a temporary's name is registered and created, inside that creation's
 // CreationWindow: if a handler has started, removes it, leaves the window (the handler need not
@@ -50,17 +66,37 @@ void AbandonIfDying(const std::string& name) {
   if (!dying) return;
   unlink(name.c_str());
   --creating;
-  for (;;) pause();
+  WaitForDeathIfDying();
 }
 
 // Counts the calling thread in `creating` from before a temporary's name is registered until
-// AbandonIfDying has run on it (or the creation failed).
+// AbandonIfDying has run on it (or the creation failed), with the handled signals blocked in
+// this thread meanwhile: the handler then never runs on a thread inside its window (it would
+// wait for itself), and may wait for every window to close. A window opened after the handler
+// set `dying` creates nothing: the thread waits for the process's death. The two orders are
+// exclusive (sequentially consistent atomics, as in Dekker's algorithm): the handler sets `dying`
+// then reads `creating`, a thread increments `creating` then reads `dying`, so either the handler
+// sees this window and waits for it, or this thread sees `dying`.
 class CreationWindow {
  public:
-  CreationWindow() { ++creating; }
-  ~CreationWindow() { --creating; }
+  CreationWindow() {
+    const sigset_t handled = HandledSignals();
+    pthread_sigmask(SIG_BLOCK, &handled, &previous_mask_);
+    ++creating;
+    if (dying) {
+      --creating;
+      WaitForDeathIfDying();
+    }
+  }
+  ~CreationWindow() {
+    --creating;
+    pthread_sigmask(SIG_SETMASK, &previous_mask_, nullptr);
+  }
   CreationWindow(const CreationWindow&) = delete;
   CreationWindow& operator=(const CreationWindow&) = delete;
+
+ private:
+  sigset_t previous_mask_;
 };
 
 // Registers a temporary's path for removal on a signal, until cleared or destroyed; silently
@@ -99,12 +135,13 @@ class SignalCleanup {
 
 extern "C" void RemoveTemporariesAndDie(int signal_number) {
   dying = true;
-  // Let the threads creating a temporary finish creating it (it is then registered, and removed
-  // below) or see `dying` and remove it themselves. Bounded: if this handler interrupted such a
-  // thread, that thread cannot move on, and its temporary, if created, is registered already.
-  constexpr int kWaits = 100;
+  // Let the threads inside a CreationWindow finish creating their temporary (it is then
+  // registered, and removed below) or see `dying` and remove it themselves. Each window is a
+  // few system calls (open, or linkat, on a local folder); the bound only keeps a kill working
+  // where one hangs (an unresponsive network file system), at the risk of leaving its file.
+  constexpr int kWaitsMs = 10000;
   const timespec millisecond{0, 1000000};
-  for (int i = 0; i < kWaits && creating.load() > 0; ++i) nanosleep(&millisecond, nullptr);
+  for (int i = 0; i < kWaitsMs && creating.load() > 0; ++i) nanosleep(&millisecond, nullptr);
   for (PendingTemporary& slot : pending_temporaries) {
     if (slot.ready) unlink(slot.path);
   }
@@ -312,7 +349,10 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   temporary.fd = -1;
   if (close(fd) != 0) throw InputError("cannot write " + path + ": close: " + ErrnoText(errno));
   if (std::rename(name.c_str(), target.c_str()) != 0) {
-    throw InputError("cannot write " + path + ": rename: " + ErrnoText(errno));
+    const int error = errno;
+    // The handler removed the temporary (ENOENT): no message, the process is about to die.
+    WaitForDeathIfDying();
+    throw InputError("cannot write " + path + ": rename: " + ErrnoText(error));
   }
   temporary.name.clear();
   SweepStaleTemporaries(folder);

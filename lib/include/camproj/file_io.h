@@ -13,7 +13,8 @@ namespace camproj {
 //  - the data goes to an unnamed file (O_TMPFILE) in the target's folder, flushed to disk, then
 //    linked under a short temporary name ".camproj-XXXXXX" and renamed over the target; where the
 //    file system has no O_TMPFILE, that short name is created directly (it fits NAME_MAX for any
-//    target name) and InstallTemporaryFileCleanup's handlers remove it on SIGINT/SIGTERM/SIGHUP;
+//    target name); either way InstallTemporaryFileCleanup's handlers remove it on SIGINT, SIGTERM
+//    and SIGHUP (safe with several threads writing: docs/reliability.md);
 //  - a `path` that is a symbolic link is written through: its target is replaced, the link stays;
 //  - a replaced file keeps its permission bits; a new one gets 0666 minus the umask;
 //  - after the rename, temporaries of this function in the folder last modified over an hour ago
