@@ -297,6 +297,32 @@ PY
     expect_exit 0 "$bin" fit --help
     expect_in out "Examples"
     ;;
+  stdout_write_errors)
+    # A standard output that cannot be written (a full disk: /dev/full; a closed descriptor) is
+    # exit 2 naming it, never a truncated output with exit 0 (it was, before session 37).
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/cam.json"
+    "$bin" export "$work/cam.json" --to gl >/dev/full 2>"$work/err"
+    code=$?
+    [[ $code -eq 2 ]] || fail "export to /dev/full: exit $code, expected 2"
+    expect_in err "camproj: error: cannot write the standard output: No space left on device"
+    "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 >&- 2>"$work/err"
+    code=$?
+    [[ $code -eq 2 ]] || fail "fit with stdout closed: exit $code, expected 2"
+    expect_in err "cannot write the standard output: Bad file descriptor"
+    # A refusal keeps its own exit code (3) and says both.
+    awk -F, 'BEGIN { OFS = "," } NR <= 2 { print; next } { $1 = -$1; print }' \
+        "$data/projector/points.csv" >"$work/mirrored.csv"
+    "$bin" fit "$work/mirrored.csv" --image-size 1920x1080 >/dev/full 2>"$work/err"
+    code=$?
+    [[ $code -eq 3 ]] || fail "a refusal with stdout full: exit $code, expected 3:\n$(cat "$work/err")"
+    expect_in err "cannot fit"
+    # Nothing written to a closed stdout is no error; a file written with -o is not affected.
+    expect_exit 0 "$bin" export "$work/cam.json" --to gl -o "$work/gl.txt"
+    "$bin" export "$work/cam.json" --to gl -o "$work/gl2.txt" >&- 2>/dev/null
+    code=$?
+    [[ $code -eq 0 ]] || fail "export -o with stdout closed: exit $code, expected 0"
+    cmp -s "$work/gl.txt" "$work/gl2.txt" || fail "export -o with stdout closed wrote another file"
+    ;;
   export_formats)
     for to in gl glm opencv-yaml colmap three json; do
       expect_exit 0 "$bin" export "$data/projector/truth.json" --to "$to"

@@ -1,6 +1,9 @@
 // camproj: the command line. Each subcommand parses, reads, calls the library and prints or
 // writes (one file per subcommand). Exit codes: 0 ok, 1 usage, 2 bad input, 3 the scene cannot
 // determine the requested camera.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <vector>
 
@@ -11,8 +14,28 @@
 #include "camproj_git_revision.h"
 #include "cli.h"
 
-int main(int argc, char** argv) {
-  using namespace camproj::cli;
+namespace {
+
+using namespace camproj::cli;
+
+// The command's exit code once its standard output is flushed and closed: a failed write there
+// (a full disk behind `>`, a closed descriptor) is reported and exits 2 where the command would
+// have exited 0, so that a truncated output never looks like a success.
+int FinishStandardOutput(int code) {
+  std::cout.flush();
+  const bool written = std::cout.good() && std::fflush(stdout) == 0 && !std::ferror(stdout);
+  const int error = errno;
+  // Closed explicitly: a write error a file system reports only on close (NFS) is caught too.
+  // EBADF there, after every write succeeded, is a descriptor closed by the caller (`>&-`) that
+  // nothing was written to: not an error (as GNU's close_stdout).
+  const bool closed = std::fclose(stdout) == 0 || (written && errno == EBADF);
+  if (written && closed) return code;
+  std::cerr << "camproj: error: cannot write the standard output: "
+            << std::strerror(written ? errno : error) << '\n';
+  return code == kExitOk ? kExitBadInput : code;
+}
+
+int Run(int argc, char** argv) {
   CLI::App app{
       "camproj: make an OpenGL camera see exactly what a real camera or projector sees.\n\n"
       "Fit a camera to 2D-3D correspondences, export it as OpenGL / glm / OpenCV / COLMAP /\n"
@@ -67,3 +90,7 @@ int main(int argc, char** argv) {
   }
   return kExitUsage;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return FinishStandardOutput(Run(argc, argv)); }
