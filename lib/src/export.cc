@@ -319,80 +319,64 @@ ordered_json Matrix4Json(const Eigen::Matrix4d& m) {
   return numbers;
 }
 
-std::string ExportThreeText(const Camera& camera, const ExportOptions& options) {
-  const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
-  // With a world origin three's world is the origin-relative one: the scene's positions are
-  // point_in_world - world_origin (three's numbers are doubles until they reach the GPU).
-  const Rigid3 world_from_gl_eye = Inverse(Rigid3FromMatrix(views.gl_eye_from_origin_world));
-  const Eigen::Quaterniond q(world_from_gl_eye.rotation);
-  const Eigen::Vector3d& position = world_from_gl_eye.translation;
-  const GlDepth& depth = options.depth;
-
-  ordered_json document;
-  document["projectionMatrix"] = Matrix4Json(views.clip_from_gl_eye);
-  document["matrixWorld"] = Matrix4Json(world_from_gl_eye.ToMatrix());
-  document["position"] = {position.x(), position.y(), position.z()};
-  document["quaternion"] = {q.x(), q.y(), q.z(), q.w()};  // three's Quaternion.fromArray order
-  // Why three's updateProjectionMatrix() cannot rebuild projectionMatrix, if it cannot.
+// Why three's updateProjectionMatrix() cannot rebuild projectionMatrix ("" if it can: each
+// reason " ...;"), and the note's sentence on an off-centre principal point.
+struct ThreeRebuild {
   std::string no_rebuild;
   std::string off_axis;
+};
+
+// `type` and the fields three rebuilds projectionMatrix from: the glOrtho box, or fov, aspect and
+// (off-centre) the view offset.
+ThreeRebuild SetThreeProjectionFields(const Camera& camera, const CameraViews& views,
+                                      ordered_json* document) {
+  ThreeRebuild rebuild;
   if (camera.projection == Projection::kOrthographic) {
     // THREE.OrthographicCamera(left, right, top, bottom, near, far): the glOrtho box.
-    document["type"] = "OrthographicCamera";
+    (*document)["type"] = "OrthographicCamera";
     if (views.ortho) {
-      document["left"] = views.ortho->left;
-      document["right"] = views.ortho->right;
-      document["top"] = views.ortho->top;
-      document["bottom"] = views.ortho->bottom;
+      (*document)["left"] = views.ortho->left;
+      (*document)["right"] = views.ortho->right;
+      (*document)["top"] = views.ortho->top;
+      (*document)["bottom"] = views.ortho->bottom;
     } else {
-      no_rebuild += " skew != 0 (no left, right, top, bottom form);";
+      rebuild.no_rebuild += " skew != 0 (no left, right, top, bottom form);";
     }
-  } else if (views.frustum) {
-    document["type"] = "PerspectiveCamera";
-    // Enlarge the frustum to one centred on the gaze and show the image as a window of it, in
-    // units of s = W / (r - l) per near-plane unit on both axes, so that fullWidth / fullHeight
-    // is the full view's aspect (setViewOffset sets aspect to it). Exactly centred: no window.
-    const Frustum& f = *views.frustum;
-    const double half_width = std::max(-f.left, f.right);
-    const double half_height = std::max(f.top, -f.bottom);
-    const double s = camera.image_size.width / (f.right - f.left);
-    document["fov"] = 2.0 * std::atan(half_height / f.z_near) * kRadToDeg;
-    document["aspect"] = half_width / half_height;
-    if (f.left != -f.right || f.bottom != -f.top) {
-      document["view"] = {{"enabled", true},
-                          {"fullWidth", 2.0 * half_width * s},
-                          {"fullHeight", 2.0 * half_height * s},
-                          {"offsetX", (f.left + half_width) * s},
-                          {"offsetY", (half_height - f.top) * s},
-                          {"width", (f.right - f.left) * s},
-                          {"height", (f.top - f.bottom) * s}};
-      off_axis =
-          " The principal point is off-centre: fov and aspect are those of an enlarged view "
-          "centred on the gaze, and view is the image's window in it, as "
-          "camera.setViewOffset(fullWidth, fullHeight, offsetX, offsetY, width, height) sets it.";
-    }
-  } else {
-    no_rebuild += " skew != 0 (no fov, aspect or view form);";
+    return rebuild;
   }
-  document["near"] = camera.z_near;
-  if (std::isfinite(camera.z_far)) {
-    document["far"] = camera.z_far;
-  } else {
-    document["far"] = nullptr;
-    no_rebuild += " the far plane is infinite (far = Infinity gives NaN);";
+  if (!views.frustum) {
+    rebuild.no_rebuild += " skew != 0 (no fov, aspect or view form);";
+    return rebuild;
   }
-  document["zoom"] = 1.0;
-  document["filmOffset"] = 0.0;
-  document["depth"] = ToString(depth.clip_depth);
-  document["reversed_z"] = depth.reversed_z;
-  document["image_size"] = {camera.image_size.width, camera.image_size.height};
-  if (camera.world_origin) {
-    document["world_origin"] = {camera.world_origin->x(), camera.world_origin->y(),
-                                camera.world_origin->z()};
-  } else {
-    document["world_origin"] = nullptr;
+  (*document)["type"] = "PerspectiveCamera";
+  // Enlarge the frustum to one centred on the gaze and show the image as a window of it, in
+  // units of s = W / (r - l) per near-plane unit on both axes, so that fullWidth / fullHeight
+  // is the full view's aspect (setViewOffset sets aspect to it). Exactly centred: no window.
+  const Frustum& f = *views.frustum;
+  const double half_width = std::max(-f.left, f.right);
+  const double half_height = std::max(f.top, -f.bottom);
+  const double s = camera.image_size.width / (f.right - f.left);
+  (*document)["fov"] = 2.0 * std::atan(half_height / f.z_near) * kRadToDeg;
+  (*document)["aspect"] = half_width / half_height;
+  if (f.left != -f.right || f.bottom != -f.top) {
+    (*document)["view"] = {{"enabled", true},
+                           {"fullWidth", 2.0 * half_width * s},
+                           {"fullHeight", 2.0 * half_height * s},
+                           {"offsetX", (f.left + half_width) * s},
+                           {"offsetY", (half_height - f.top) * s},
+                           {"width", (f.right - f.left) * s},
+                           {"height", (f.top - f.bottom) * s}};
+    rebuild.off_axis =
+        " The principal point is off-centre: fov and aspect are those of an enlarged view "
+        "centred on the gaze, and view is the image's window in it, as "
+        "camera.setViewOffset(fullWidth, fullHeight, offsetX, offsetY, width, height) sets it.";
   }
+  return rebuild;
+}
 
+// The export's `note`: how to load the matrices into three, whether updateProjectionMatrix may
+// run, the renderer the depth convention needs, pixels, distortion, matrixWorld and the origin.
+std::string ThreeNote(const Camera& camera, const GlDepth& depth, ThreeRebuild rebuild) {
   std::string note =
       "projectionMatrix is exact: camera.projectionMatrix.fromArray(projectionMatrix); "
       "camera.projectionMatrixInverse.copy(camera.projectionMatrix).invert(). "
@@ -401,6 +385,7 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
       std::string(camera.projection == Projection::kOrthographic
                       ? "left, right, top, bottom, near, far and zoom: "
                       : "fov, aspect, near, far, zoom and view: ");
+  std::string& no_rebuild = rebuild.no_rebuild;
   if (depth.clip_depth == ClipDepth::kNegativeOneToOne && depth.reversed_z) {
     no_rebuild += " three has no [-1, 1] reversed-Z depth;";
   }
@@ -410,7 +395,7 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
     no_rebuild.pop_back();
     note += "here it cannot (" + no_rebuild.substr(1) + "), so never let it run.";
   }
-  note += off_axis;
+  note += rebuild.off_axis;
   note += depth.reversed_z
               ? (depth.clip_depth == ClipDepth::kZeroToOne
                      ? " Depth zo reversed-Z: a renderer made with reversedDepthBuffer: true."
@@ -436,7 +421,43 @@ std::string ExportThreeText(const Camera& camera, const ExportOptions& options) 
                  "matrices in double, so vertices small around their object's position are "
                  "precise either way)."
                : ".");
-  document["note"] = note;
+  return note;
+}
+
+std::string ExportThreeText(const Camera& camera, const ExportOptions& options) {
+  const CameraViews views = ViewsOfCamera(camera, 1.0, options.depth);
+  // With a world origin three's world is the origin-relative one: the scene's positions are
+  // point_in_world - world_origin (three's numbers are doubles until they reach the GPU).
+  const Rigid3 world_from_gl_eye = Inverse(Rigid3FromMatrix(views.gl_eye_from_origin_world));
+  const Eigen::Quaterniond q(world_from_gl_eye.rotation);
+  const Eigen::Vector3d& position = world_from_gl_eye.translation;
+  const GlDepth& depth = options.depth;
+
+  ordered_json document;
+  document["projectionMatrix"] = Matrix4Json(views.clip_from_gl_eye);
+  document["matrixWorld"] = Matrix4Json(world_from_gl_eye.ToMatrix());
+  document["position"] = {position.x(), position.y(), position.z()};
+  document["quaternion"] = {q.x(), q.y(), q.z(), q.w()};  // three's Quaternion.fromArray order
+  ThreeRebuild rebuild = SetThreeProjectionFields(camera, views, &document);
+  document["near"] = camera.z_near;
+  if (std::isfinite(camera.z_far)) {
+    document["far"] = camera.z_far;
+  } else {
+    document["far"] = nullptr;
+    rebuild.no_rebuild += " the far plane is infinite (far = Infinity gives NaN);";
+  }
+  document["zoom"] = 1.0;
+  document["filmOffset"] = 0.0;
+  document["depth"] = ToString(depth.clip_depth);
+  document["reversed_z"] = depth.reversed_z;
+  document["image_size"] = {camera.image_size.width, camera.image_size.height};
+  if (camera.world_origin) {
+    document["world_origin"] = {camera.world_origin->x(), camera.world_origin->y(),
+                                camera.world_origin->z()};
+  } else {
+    document["world_origin"] = nullptr;
+  }
+  document["note"] = ThreeNote(camera, depth, std::move(rebuild));
   return document.dump(2) + "\n";
 }
 
