@@ -818,6 +818,112 @@ void WriteTable(const std::string& path, const std::vector<Row>& rows,
 
 // ---------------------------------------------------------------------------------------------
 
+// One method's outcome on a scene, added to its cell's samples: the time, a refusal, or the
+// errors and, within kFailureSigmas of `bound` (where available), their share of the bound.
+void Accumulate(const Outcome& outcome, const Method& method, const SceneInput& in,
+                const Camera& truth, double distance, double sigma, const Bound& bound,
+                Samples* s) {
+  ++s->total;
+  s->time_us.push_back(outcome.time_us);
+  if (!outcome.note.empty()) ++s->notes[outcome.note];
+  if (outcome.refused) {
+    ++s->refused;
+    ++s->errors[outcome.error];
+    return;
+  }
+  const Errors e = ErrorsOf(outcome.estimate, in, truth);
+  if (!e.valid) {
+    ++s->outliers;
+    ++s->errors["answer has points behind the camera or non-finite values"];
+    return;
+  }
+  s->rms_px.push_back(e.rms_px);
+  s->focal_pct.push_back(100.0 * std::abs(e.focal_px) / truth.intrinsics.fx);
+  s->rotation_deg.push_back(e.rotation_deg);
+  s->centre_rel.push_back(e.centre / distance);
+  if (!bound.available) return;
+  const double sigma_for_failure = std::max(sigma, kZeroNoiseFloorPx);
+  const double limit2 = kFailureSigmas * kFailureSigmas * sigma_for_failure * sigma_for_failure;
+  const bool focal_out =
+      method.model != Model::kPose && e.focal_px * e.focal_px > limit2 * bound.var_focal;
+  const bool eye_out = e.centre * e.centre > limit2 * bound.var_eye;
+  const bool rotation_out = e.rotation_deg * e.rotation_deg > limit2 * bound.var_rotation;
+  if (focal_out || eye_out || rotation_out) {
+    ++s->outliers;
+    return;
+  }
+  ++s->bound_count;
+  const double sigma2 = sigma * sigma;
+  s->sum_focal2 += e.focal_px * e.focal_px;
+  s->sum_var_focal += sigma2 * bound.var_focal;
+  s->sum_eye2 += e.centre * e.centre;
+  s->sum_var_eye += sigma2 * bound.var_eye;
+  s->sum_rotation2 += e.rotation_deg * e.rotation_deg;
+  s->sum_var_rotation += sigma2 * bound.var_rotation;
+}
+
+using SampleMap = std::map<std::pair<CellKey, int>, Samples>;  // (cell, method index)
+
+// Scene `index` of N = n points, `object` and `lens` at every noise level, every method: its
+// outcomes into `samples`, a Cramér–Rao bound that could not be computed into `bound_warnings`.
+void MeasureScene(int n, Object object, Lens lens, int index, const MethodConfig& config,
+                  SampleMap* samples, std::map<std::string, int>* bound_warnings) {
+  SynthOptions synth;
+  synth.seed = static_cast<uint64_t>(index) + 1;
+  synth.num_points = n;
+  synth.object = object == Object::kCloud ? SynthObject::kCloud : SynthObject::kPlane;
+  synth.image_size = kImageSize;
+  synth.fovy_deg = kFovyDeg;
+  synth.principal_point_offset =
+      lens == Lens::kCentred ? Eigen::Vector2d(0, 0) : Eigen::Vector2d(0, 0.5);
+  const bool planar = object == Object::kPlane;
+  // The noise is drawn after the geometry: the same seed gives the same points and camera at
+  // every noise level, and noise 0 gives the true pixels.
+  synth.noise_px = 0.0;
+  const SynthScene truth_scene = SynthesizeScene(synth);
+  const Camera& truth = truth_scene.truth;
+  const SceneInput noise_free = MakeInput(truth_scene, planar);
+  std::map<Model, Bound> bounds;
+  for (Model model : {Model::kShared, Model::kDefault, Model::kPose}) {
+    std::string warning;
+    bounds[model] = BoundFor(model, noise_free, truth, &warning);
+    if (!warning.empty()) ++(*bound_warnings)[ErrorKind(warning)];
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& x : noise_free.points) centroid += x;
+  centroid /= static_cast<double>(n);
+  const double distance = (CameraCenterInWorld(truth.cam_from_world) - centroid).norm();
+
+  for (double sigma : kSigmas) {
+    synth.noise_px = sigma;
+    const SynthScene scene = SynthesizeScene(synth);
+    const SceneInput in = MakeInput(scene, planar);
+    const CellKey cell{n, sigma, object, lens};
+    for (size_t m = 0; m < kMethods.size(); ++m) {
+      const Method& method = kMethods[m];
+      Accumulate(Run(method, in, config), method, in, truth, distance, sigma,
+                 bounds[method.model], &(*samples)[{cell, static_cast<int>(m)}]);
+    }
+  }
+}
+
+// The self-check that makes --quick a smoke test: on noise-free pixels camproj must answer every
+// scene at the truth. OpenCV's failures are results, not errors (calibrateCamera from the 80
+// degree guess can settle in a local minimum even without noise). The number of rows that fail.
+int NoiseFreeFailures(const std::vector<Row>& rows) {
+  int broken = 0;
+  for (const Row& r : rows) {
+    const bool ours = std::string(r.method->name).rfind("ours-", 0) == 0;
+    if (ours && r.cell.sigma == 0.0 && r.refused + r.outliers > 0) {
+      std::cerr << "bench: check failed: " << r.method->name << " failed " << r.refused + r.outliers
+                << " of " << r.scenes << " noise-free scenes (N = " << r.cell.n << ", "
+                << Name(r.cell.object) << ", " << Name(r.cell.lens) << ")\n";
+      ++broken;
+    }
+  }
+  return broken;
+}
+
 int Main(const BenchOptions& options) {
   cv::setNumThreads(1);
   std::filesystem::create_directories(options.out_dir);
@@ -842,7 +948,7 @@ int Main(const BenchOptions& options) {
     for (const Method& m : kMethods) Run(m, in, config);
   }
 
-  std::map<std::pair<CellKey, int>, Samples> samples;  // (cell, method index)
+  SampleMap samples;
   std::map<std::string, int> bound_warnings;
   for (int n : kNumPoints) {
     const int scenes = ScenesPerCell(n, options);
@@ -851,83 +957,7 @@ int Main(const BenchOptions& options) {
     for (Object object : {Object::kCloud, Object::kPlane}) {
       for (Lens lens : {Lens::kCentred, Lens::kProjector}) {
         for (int index = 0; index < scenes; ++index) {
-          SynthOptions synth;
-          synth.seed = static_cast<uint64_t>(index) + 1;
-          synth.num_points = n;
-          synth.object = object == Object::kCloud ? SynthObject::kCloud : SynthObject::kPlane;
-          synth.image_size = kImageSize;
-          synth.fovy_deg = kFovyDeg;
-          synth.principal_point_offset =
-              lens == Lens::kCentred ? Eigen::Vector2d(0, 0) : Eigen::Vector2d(0, 0.5);
-          const bool planar = object == Object::kPlane;
-          // The noise is drawn after the geometry: the same seed gives the same points and
-          // camera at every noise level, and noise 0 gives the true pixels.
-          synth.noise_px = 0.0;
-          const SynthScene truth_scene = SynthesizeScene(synth);
-          const Camera& truth = truth_scene.truth;
-          const SceneInput noise_free = MakeInput(truth_scene, planar);
-          std::map<Model, Bound> bounds;
-          for (Model model : {Model::kShared, Model::kDefault, Model::kPose}) {
-            std::string warning;
-            bounds[model] = BoundFor(model, noise_free, truth, &warning);
-            if (!warning.empty()) ++bound_warnings[ErrorKind(warning)];
-          }
-          Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-          for (const auto& x : noise_free.points) centroid += x;
-          centroid /= static_cast<double>(n);
-          const double distance = (CameraCenterInWorld(truth.cam_from_world) - centroid).norm();
-
-          for (double sigma : kSigmas) {
-            synth.noise_px = sigma;
-            const SynthScene scene = SynthesizeScene(synth);
-            const SceneInput in = MakeInput(scene, planar);
-            const CellKey cell{n, sigma, object, lens};
-            const double sigma_for_failure = std::max(sigma, kZeroNoiseFloorPx);
-            for (size_t m = 0; m < kMethods.size(); ++m) {
-              const Method& method = kMethods[m];
-              const Outcome outcome = Run(method, in, config);
-              Samples& s = samples[{cell, static_cast<int>(m)}];
-              ++s.total;
-              s.time_us.push_back(outcome.time_us);
-              if (!outcome.note.empty()) ++s.notes[outcome.note];
-              if (outcome.refused) {
-                ++s.refused;
-                ++s.errors[outcome.error];
-                continue;
-              }
-              const Errors e = ErrorsOf(outcome.estimate, in, truth);
-              if (!e.valid) {
-                ++s.outliers;
-                ++s.errors["answer has points behind the camera or non-finite values"];
-                continue;
-              }
-              s.rms_px.push_back(e.rms_px);
-              s.focal_pct.push_back(100.0 * std::abs(e.focal_px) / truth.intrinsics.fx);
-              s.rotation_deg.push_back(e.rotation_deg);
-              s.centre_rel.push_back(e.centre / distance);
-              const Bound& bound = bounds[method.model];
-              if (!bound.available) continue;
-              const double limit2 = kFailureSigmas * kFailureSigmas * sigma_for_failure *
-                                    sigma_for_failure;
-              const bool focal_out = method.model != Model::kPose &&
-                                     e.focal_px * e.focal_px > limit2 * bound.var_focal;
-              const bool eye_out = e.centre * e.centre > limit2 * bound.var_eye;
-              const bool rotation_out =
-                  e.rotation_deg * e.rotation_deg > limit2 * bound.var_rotation;
-              if (focal_out || eye_out || rotation_out) {
-                ++s.outliers;
-                continue;
-              }
-              ++s.bound_count;
-              const double sigma2 = sigma * sigma;
-              s.sum_focal2 += e.focal_px * e.focal_px;
-              s.sum_var_focal += sigma2 * bound.var_focal;
-              s.sum_eye2 += e.centre * e.centre;
-              s.sum_var_eye += sigma2 * bound.var_eye;
-              s.sum_rotation2 += e.rotation_deg * e.rotation_deg;
-              s.sum_var_rotation += sigma2 * bound.var_rotation;
-            }
-          }
+          MeasureScene(n, object, lens, index, config, &samples, &bound_warnings);
         }
       }
     }
@@ -955,20 +985,7 @@ int Main(const BenchOptions& options) {
   }
   std::cerr << "bench: " << rows.size() << " rows in " << Format(total_seconds, "%.1f")
             << " s -> " << options.out_dir << "/{results.csv,results.json,table.md}\n";
-  // Self-check (what makes --quick a smoke test): on noise-free pixels camproj must answer every
-  // scene at the truth. OpenCV's failures are results, not errors (calibrateCamera from the 80
-  // degree guess can settle in a local minimum even without noise).
-  int broken = 0;
-  for (const Row& r : rows) {
-    const bool ours = std::string(r.method->name).rfind("ours-", 0) == 0;
-    if (ours && r.cell.sigma == 0.0 && r.refused + r.outliers > 0) {
-      std::cerr << "bench: check failed: " << r.method->name << " failed " << r.refused + r.outliers
-                << " of " << r.scenes << " noise-free scenes (N = " << r.cell.n << ", "
-                << Name(r.cell.object) << ", " << Name(r.cell.lens) << ")\n";
-      ++broken;
-    }
-  }
-  return broken == 0 ? 0 : 3;
+  return NoiseFreeFailures(rows) == 0 ? 0 : 3;
 }
 
 }  // namespace
