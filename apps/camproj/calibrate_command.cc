@@ -220,7 +220,7 @@ void AddCalibrateOptions(CLI::App* app, CalibrateArgs* args) {
   app->add_option("--sigma", args->sigma,
                   "pixel noise (px, 1 sigma) for --model auto's criterion; default: estimated "
                   "from the richest model")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveFinite());
   app->add_flag("--keep-all-views", args->keep_all_views,
                 "keep views that do not fit the camera the others share (by default such a view, "
                 "more than 2.5x the others' RMS and beyond their noise, is left out and named)");

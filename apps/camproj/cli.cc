@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 
 namespace camproj::cli {
 
@@ -17,7 +18,38 @@ bool ParseDouble(const std::string& text, double* value) {
   return error == std::errc() && ptr == end && std::isfinite(*value);
 }
 
+// A validator of finite numbers `accepted` accepts; `requirement` words what it does not
+// ("positive"), `description` is the help's type suffix ("POSITIVE", or "" for none).
+CLI::Validator FiniteValidator(const std::function<bool(double)>& accepted,
+                               const std::string& requirement, const std::string& description) {
+  return CLI::Validator(
+      [accepted, requirement](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!ParseDouble(text, &value)) return "\"" + text + "\" is not a finite number";
+        if (!accepted(value)) return "must be " + requirement + ", got " + text;
+        return "";
+      },
+      description);
+}
+
 }  // namespace
+
+const CLI::Validator& FiniteNumber() {
+  static const CLI::Validator validator = FiniteValidator([](double) { return true; }, "", "");
+  return validator;
+}
+
+const CLI::Validator& PositiveFinite() {
+  static const CLI::Validator validator =
+      FiniteValidator([](double v) { return v > 0.0; }, "positive", "POSITIVE");
+  return validator;
+}
+
+const CLI::Validator& NonNegativeFinite() {
+  static const CLI::Validator validator =
+      FiniteValidator([](double v) { return v >= 0.0; }, "0 or more", "NONNEGATIVE");
+  return validator;
+}
 
 ImageSize ParseImageSize(const std::string& text, const std::string& option) {
   const size_t x = text.find('x');

@@ -30,6 +30,15 @@ ImageSize ParseImageSize(const std::string& text, const std::string& option);
 // "a,b,c" -> exactly `count` finite numbers; throws UsageError naming `option`.
 std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option);
 
+// Checks of a floating-point option's value, for CLI::Option::check: a finite number (what
+// ParseNumbers accepts), and above 0 or at least 0. CLI::PositiveNumber and NonNegativeNumber let
+// NaN through (a NaN --focal or --sigma was then taken as not given) and print the largest
+// double in full in their message. CLI11 prefixes the option's name to the message; the value is
+// refused with exit 1 before anything runs.
+const CLI::Validator& FiniteNumber();
+const CLI::Validator& PositiveFinite();
+const CLI::Validator& NonNegativeFinite();
+
 // Files named on the command line, a folder standing for its *.csv files (sorted); throws
 // UsageError for a folder without any.
 std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths);

@@ -48,9 +48,12 @@ Command AddConvertCommand(CLI::App& root) {
   from->add_option("--frustum", args->frustum, "left,right,bottom,top,near,far as glFrustum");
   from->require_option(1);
   app->add_option("--image-size", args->image_size, "WIDTHxHEIGHT")->required();
-  app->add_option("--skew", args->skew, "skew (px) with --intrinsics (only --to gl can carry it)");
-  app->add_option("--near", args->z_near, "near plane distance (with --intrinsics)");
-  app->add_option("--far", args->z_far, "far plane distance (with --intrinsics)");
+  app->add_option("--skew", args->skew, "skew (px) with --intrinsics (only --to gl can carry it)")
+      ->check(FiniteNumber());
+  app->add_option("--near", args->z_near, "near plane distance (with --intrinsics)")
+      ->check(FiniteNumber());
+  app->add_option("--far", args->z_far, "far plane distance (with --intrinsics)")
+      ->check(FiniteNumber());
   app->add_option("--to", args->to, "output")
       ->required()->check(CLI::IsMember({"frustum", "perspective", "gl", "intrinsics"}));
   app->add_option("--depth", args->depth, "gl: no = [-1,1], zo = [0,1]")->check(CLI::IsMember({"no", "zo"}));

@@ -267,8 +267,8 @@ Command AddExportCommand(CLI::App& root) {
       ->check(CLI::IsMember({"no", "zo"}));
   app->add_flag("--reversed-z", args->reversed_z, "near maps to 1, far to 0 (zo) or -1 (no)");
   app->add_flag("--infinite-far", args->infinite_far, "far plane at infinity");
-  app->add_option("--near", args->z_near, "override the near plane")->check(CLI::PositiveNumber);
-  app->add_option("--far", args->z_far, "override the far plane")->check(CLI::PositiveNumber);
+  app->add_option("--near", args->z_near, "override the near plane")->check(PositiveFinite());
+  app->add_option("--far", args->z_far, "override the far plane")->check(PositiveFinite());
   app->add_flag("--row-major", args->row_major, "gl: print rows instead of column-major order");
   app->add_option("--pixel-origin", args->pixel_origin, "json: convention of cx, cy written")
       ->check(CLI::IsMember({"center", "corner"}));

@@ -340,14 +340,14 @@ void AddModelOptions(CLI::App* app, FitArgs* args) {
   app->add_option("--fix", args->fit.fix, "hold these at their defaults (aspect 1, principal point at "
                                       "the image centre, skew 0, k 0)")
       ->delimiter(',')->check(CLI::IsMember(kParameterNames));
-  app->add_option("--focal", args->fit.focal, "fix the focal length fx (px)")->check(CLI::PositiveNumber);
+  app->add_option("--focal", args->fit.focal, "fix the focal length fx (px)")->check(PositiveFinite());
   app->add_option("--fovy", args->fit.fovy_deg, "fix the focal length by the vertical field of view (degrees)")
-      ->check(CLI::PositiveNumber);
-  app->add_option("--aspect", args->fit.aspect, "fix fy/fx")->check(CLI::PositiveNumber);
+      ->check(PositiveFinite());
+  app->add_option("--aspect", args->fit.aspect, "fix fy/fx")->check(PositiveFinite());
   app->add_option("--principal-point", args->principal_point, "fix cx,cy (px)");
-  app->add_option("--skew", args->fit.skew, "fix the skew (px)");
-  app->add_option("--k1", args->fit.k1, "fix k1");
-  app->add_option("--k2", args->fit.k2, "fix k2");
+  app->add_option("--skew", args->fit.skew, "fix the skew (px)")->check(FiniteNumber());
+  app->add_option("--k1", args->fit.k1, "fix k1")->check(FiniteNumber());
+  app->add_option("--k2", args->fit.k2, "fix k2")->check(FiniteNumber());
   app->add_option("--intrinsics,--shared-intrinsics", args->intrinsics_path,
                   "known intrinsics (a camera file, a calibration from `camproj calibrate`, or "
                   "{\"intrinsics\": {...}}): fit the pose only");
@@ -366,17 +366,17 @@ void AddRefinementOptions(CLI::App* app, FitArgs* args) {
   app->add_option("--ransac", args->fit.ransac_px,
                   "find mis-clicked points by RANSAC at this inlier threshold in px (e.g. 4) "
                   "instead of the automatic outlier stage; they are left out and listed")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveFinite());
   app->add_flag("--keep-all", args->fit.keep_all,
                 "keep every point: no automatic outlier stage (a scene with mis-clicks is then "
                 "refused by the consistency check, naming the worst points)");
   app->add_option("--sigma", args->fit.sigma,
                   "pixel noise per axis (px): the model selection, the consistency check and the "
                   "uncertainties use it; default: a 1 px prior for clicked points, combined with "
-                  "the residuals")->check(CLI::PositiveNumber);
+                  "the residuals")->check(PositiveFinite());
   app->add_option("--max-uncertainty", args->fit.max_uncertainty,
                   "refuse a camera the points determine more loosely than this (px, 1 sigma over "
-                  "the box the points span; default 5)")->check(CLI::PositiveNumber);
+                  "the box the points span; default 5)")->check(PositiveFinite());
   app->add_option("--object-points", args->object_points_path,
                   "CSV with X,Y,Z of the object's other points (e.g. the model's vertices): the "
                   "camera must be determined to --max-uncertainty there too, where they are in "
@@ -386,8 +386,8 @@ void AddRefinementOptions(CLI::App* app, FitArgs* args) {
 // The GL view: near, far, world origin; and the iteration budget.
 void AddViewOptions(CLI::App* app, FitArgs* args) {
   app->add_option("--near", args->fit.z_near, "near plane of the GL matrices (default: tight)")
-      ->check(CLI::PositiveNumber);
-  app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(CLI::PositiveNumber);
+      ->check(PositiveFinite());
+  app->add_option("--far", args->fit.z_far, "far plane (default: tight)")->check(PositiveFinite());
   app->add_option("--bounds", args->bounds,
                   "X0,Y0,Z0,X1,Y1,Z1: near and far cover this world box (e.g. the whole model; "
                   "its 8 corners' depths + 10 %) instead of the fitted points only");

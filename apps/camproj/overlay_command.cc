@@ -45,7 +45,7 @@ Command AddOverlayCommand(CLI::App& root) {
                   "image to write: PNG or JPEG by the extension (.png, .jpg, .jpeg)")->required();
   app->add_option("--magnify", args->magnify,
                   "residual magnification (default: the largest residual drawn 8 % of the image)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveFinite());
   app->add_option("--labels", args->labels_path,
                   "also write where each id was written, as CSV: id,kind,u,v,left,top,width,"
                   "height,residual_px");

@@ -37,15 +37,16 @@ Command AddSynthCommand(CLI::App& root) {
       "      -o points.csv --truth truth.json");
   app->add_option("--seed", args->seed, "random seed");
   app->add_option("--points", args->points, "number of points")->check(CLI::Range(1, 100000000));
-  app->add_option("--noise", args->noise, "pixel noise sigma per axis (px)")->check(CLI::NonNegativeNumber);
+  app->add_option("--noise", args->noise, "pixel noise sigma per axis (px)")->check(NonNegativeFinite());
   app->add_flag("--planar", args->planar, "points on a plane (same as --object plane)");
   app->add_option("--object", args->object, "cloud (in a box volume), box (its faces), plane")
       ->check(CLI::IsMember({"cloud", "box", "plane"}));
-  app->add_option("--fovy", args->fovy_deg, "vertical field of view (degrees)");
+  app->add_option("--fovy", args->fovy_deg, "vertical field of view (degrees)")
+      ->check(FiniteNumber());
   app->add_option("--principal-point-offset", args->principal_point_offset,
                   "DX,DY from the image centre as fractions of the image size (0,0.5: bottom edge)");
   app->add_option("--image-size", args->image_size, "WIDTHxHEIGHT");
-  app->add_option("--aspect", args->aspect, "fy/fx of the true camera");
+  app->add_option("--aspect", args->aspect, "fy/fx of the true camera")->check(FiniteNumber());
   app->add_option("-o,--output", args->output_path, "points CSV to write")->required();
   app->add_option("--truth", args->truth_path, "true camera file to write")->required();
   return {app, [args]() {
