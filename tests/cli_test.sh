@@ -805,6 +805,30 @@ json.load(open(rows[1]["camera_file"]))
     kill_batch TERM 0 CAMPROJ_TEST_NO_TMPFILE=1
     kill_batch HUP 0.05 CAMPROJ_TEST_NO_TMPFILE=1
     ;;
+  outputs_distinct_all_or_nothing)
+    # Two outputs of one command naming one file are refused before any work (the second write
+    # destroyed the first, exit 0, before session 37); where the second cannot be written, the
+    # first is not written either (it was left behind with exit 2).
+    boards="$data/real/opencv_chessboard"
+    points="$data/projector/points.csv"
+    cd "$work" || fail "cd"
+    expect_exit 1 "$bin" synth -o same.json --truth ./same.json
+    expect_in err "usage: -o and --truth both name ./same.json: give each output its own path"
+    expect_exit 1 "$bin" calibrate "$boards"/left0[1-5].csv --image-size 640x480 -o c.json --poses c.json
+    expect_in err "usage: -o and --poses both name c.json"
+    expect_exit 1 "$bin" fit "$points" --image-size 1920x1080 -o r.svg --report sub/../r.svg
+    expect_in err "usage: -o and --report both name sub/../r.svg"
+    expect_exit 0 "$bin" fit "$points" --image-size 1920x1080 -o cam.json
+    expect_exit 1 "$bin" overlay cam.json "$points" -o o.png --labels o.png
+    expect_in err "usage: -o and --labels both name o.png"
+    expect_exit 2 "$bin" synth -o pts.csv --truth missing/t.json
+    expect_exit 2 "$bin" calibrate "$boards"/left0[1-5].csv --image-size 640x480 -o c2.json --poses missing/p.csv
+    expect_exit 2 "$bin" fit "$points" --image-size 1920x1080 -o cam2.json --report missing/r.svg
+    expect_exit 2 "$bin" overlay cam.json "$points" -o o2.png --labels missing/l.csv
+    expect_in err "cannot write missing/l.csv: cannot create a file in missing: No such file or directory"
+    left=$(ls -A | grep -v '^cam.json$\|^out$\|^err$')
+    [[ -z "$left" ]] || fail "outputs left behind by failed or refused commands: $left"
+    ;;
   file_size_limit)
     # ulimit -f 2 (2 KiB) is below a camera file (~6 KB): exit 2 naming the file and the reason,
     # no partial file (main died of SIGXFSZ leaving out.json.tmp.XXXXXX).

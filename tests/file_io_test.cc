@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include "camproj/errors.h"
 #include "seeds.h"
 #include "write_until_killed.h"
 
@@ -126,6 +128,85 @@ TEST(FileIoTest, SignalDuringWritesLeavesWholeFilesAndNoTemporary) {
                failures, kRoundsPerMode, 0.0);
   }
   fs::remove_all(root);
+}
+
+// A fresh folder under the temporary directory, removed at the end of the test.
+class TemporaryFolder {
+ public:
+  explicit TemporaryFolder(const std::string& name)
+      : path_(fs::temp_directory_path() / (name + "_" + std::to_string(getpid()))) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TemporaryFolder() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+  // The names in the folder, sorted.
+  std::vector<std::string> Names() const {
+    std::vector<std::string> names;
+    for (const fs::directory_entry& e : fs::directory_iterator(path_)) {
+      names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+ private:
+  fs::path path_;
+};
+
+TEST(FileIoTest, SameFileResolvesDotsLinksAndHardLinks) {
+  const TemporaryFolder folder("camproj_same_file");
+  const fs::path& d = folder.path();
+  fs::create_directories(d / "sub");
+  fs::create_directory_symlink(d / "sub", d / "link");
+  const std::string a = (d / "a.json").string();
+  EXPECT_TRUE(SameFile(a, (d / "sub" / ".." / "a.json").string()));  // neither exists
+  EXPECT_TRUE(SameFile((d / "link" / "c.json").string(), (d / "sub" / "c.json").string()));
+  EXPECT_FALSE(SameFile(a, (d / "b.json").string()));
+  WriteFileAtomically(a, "a");
+  fs::create_hard_link(a, d / "hard.json");
+  EXPECT_TRUE(SameFile(a, (d / "hard.json").string()));
+  fs::create_symlink(a, d / "soft.json");
+  EXPECT_TRUE(SameFile((d / "soft.json").string(), a));
+  // A relative path and its absolute form.
+  const fs::path before = fs::current_path();
+  fs::current_path(d);
+  EXPECT_TRUE(SameFile("./x.json", (d / "x.json").string()));
+  EXPECT_TRUE(SameFile("x.json", "./x.json"));
+  fs::current_path(before);
+}
+
+TEST(FileIoTest, WriteFilesAtomicallyWritesAllOrNone) {
+  const TemporaryFolder folder("camproj_write_files");
+  const fs::path& d = folder.path();
+  const std::string first = (d / "first.json").string();
+  const std::string second = (d / "second.csv").string();
+  WriteFilesAtomically({{first, "one", "-o"}, {second, "two", "--poses"}});
+  EXPECT_EQ(ReadWholeFile(first), "one");
+  EXPECT_EQ(ReadWholeFile(second), "two");
+  // The second cannot be written (its folder does not exist): the first keeps its old
+  // contents, a new first output is not created, and no temporary is left.
+  const std::string missing = (d / "missing" / "x.csv").string();
+  for (const bool named : {false, true}) {
+    if (named) setenv("CAMPROJ_TEST_NO_TMPFILE", "1", 1);
+    EXPECT_THROW(WriteFilesAtomically({{first, "changed", "-o"}, {missing, "x", "--poses"}}),
+                 InputError);
+    EXPECT_THROW(WriteFilesAtomically({{(d / "new.json").string(), "new", "-o"},
+                                       {missing, "x", "--poses"}}),
+                 InputError);
+    if (named) unsetenv("CAMPROJ_TEST_NO_TMPFILE");
+    EXPECT_EQ(ReadWholeFile(first), "one");
+    EXPECT_EQ(folder.Names(), (std::vector<std::string>{"first.json", "second.csv"}));
+  }
+  // Two outputs naming one file: refused before anything is written, naming both.
+  try {
+    WriteFilesAtomically({{(d / "n.json").string(), "a", "-o"},
+                          {(d / "." / "n.json").string(), "b", "--truth"}});
+    ADD_FAILURE() << "two outputs naming one file were written";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("-o and --truth both name"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(folder.Names(), (std::vector<std::string>{"first.json", "second.csv"}));
 }
 
 }  // namespace

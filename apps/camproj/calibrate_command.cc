@@ -179,6 +179,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   options.remove_outliers = !args.keep_all_points;
   const PixelOrigin origin = PixelOriginFromString(args.pixel_origin);
   const std::vector<std::string> inputs = ExpandInputs(args.view_paths);
+  RequireDistinctOutputs({{"-o", args.output_path}, {"--poses", args.poses_path}});
   RequireOutputIsNotAnInput(args.output_path, inputs);
   if (!args.poses_path.empty()) RequireOutputIsNotAnInput(args.poses_path, inputs);
 
@@ -186,11 +187,12 @@ int RunCalibrate(const CalibrateArgs& args) {
   const Calibration calibration = Calibrate(views, options);
   CameraFileOptions file_options;
   file_options.pixel_origin = origin;
-  // Both files are made before either is written: a failure leaves neither.
+  // Both files are made before either is written, and written as one: a failure leaves neither.
   const std::string calibration_text = CalibrationToJsonText(calibration, file_options);
   const std::string poses_text = CalibrationPosesCsvText(calibration, file_options);
-  WriteFileAtomically(args.output_path, calibration_text);
-  if (!args.poses_path.empty()) WriteFileAtomically(args.poses_path, poses_text);
+  std::vector<OutputFile> outputs = {{args.output_path, calibration_text, "-o"}};
+  if (!args.poses_path.empty()) outputs.push_back({args.poses_path, poses_text, "--poses"});
+  WriteFilesAtomically(outputs);
   std::cout << TerminalSafe(CalibrationSummaryText(calibration, origin, args));
   return kExitOk;
 }

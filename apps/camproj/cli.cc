@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <functional>
 
+#include "camproj/file_io.h"
+
 namespace camproj::cli {
 
 namespace {
@@ -86,6 +88,18 @@ std::vector<double> ParseNumbers(const std::string& text, size_t count, const st
                      text + "\"");
   }
   return numbers;
+}
+
+void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
+          SameFile(outputs[i].second, outputs[j].second)) {
+        throw UsageError(outputs[j].first + " and " + outputs[i].first + " both name " +
+                         outputs[i].second + ": give each output its own path");
+      }
+    }
+  }
 }
 
 std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths) {

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -38,6 +39,10 @@ std::vector<double> ParseNumbers(const std::string& text, size_t count, const st
 const CLI::Validator& FiniteNumber();
 const CLI::Validator& PositiveFinite();
 const CLI::Validator& NonNegativeFinite();
+
+// Throws UsageError if two of the outputs (option, path) name one file (SameFile, file_io.h):
+// the second write would destroy the first. Call it before any work. Empty paths are skipped.
+void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // Files named on the command line, a folder standing for its *.csv files (sorted); throws
 // UsageError for a folder without any.

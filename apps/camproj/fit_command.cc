@@ -432,6 +432,7 @@ void PrintNotes(const FitRequest& request, const FitResult& fit) {
 int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest& request,
                const FitArgs& args) {
   const auto begin = std::chrono::steady_clock::now();
+  RequireDistinctOutputs({{"-o", args.output_path}, {"--report", args.report_path}});
   if (!args.output_path.empty()) {
     RequireOutputIsNotAnInput(args.output_path, {input, args.intrinsics_path,
                                                  args.object_points_path, args.bounds_mesh_path});
@@ -448,19 +449,23 @@ int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest
   }
   const auto [data, fit] = FitFile(input, size, request);
   const std::string text = CameraFileTextOf(fit, request.options().pixel_origin);
-  if (!args.output_path.empty()) WriteFileAtomically(args.output_path, text);
+  // The camera file and the report as one write: a report that cannot be written leaves no
+  // camera file either.
+  std::vector<OutputFile> outputs;
+  if (!args.output_path.empty()) outputs.push_back({args.output_path, text, "-o"});
   if (!args.report_path.empty()) {
     std::vector<Eigen::Vector2d> observed = data.pixels;
     for (auto& p : observed) {
       p = ConvertPixelOrigin(p, request.options().pixel_origin, PixelOrigin::kCenter);
     }
-    WriteFileAtomically(
-        args.report_path,
-        FitReportFormatOfPath(args.report_path) == "svg"
-            ? FitReportSvg(fit, observed, data.ids)
-            : FitReportHtml(fit, observed, data.ids, FitSummaryText(fit, data.ids),
-                            "camproj fit " + input));
+    outputs.push_back({args.report_path,
+                       FitReportFormatOfPath(args.report_path) == "svg"
+                           ? FitReportSvg(fit, observed, data.ids)
+                           : FitReportHtml(fit, observed, data.ids, FitSummaryText(fit, data.ids),
+                                           "camproj fit " + input),
+                       "--report"});
   }
+  WriteFilesAtomically(outputs);
   if (args.json) {
     std::cout << text;
   } else {

@@ -52,6 +52,7 @@ Command AddOverlayCommand(CLI::App& root) {
   app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
       ->check(CLI::IsMember({"center", "corner"}));
   return {app, [args]() {
+            RequireDistinctOutputs({{"-o", args->output_path}, {"--labels", args->labels_path}});
             RequireOutputIsNotAnInput(args->output_path,
                                       {args->camera_path, args->points_path, args->image_path});
             if (!args->labels_path.empty()) {
@@ -73,15 +74,18 @@ Command AddOverlayCommand(CLI::App& root) {
             options.magnify = args->magnify;
             options.background_path = args->image_path;
             options.outliers = OutlierIndicesFromJsonText(camera_text, args->camera_path);
-            OverlayStats stats;
+            OverlayPicture picture;
             try {
-              stats = WriteOverlayImage(camera, points, options, args->output_path);
+              picture = DrawOverlayImage(camera, points, options, ImageFormatOfPath(args->output_path));
             } catch (const std::invalid_argument& e) {
               throw InputError(args->camera_path + ": " + e.what());
             }
+            const OverlayStats& stats = picture.stats;
+            std::vector<OutputFile> outputs = {{args->output_path, picture.encoded, "-o"}};
             if (!args->labels_path.empty()) {
-              WriteFileAtomically(args->labels_path, OverlayLabelsCsv(stats));
+              outputs.push_back({args->labels_path, OverlayLabelsCsv(stats), "--labels"});
             }
+            WriteFilesAtomically(outputs);
             std::cout << "wrote " << args->output_path << " (" << stats.drawn << " points";
             if (stats.outliers > 0) std::cout << ", " << stats.outliers << " outliers";
             if (stats.behind > 0) std::cout << ", " << stats.behind << " behind the camera";

@@ -66,13 +66,14 @@ Command AddSynthCommand(CLI::App& root) {
             } catch (const std::invalid_argument& e) {
               throw UsageError(e.what());
             }
+            RequireDistinctOutputs({{"-o", args->output_path}, {"--truth", args->truth_path}});
             const SynthScene scene = SynthesizeScene(options);
             const std::string csv =
                 "# camproj synth --seed " + std::to_string(args->seed) + " --points " +
                 std::to_string(args->points) + " (pixels: OpenCV convention)\n" +
                 CorrespondencesToCsvText(scene.correspondences);
-            WriteFileAtomically(args->output_path, csv);
-            WriteFileAtomically(args->truth_path, CameraToJsonText(scene.truth));
+            WriteFilesAtomically({{args->output_path, csv, "-o"},
+                                  {args->truth_path, CameraToJsonText(scene.truth), "--truth"}});
             std::cout << "wrote " << args->output_path << " (" << args->points << " points) and "
                       << args->truth_path << "\n";
             return kExitOk;

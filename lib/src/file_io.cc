@@ -15,6 +15,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <system_error>
 
 #include "camproj/errors.h"
 
@@ -262,33 +266,52 @@ void InstallTemporaryFileCleanup() {
   std::signal(SIGXFSZ, SIG_IGN);
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& contents) {
-  const std::string target = ResolveLinks(path);
-  const std::string folder = FolderOf(target);
+namespace {
+
+// A write whose data is in its temporary, flushed, not yet under the target's name: the
+// temporary (unnamed, or named and registered for the signal handler) is removed if the write
+// is dropped before CommitWrite.
+struct PreparedWrite {
+  std::string path;    // as given, for messages
+  std::string target;  // links resolved
+  std::string folder;
+  bool replacing = false;
+  bool unnamed = false;
+  TemporaryGuard temporary;
+  SignalCleanup cleanup;
+};
+
+// Everything of a write but giving the file its name: the temporary in the target's folder,
+// the contents, the replaced file's owner and permissions, fsync.
+std::unique_ptr<PreparedWrite> PrepareWrite(const std::string& path, const std::string& contents) {
+  auto write = std::make_unique<PreparedWrite>();
+  write->path = path;
+  write->target = ResolveLinks(path);
+  write->folder = FolderOf(write->target);
+  const std::string& folder = write->folder;
   struct stat existing {};
-  const bool replacing = stat(target.c_str(), &existing) == 0;
-  if (replacing && !S_ISREG(existing.st_mode)) {
+  write->replacing = stat(write->target.c_str(), &existing) == 0;
+  if (write->replacing && !S_ISREG(existing.st_mode)) {
     throw InputError("cannot write " + path + ": it is " + KindOf(existing.st_mode) +
                      ", not a regular file");
   }
 
-  TemporaryGuard temporary;
+  TemporaryGuard& temporary = write->temporary;
   // An unnamed file first: nothing to leave behind if the process dies while writing. The test
   // suite sets CAMPROJ_TEST_NO_TMPFILE to run the fallback on file systems that have O_TMPFILE.
   const bool try_unnamed = std::getenv("CAMPROJ_TEST_NO_TMPFILE") == nullptr;
   temporary.fd = try_unnamed ? open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666) : -1;
-  const bool unnamed = temporary.fd >= 0;
-  std::string name;
-  SignalCleanup cleanup;
-  if (!unnamed) {
+  write->unnamed = temporary.fd >= 0;
+  if (!write->unnamed) {
     const CreationWindow window;
+    std::string name;
     for (int attempt = 0; attempt < 100 && temporary.fd < 0; ++attempt) {
       name = TemporaryName(folder);
-      cleanup.Set(name);
+      write->cleanup.Set(name);
       temporary.fd = open(name.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0666);
       if (temporary.fd < 0) {
         const int error = errno;
-        cleanup.Clear();
+        write->cleanup.Clear();
         if (error != EEXIST) {
           throw InputError("cannot write " + path + ": cannot create a file in " + folder + ": " +
                            ErrnoText(error));
@@ -300,7 +323,7 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
     AbandonIfDying(name);
   }
   WriteAll(temporary.fd, contents, path);
-  if (replacing) {
+  if (write->replacing) {
     // The replaced file's owner and permissions carry over (the owner only where allowed).
     if (fchown(temporary.fd, existing.st_uid, existing.st_gid) != 0) {
       // Not the owner: the new file is ours, with the old permission bits.
@@ -310,11 +333,22 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
     }
   }
   if (fsync(temporary.fd) != 0) throw InputError("cannot write " + path + ": fsync: " + ErrnoText(errno));
-  if (unnamed) {
+  return write;
+}
+
+// Gives a prepared write the target's name: linkat for a new file from an unnamed temporary,
+// else a short temporary name and rename over the target.
+void CommitWrite(PreparedWrite* write) {
+  const std::string& path = write->path;
+  const std::string& target = write->target;
+  const std::string& folder = write->folder;
+  TemporaryGuard& temporary = write->temporary;
+  std::string name = temporary.name;
+  if (write->unnamed) {
     const std::string fd_path = "/proc/self/fd/" + std::to_string(temporary.fd);
     // A new file gets its final name at once: no instant with a named temporary, which a kill
     // there would leave behind (a batch writing into a fresh folder; seen under load).
-    if (!replacing) {
+    if (!write->replacing) {
       if (linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, target.c_str(), AT_SYMLINK_FOLLOW) == 0) {
         const int fd = temporary.fd;
         temporary.fd = -1;
@@ -329,17 +363,17 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
     const CreationWindow window;
     for (int attempt = 0; attempt < 100; ++attempt) {
       name = TemporaryName(folder);
-      cleanup.Set(name);
+      write->cleanup.Set(name);
       if (linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
         AbandonIfDying(name);
         break;
       }
       if (errno != EEXIST) {
         const int error = errno;
-        cleanup.Clear();
+        write->cleanup.Clear();
         throw InputError("cannot write " + path + ": link: " + ErrnoText(error));
       }
-      cleanup.Clear();
+      write->cleanup.Clear();
       name.clear();
     }
     if (name.empty()) throw InputError("cannot write " + path + ": no free temporary name in " + folder);
@@ -356,6 +390,43 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   }
   temporary.name.clear();
   SweepStaleTemporaries(folder);
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& contents) {
+  const std::unique_ptr<PreparedWrite> write = PrepareWrite(path, contents);
+  CommitWrite(write.get());
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  // Absolute first: weakly_canonical leaves a relative path with no existing prefix relative.
+  std::error_code error;
+  const std::filesystem::path canonical_a =
+      std::filesystem::weakly_canonical(std::filesystem::absolute(a, error), error);
+  if (error) return false;
+  const std::filesystem::path canonical_b =
+      std::filesystem::weakly_canonical(std::filesystem::absolute(b, error), error);
+  if (error) return false;
+  if (canonical_a == canonical_b) return true;
+  struct stat info_a {};
+  struct stat info_b {};
+  return stat(a.c_str(), &info_a) == 0 && stat(b.c_str(), &info_b) == 0 &&
+         info_a.st_dev == info_b.st_dev && info_a.st_ino == info_b.st_ino;
+}
+
+void WriteFilesAtomically(const std::vector<OutputFile>& files) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (SameFile(files[i].path, files[j].path)) {
+        throw std::invalid_argument(files[j].what + " and " + files[i].what + " both name " +
+                                    files[i].path + ": give each output its own path");
+      }
+    }
+  }
+  std::vector<std::unique_ptr<PreparedWrite>> writes;
+  for (const OutputFile& file : files) writes.push_back(PrepareWrite(file.path, file.contents));
+  for (const std::unique_ptr<PreparedWrite>& write : writes) CommitWrite(write.get());
 }
 
 InputFile::InputFile(const std::string& path) : path_(path) {

@@ -295,11 +295,10 @@ Box DrawLegend(cv::Mat& image, const OverlayStats& stats, const std::vector<Eige
 
 }  // namespace
 
-OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
-                               const OverlayOptions& options, const std::string& output_path) {
+OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& correspondences,
+                                const OverlayOptions& options, ImageFormat format) {
   options.Check();
   camera.Check();
-  const ImageFormat format = ImageFormatOfPath(output_path);
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
   if (int64_t{w} * h > kMaxImagePixels) {
@@ -439,10 +438,17 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
   if (!internal::EncodeImage(extension, image, &encoded)) {
-    throw InputError(internal::Concat(output_path, ": cannot encode the image as ", extension));
+    throw InputError(internal::Concat("cannot encode the image as ", extension));
   }
-  WriteFileAtomically(output_path, std::string(encoded.begin(), encoded.end()));
-  return stats;
+  return {std::string(encoded.begin(), encoded.end()), std::move(stats)};
+}
+
+OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
+                               const OverlayOptions& options, const std::string& output_path) {
+  OverlayPicture picture =
+      DrawOverlayImage(camera, correspondences, options, ImageFormatOfPath(output_path));
+  WriteFileAtomically(output_path, picture.encoded);
+  return std::move(picture.stats);
 }
 
 std::string OverlayLabelsCsv(const OverlayStats& stats) {

@@ -23,6 +23,26 @@ namespace camproj {
 // SIGXFSZ is ignored as InstallTemporaryFileCleanup arranges) and removes the temporary.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
+// One output of a command that writes several: the path, the bytes, and what names it in
+// messages (an option: "-o", "--truth").
+struct OutputFile {
+  std::string path;
+  std::string contents;
+  std::string what;
+};
+
+// Writes every file as WriteFileAtomically does, but none gets its name until every one's data
+// is in its temporary, flushed: a failure before that (a folder that does not exist or is not
+// writable, a full disk, `ulimit -f`) leaves every target as it was and no temporary. (A failure
+// of a later rename, after an earlier file was renamed, is reported but leaves the earlier one
+// replaced; a rename within a folder fails only on a full directory or a changed file system.)
+// Throws std::invalid_argument, before writing anything, if two paths name one file (SameFile).
+void WriteFilesAtomically(const std::vector<OutputFile>& files);
+
+// Whether two paths name one file: the same path once symbolic links and "." / ".." are
+// resolved (the file need not exist), or two existing hard links to one inode.
+bool SameFile(const std::string& a, const std::string& b);
+
 // Installs handlers that remove the temporary of a WriteFileAtomically in progress on SIGINT,
 // SIGTERM and SIGHUP, then die of the signal as before; ignores SIGXFSZ so that a write beyond
 // `ulimit -f` fails with EFBIG (reported, temporary removed) instead of killing the process.

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "camproj/camera.h"
+#include "camproj/image_header.h"
 #include "camproj/points_file.h"
 
 namespace camproj {
@@ -50,6 +51,17 @@ struct OverlayStats {
   double largest_residual_px = 0.0; // among the points the fit kept (the colour scale's top)
   std::vector<OverlayLabel> labels;  // one per point, in the order of the correspondences
 };
+
+// The picture, encoded, and what was drawn.
+struct OverlayPicture {
+  std::string encoded;  // the PNG or JPEG file's bytes
+  OverlayStats stats;
+};
+
+// Draws the picture and encodes it as `format`, writing nothing (WriteOverlayImage writes it).
+// Throws as WriteOverlayImage does, but for the output.
+OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& correspondences,
+                                const OverlayOptions& options, ImageFormat format);
 
 // Draws and writes the picture to `output_path` atomically, as PNG or JPEG by its extension
 // (ImageFormatOfPath). Pixels of `correspondences` are in kCenter.
