@@ -312,6 +312,31 @@ PY
         -o "$work/c.json" --sigma 0
     expect_in err "^--sigma: must be positive, got 0"
     [[ ! -e "$work/p.csv" && ! -e "$work/c.json" ]] || fail "a refused option left a file"
+    # Options that would be dropped are refused (before session 37 each was ignored, exit 0):
+    # a value beside --intrinsics, intrinsics of another image size, --skew/--near/--far with
+    # --frustum; and an image side the camera files cannot record.
+    truth="$data/projector/truth.json"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --intrinsics "$truth" --focal 1000 --k1 0
+    expect_in err "usage: --intrinsics gives every intrinsic (the pose alone is fitted): leave out --focal, --k1, or leave out --intrinsics"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --intrinsics "$truth" --model focal+principal-point
+    expect_in err "leave out --model focal+principal-point"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 640x480 --intrinsics "$truth"
+    expect_in err "usage: --intrinsics .*truth.json is for a 1920x1080 image, but --image-size is 640x480"
+    expect_exit 0 "$bin" fit "$local_points" --image-size 1920x1080 --intrinsics "$truth" --model pose
+    expect_exit 1 "$bin" convert --frustum -0.05,0.05,-0.05,0.05,0.1,1 --image-size 100x100 --to gl --near 5
+    expect_in err "usage: --skew, --near and --far go with --intrinsics"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 2000000x1000
+    expect_in err "usage: --image-size: at most 1000000 px per side"
+    expect_exit 1 "$bin" synth --image-size 1000x2000000 -o "$work/p.csv" --truth "$work/t.json"
+    # Conversions whose results overflow a double are refused, never printed as inf or 0.
+    expect_exit 2 "$bin" convert --frustum -1e-310,1e-310,-0.1,0.1,0.1,1 --image-size 100x100 --to intrinsics
+    expect_in err "the frustum's intrinsics are not finite"
+    expect_exit 2 "$bin" convert --intrinsics 100,100,49.5,49.5 --image-size 100x100 --near 0.1 --far 1 --to gl --skew 1e308
+    expect_in err "the projection matrix is not finite"
+    expect_exit 2 "$bin" convert --frustum -1e308,1e308,-0.1,0.1,1e-308,1 --image-size 100x100 --to gl
+    expect_in err "the frustum's width and height must be finite"
+    expect_exit 2 "$bin" convert --intrinsics 100,100,1e308,50 --image-size 100x100 --near 0.1 --far 1 --to frustum
+    expect_in err "frustum left must be less than right"
     expect_exit 0 "$bin" --help
     expect_in out "Exit codes"
     expect_exit 0 "$bin" fit --help

@@ -55,6 +55,9 @@ TEST(ConventionsTest, StringsRoundTripAndBadTextIsNamed) {
 TEST(ConventionsTest, ZeroSizeImageIsRefused) {
   EXPECT_THROW((ImageSize{0, 480}.Check()), std::invalid_argument);
   EXPECT_THROW((ImageSize{640, -1}.Check()), std::invalid_argument);
+  // The camera files' limit: a side beyond it would be written and then refused on reading.
+  EXPECT_NO_THROW((ImageSize{kMaxImageSide, kMaxImageSide}.Check()));
+  EXPECT_THROW((ImageSize{kMaxImageSide + 1, 480}.Check()), std::invalid_argument);
   EXPECT_THROW(WindowFromPixel({0, 0}, ImageSize{0, 0}), std::invalid_argument);
 }
 

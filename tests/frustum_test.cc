@@ -189,5 +189,22 @@ TEST(FrustumTest, BadInputIsNamed) {
   expect_message([&] { WindowFromNdc({0, 0, 0}, Viewport{0, 0, 0, 10}); }, "viewport");
 }
 
+// Conversions whose results a double cannot hold throw instead of returning inf, 0 or a
+// collapsed frustum (camproj convert printed them with exit 0 before session 37).
+TEST(FrustumTest, OverflowingConversionsThrow) {
+  const ImageSize size{100, 100};
+  // r - l overflows: the matrix's scale would be 0.
+  EXPECT_THROW(ClipFromGlEye(Frustum{-1e308, 1e308, -0.1, 0.1, 1e-308, 1.0}), std::invalid_argument);
+  // Extents below what near can be divided by: fx = near W / (r - l) = inf.
+  EXPECT_THROW(IntrinsicsFromFrustum(Frustum{-1e-310, 1e-310, -0.1, 0.1, 0.1, 1.0}, size),
+               std::invalid_argument);
+  // cx = 1e308: left and right round to the same plane.
+  Intrinsics k;
+  k.fx = k.fy = 100.0;
+  k.cx = 1e308;
+  k.cy = 50.0;
+  EXPECT_THROW(FrustumFromIntrinsics(k, size, 0.1, 1.0), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace camproj

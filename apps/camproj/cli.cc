@@ -62,6 +62,10 @@ ImageSize ParseImageSize(const std::string& text, const std::string& option) {
     const auto [h_end, h_error] = std::from_chars(text.data() + x + 1, text.data() + text.size(), height);
     if (w_error == std::errc() && h_error == std::errc() && w_end == text.data() + x &&
         h_end == text.data() + text.size() && width > 0 && height > 0) {
+      if (width > kMaxImageSide || height > kMaxImageSide) {
+        throw UsageError(option + ": at most " + std::to_string(kMaxImageSide) +
+                         " px per side, got \"" + text + "\"");
+      }
       return {width, height};
     }
   }

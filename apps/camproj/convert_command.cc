@@ -1,6 +1,7 @@
 // camproj convert: intrinsics <-> frustum <-> perspective <-> GL projection, on command-line values.
 #include <iomanip>
 #include <iostream>
+#include <stdexcept>
 #include <limits>
 #include <memory>
 
@@ -26,6 +27,10 @@ struct ConvertArgs {
 };
 
 void PrintMatrix(const Eigen::Matrix4d& m) {
+  if (!m.allFinite()) {
+    throw std::invalid_argument("the projection matrix is not finite: the values are too large "
+                                "for a double");
+  }
   std::cout << "projection (column-major)";
   for (int i = 0; i < 16; ++i) std::cout << ' ' << m.data()[i];
   std::cout << '\n';
@@ -69,6 +74,10 @@ Command AddConvertCommand(CLI::App& root) {
               const Frustum frustum{f[0], f[1], f[2], f[3], f[4], f[5]};
               if (args->to != "intrinsics" && args->to != "gl" && args->to != "perspective") {
                 throw UsageError("--frustum converts --to intrinsics, perspective or gl");
+              }
+              if (args->skew != 0.0 || args->z_near != 0.0 || args->z_far != 0.0) {
+                throw UsageError("--skew, --near and --far go with --intrinsics: a frustum has "
+                                 "its own near and far, and no skew");
               }
               if (args->to == "intrinsics") {
                 const Intrinsics k = IntrinsicsFromFrustum(frustum, size, origin);

@@ -98,6 +98,17 @@ json Matrix4Json(const Eigen::Matrix4d& m) {
 
 json FarJson(double z_far) { return std::isinf(z_far) ? json("inf") : json(z_far); }
 
+// The document's "image_size": [width, height], whole numbers in [1, kMaxImageSide].
+ImageSize ReadImageSize(const json& document, const Reader& reader) {
+  const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
+  if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
+      size[1] < 1 || size[0] > kMaxImageSide || size[1] > kMaxImageSide) {
+    reader.Fail("image_size", internal::Concat("expected two positive integers (width, height), at most ",
+                                               kMaxImageSide, " each"));
+  }
+  return {static_cast<int>(size[0]), static_cast<int>(size[1])};
+}
+
 // The intrinsics of a camera-file document, in kCenter.
 Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
   PixelOrigin origin = PixelOrigin::kCenter;
@@ -185,12 +196,7 @@ namespace {
 // A camera file's document, or a calibration file's views[i].camera.
 Camera CameraFromDocument(const json& document, const Reader& reader) {
   Camera camera;
-  const Eigen::VectorXd size = reader.Vector(reader.Member(document, "", "image_size"), "image_size", 2);
-  if (size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]) || size[0] < 1 ||
-      size[1] < 1 || size[0] > 1e6 || size[1] > 1e6) {
-    reader.Fail("image_size", "expected two positive integers (width, height)");
-  }
-  camera.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
+  camera.image_size = ReadImageSize(document, reader);
 
   camera.intrinsics = ReadIntrinsics(document, reader);
   if (document.contains("projection")) {
@@ -332,13 +338,23 @@ Camera ReadCalibrationView(const std::string& path, const std::string& view) {
   return CalibrationViewFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path, view);
 }
 
-Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source) {
-  return ReadIntrinsics(ParseJson(text, source), Reader(source));
+Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source,
+                                  std::optional<ImageSize>* image_size) {
+  const json document = ParseJson(text, source);
+  const Reader reader(source);
+  const Intrinsics intrinsics = ReadIntrinsics(document, reader);
+  if (image_size != nullptr) {
+    *image_size = std::nullopt;
+    if (document.is_object() && document.contains("image_size")) {
+      *image_size = ReadImageSize(document, reader);
+    }
+  }
+  return intrinsics;
 }
 
-Intrinsics ReadIntrinsicsFile(const std::string& path) {
+Intrinsics ReadIntrinsicsFile(const std::string& path, std::optional<ImageSize>* image_size) {
   // Also a calibration file's intrinsics (`camproj fit --intrinsics CALIB.json`).
-  return IntrinsicsFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path);
+  return IntrinsicsFromJsonText(ReadWholeFile(path, kMaxCalibrationFileBytes), path, image_size);
 }
 
 std::vector<int> OutlierIndicesFromJsonText(const std::string& text, const std::string& source) {

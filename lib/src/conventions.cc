@@ -8,6 +8,8 @@ using internal::Require;
 
 void ImageSize::Check() const {
   Require(width > 0 && height > 0, "image size must be positive, got ", width, "x", height);
+  Require(width <= kMaxImageSide && height <= kMaxImageSide, "image size must be at most ",
+          kMaxImageSide, " px per side, got ", width, "x", height);
 }
 
 Eigen::Matrix3d GlEyeFromCam() { return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal(); }

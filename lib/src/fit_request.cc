@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
@@ -133,6 +135,26 @@ void SetModel(const FitArguments& args, const ImageSize& size, FitOptions* optio
 void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool automatic,
                         FitOptions* options_out) {
   FitOptions& options = *options_out;
+  if (args.known_intrinsics) {
+    // --intrinsics gives every intrinsic: a value or mode beside it would be dropped.
+    std::vector<std::string> given;
+    if (args.model != "auto" && args.model != "pose") given.push_back("--model " + args.model);
+    if (args.focal > 0.0) given.push_back("--focal");
+    if (args.fovy_deg > 0.0) given.push_back("--fovy");
+    if (args.aspect > 0.0) given.push_back("--aspect");
+    if (args.principal_point) given.push_back("--principal-point");
+    if (!std::isnan(args.skew)) given.push_back("--skew");
+    if (!std::isnan(args.k1)) given.push_back("--k1");
+    if (!std::isnan(args.k2)) given.push_back("--k2");
+    if (!args.free.empty()) given.push_back("--free");
+    if (!args.fix.empty()) given.push_back("--fix");
+    if (!given.empty()) {
+      std::string list = given[0];
+      for (size_t i = 1; i < given.size(); ++i) list += ", " + given[i];
+      throw std::invalid_argument("--intrinsics gives every intrinsic (the pose alone is fitted): "
+                                  "leave out " + list + ", or leave out --intrinsics");
+    }
+  }
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {
     if (name == "focal") {

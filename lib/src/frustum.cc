@@ -43,6 +43,11 @@ void Frustum::Check() const {
           ", right = ", right);
   Require(bottom < top, "frustum bottom must be less than top, got bottom = ", bottom,
           ", top = ", top);
+  // The projection divides by the extents: beyond the largest double they overflow to infinity
+  // (and the matrix's scale entries to 0).
+  Require(std::isfinite(right - left) && std::isfinite(top - bottom),
+          "the frustum's width and height must be finite, got right - left = ", right - left,
+          ", top - bottom = ", top - bottom);
   CheckNearFar(z_near, z_far);
 }
 
@@ -123,6 +128,8 @@ Frustum FrustumFromIntrinsics(const Intrinsics& intrinsics, const ImageSize& siz
   frustum.bottom = -z_near * (size.height - k.cy) / k.fy;
   frustum.z_near = z_near;
   frustum.z_far = z_far;
+  // Extreme values (a principal point of 1e308 px) overflow or collapse the planes.
+  frustum.Check();
   return frustum;
 }
 
@@ -135,6 +142,11 @@ Intrinsics IntrinsicsFromFrustum(const Frustum& frustum, const ImageSize& size,
   corner.fy = frustum.z_near * size.height / (frustum.top - frustum.bottom);
   corner.cx = -frustum.left * size.width / (frustum.right - frustum.left);
   corner.cy = frustum.top * size.height / (frustum.top - frustum.bottom);
+  // A frustum narrower than the doubles can divide by gives an infinite focal length.
+  Require(std::isfinite(corner.fx) && std::isfinite(corner.fy) && std::isfinite(corner.cx) &&
+              std::isfinite(corner.cy),
+          "the frustum's intrinsics are not finite (fx = ", corner.fx, ", fy = ", corner.fy,
+          "): its extents are too small against near for a double");
   return ConvertPixelOrigin(corner, PixelOrigin::kCorner, origin);
 }
 

@@ -4,6 +4,7 @@
 #ifndef CAMPROJ_CAMERA_FILE_H_
 #define CAMPROJ_CAMERA_FILE_H_
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -88,10 +89,13 @@ Camera ReadCalibrationView(const std::string& path, const std::string& view);
 
 // The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
 // skew, k1, k2]} and optionally "pixel_origin" (a calibration file too): returned in kCenter.
-// Throws InputError. ReadIntrinsicsFile and ReadCalibrationView refuse a file over 16 MiB (a
-// calibration of ~5800 views), ReadCameraFile one over 1 MiB.
-Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source);
-Intrinsics ReadIntrinsicsFile(const std::string& path);
+// `image_size`, if given, gets the object's "image_size" (the image the intrinsics are for),
+// or nullopt where it has none. Throws InputError. ReadIntrinsicsFile and ReadCalibrationView
+// refuse a file over 16 MiB (a calibration of ~5800 views), ReadCameraFile one over 1 MiB.
+Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source,
+                                  std::optional<ImageSize>* image_size = nullptr);
+Intrinsics ReadIntrinsicsFile(const std::string& path,
+                              std::optional<ImageSize>* image_size = nullptr);
 
 // The `fit.outliers` of camera-file text (0-based indices of the points the fit left out), empty
 // when there is no fit record or no outliers. Throws InputError naming `source` and the key when

@@ -29,7 +29,12 @@ enum class PixelOrigin { kCenter, kCorner };
 // The clip-space depth range after the perspective divide.
 enum class ClipDepth { kNegativeOneToOne, kZeroToOne };
 
-// Image size in pixels. Check() throws std::invalid_argument unless both are positive.
+// The largest image side, in pixels, a camera may have: camera files record sides up to it, and
+// every pixel coordinate of such an image is exact in float32 to 1/16 px.
+inline constexpr int kMaxImageSide = 1000000;
+
+// Image size in pixels. Check() throws std::invalid_argument unless both are positive and at
+// most kMaxImageSide.
 struct ImageSize {
   int width = 0;
   int height = 0;
