@@ -17,6 +17,27 @@ Rigid3 TurnedCamera() {
   return cam_from_world;
 }
 
+// Points whose pixel a double cannot hold have none (PixelFromWorld); without a lens, rays far
+// off the axis still project (the zero lens terms overflowed to NaN before session 37).
+TEST(CameraTest, PixelsBeyondADoubleAreNone) {
+  Camera camera;
+  camera.image_size = {1000, 800};
+  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
+  camera.intrinsics.cx = 499.5;
+  camera.intrinsics.cy = 399.5;
+  // |x| = 1e200: r^4 overflows; the pinhole pixel is 1e203 + cx.
+  const std::optional<Eigen::Vector2d> far = PixelFromWorld(camera, {1e200, 0.0, 1.0});
+  ASSERT_TRUE(far.has_value());
+  EXPECT_EQ(far->x(), 1000.0 * 1e200 + 499.5);
+  EXPECT_EQ(far->y(), 399.5);
+  EXPECT_FALSE(PixelFromWorld(camera, {1e300, 0.0, 1e-300}).has_value());  // x = inf
+  camera.intrinsics.k1 = -0.1;
+  EXPECT_FALSE(PixelFromWorld(camera, {1e200, 0.0, 1.0}).has_value());  // the lens overflows
+  camera.projection = Projection::kOrthographic;
+  camera.intrinsics.k1 = 0.0;
+  EXPECT_FALSE(PixelFromWorld(camera, {1e306, 0.0, 1.0}).has_value());  // fx x = inf
+}
+
 TEST(CameraTest, DepthRangeCoveringBoxByHand) {
   // x in [1, 4]: depths 6 (the x = 4 corners) to 9 (x = 1). With the 10 % margin: near 6 / 1.1,
   // far 9 * 1.1. The first corner at depth 6 is index 1 (x from max, y and z from min).

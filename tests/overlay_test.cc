@@ -129,6 +129,40 @@ TEST(OverlayTest, ObservedPixelsOutsideTheImageBecomeArrowsAtTheBorder) {
   fs::remove_all(path.parent_path());
 }
 
+// A reprojection 2^28 px away: its residual line runs to the image's edge along the true
+// direction, and nothing is drawn where the wrapped fixed-point coordinate would land (before
+// session 37 the cross was drawn at the image centre).
+TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
+  Camera camera;
+  camera.image_size = {1000, 800};
+  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
+  camera.intrinsics.cx = 499.5;
+  camera.intrinsics.cy = 399.5;
+  camera.z_near = 0.5;
+  camera.z_far = 10.0;
+  Correspondences points;
+  points.points_in_world = {{268435.4565, 0.0, 1.0}, {0.1, 0.1, 2.0}};
+  points.pixels = {{300.0, 399.5}, {550.0, 450.0}};
+  points.ids = {"far", "a"};
+  OverlayOptions options;
+  options.magnify = 1.0;
+  const OverlayPicture picture = DrawOverlayImage(camera, points, options, ImageFormat::kPng);
+  const cv::Mat image =
+      cv::imdecode(std::vector<uchar>(picture.encoded.begin(), picture.encoded.end()), cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  const cv::Vec3b background = image.at<cv::Vec3b>(700, 100);
+  // The wrapped place: u = 268435956 px, x 16 = 4294975296 = 2^32 + 8000 -> 500 px. The
+  // residual line runs through it; the cross's vertical arm would stand above and below it.
+  for (const double dv : {-6.0, -4.0, 4.0, 6.0}) {
+    EXPECT_EQ(ClosestColourDistance(image, {500.0, 399.5 + dv}, background, 0), 0) << "dv " << dv;
+  }
+  // The line from the observed pixel to the right edge, on the row of both.
+  for (const double u : {400.0, 700.0, 995.0}) {
+    EXPECT_GT(ClosestColourDistance(image, {u, 399.5}, background, 0), 30) << "u " << u;
+  }
+  EXPECT_NEAR(picture.stats.labels[0].residual_px, 268435956.0 - 300.0, 1.0);
+}
+
 TEST(OverlayTest, OutlierIndexBeyondThePointsIsRefused) {
   const Scene scene = Projector();
   OverlayOptions options;

@@ -26,7 +26,7 @@ Command AddProjectCommand(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "project",
       "Project world points through a camera: prints id,X,Y,Z,u,v,depth as CSV (depth = z in the\n"
-      "camera frame, world units; u, v empty for points behind the camera; control characters in ids\n"
+      "camera frame, world units; u, v empty for points behind the camera (or whose pixel is beyond a double); control characters in ids\n"
       "printed escaped, as \\x1b). POINTS.csv needs\n"
       "X,Y,Z; u,v columns are ignored.\n\n"
       "Example:\n"

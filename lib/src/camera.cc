@@ -84,10 +84,14 @@ std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
   if (!(point_in_cam.z() > 0.0)) return std::nullopt;
   if (camera.projection == Projection::kOrthographic) {
     const Intrinsics& k = camera.intrinsics;
-    return Eigen::Vector2d(k.fx * point_in_cam.x() + k.skew * point_in_cam.y() + k.cx,
-                           k.fy * point_in_cam.y() + k.cy);
+    const Eigen::Vector2d pixel(k.fx * point_in_cam.x() + k.skew * point_in_cam.y() + k.cx,
+                                k.fy * point_in_cam.y() + k.cy);
+    if (!pixel.allFinite()) return std::nullopt;
+    return pixel;
   }
-  return PixelFromCam(camera.intrinsics, point_in_cam);
+  const Eigen::Vector2d pixel = PixelFromCam(camera.intrinsics, point_in_cam);
+  if (!pixel.allFinite()) return std::nullopt;
+  return pixel;
 }
 
 void BoxInWorld::Check() const {

@@ -94,8 +94,15 @@ Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d
   Require(point_in_cam.z() > 0.0, "point is not in front of the camera: z = ", point_in_cam.z());
   const std::array<double, kIntrinsicsArraySize> params = IntrinsicsArray(intrinsics);
   Eigen::Vector2d pixel;
-  PixelFromNormalized(params.data(), point_in_cam.x() / point_in_cam.z(),
-                      point_in_cam.y() / point_in_cam.z(), pixel.data());
+  const double x = point_in_cam.x() / point_in_cam.z();
+  const double y = point_in_cam.y() / point_in_cam.z();
+  PixelFromNormalized(params.data(), x, y, pixel.data());
+  if (!pixel.allFinite() && !intrinsics.HasDistortion()) {
+    // Without a lens the polynomial's zero terms still overflow (r^4 * 0 = inf * 0 = NaN beyond
+    // |x| ~ 1e77) where the pinhole's pixel is finite: computed without them.
+    pixel = Eigen::Vector2d(intrinsics.fx * x + intrinsics.skew * y + intrinsics.cx,
+                            intrinsics.fy * y + intrinsics.cy);
+  }
   return pixel;
 }
 

@@ -124,13 +124,53 @@ void HaloText(cv::Mat& image, const std::string& text, cv::Point origin, const S
               s.text_thickness, cv::LINE_AA);
 }
 
-void HaloLine(cv::Mat& image, const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Style& s,
+// Drawing stays within the image widened by this margin (px): wider than any marker, and small
+// enough that Fixed's 1/16 px coordinates fit an int (a point 2^27 px away wrapped around into
+// the image before session 37).
+constexpr double kCanvasMarginPx = 4096.0;
+
+// Whether `p` is within the canvas: the image widened by kCanvasMarginPx.
+bool OnCanvas(const cv::Mat& image, const Eigen::Vector2d& p) {
+  return p.x() >= -kCanvasMarginPx && p.x() <= image.cols + kCanvasMarginPx &&
+         p.y() >= -kCanvasMarginPx && p.y() <= image.rows + kCanvasMarginPx;
+}
+
+// The part of segment [a, b] on the canvas (Liang-Barsky); false where none is.
+bool ClipToCanvas(const cv::Mat& image, Eigen::Vector2d* a, Eigen::Vector2d* b) {
+  const Eigen::Vector2d d = *b - *a;
+  const double lo[2] = {-kCanvasMarginPx, -kCanvasMarginPx};
+  const double hi[2] = {image.cols + kCanvasMarginPx, image.rows + kCanvasMarginPx};
+  double t0 = 0.0;
+  double t1 = 1.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    const double start = (*a)(axis);
+    if (d(axis) == 0.0) {
+      if (start < lo[axis] || start > hi[axis]) return false;
+      continue;
+    }
+    double enter = (lo[axis] - start) / d(axis);
+    double leave = (hi[axis] - start) / d(axis);
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter);
+    t1 = std::min(t1, leave);
+    if (!(t0 <= t1)) return false;
+  }
+  // An end on the canvas stays as it is (bit for bit: most segments are not clipped).
+  const Eigen::Vector2d start = *a;
+  if (t0 > 0.0) *a = start + t0 * d;
+  if (t1 < 1.0) *b = start + t1 * d;
+  return true;
+}
+
+void HaloLine(cv::Mat& image, Eigen::Vector2d a, Eigen::Vector2d b, const Style& s,
               const cv::Scalar& colour) {
+  if (!ClipToCanvas(image, &a, &b)) return;
   cv::line(image, Fixed(a), Fixed(b), kInk, s.line + 2, cv::LINE_AA, kShift);
   cv::line(image, Fixed(a), Fixed(b), colour, s.line, cv::LINE_AA, kShift);
 }
 
 void Ring(cv::Mat& image, const Eigen::Vector2d& c, const Style& s, const cv::Scalar& colour) {
+  if (!OnCanvas(image, c)) return;  // beyond the margin it would not show
   const int r = static_cast<int>(std::lround(s.ring * 16));
   cv::circle(image, Fixed(c), r, kInk, s.line + 2, cv::LINE_AA, kShift);
   cv::circle(image, Fixed(c), r, colour, s.line, cv::LINE_AA, kShift);

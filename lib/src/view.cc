@@ -130,10 +130,12 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
         point["ray_end_in_world"] = nullptr;
       }
       if (predicted) {
-        const Eigen::Vector2d linear = *PixelFromWorld(Camera{camera.image_size, pinhole,
-                                                              camera.cam_from_world, camera.z_near,
-                                                              camera.z_far, camera.projection},
-                                                       x);
+        // The pinhole's pixel is finite where the lens's is (a lens that overflows has none).
+        const Eigen::Vector2d linear =
+            PixelFromWorld(Camera{camera.image_size, pinhole, camera.cam_from_world, camera.z_near,
+                                  camera.z_far, camera.projection},
+                           x)
+                .value_or(*predicted);
         max_distortion_px = std::max(max_distortion_px, (linear - *predicted).norm());
         point["predicted_px"] = Vec(*predicted);
         point["predicted_linear_px"] = Vec(linear);

@@ -698,7 +698,9 @@ DeterminationCheck CheckDetermination(const Selection& selection,
   for (size_t i = 0; i < test.size(); ++i) {
     if (!(sigmas[i] <= check.max_sigma_px)) {
       check.max_sigma_px = sigmas[i];
-      check.worst_pixel = *PixelFromWorld(camera, test[i]);
+      if (const std::optional<Eigen::Vector2d> pixel = PixelFromWorld(camera, test[i])) {
+        check.worst_pixel = *pixel;
+      }
     }
   }
   const std::vector<FittedRival> fitted = FittedRivals(selection, unit_world, sigma, test);
