@@ -687,6 +687,16 @@ open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.c
     # camera alone or with points, a photo and a model; bad inputs named, nothing written.
     expect_exit 0 "$bin" view "$data/projector/truth.json" -o "$work/camera_only.html"
     expect_in out "wrote $work/camera_only.html (0 points"
+    # An id or a title that reads like one of the template's keys stays text: every key is
+    # filled in one pass over the template (an id "@CAMPROJ_PAGE_SCRIPT@" took the page script's
+    # place, leaving the page without it, before session 37).
+    printf 'id,X,Y,Z,u,v\n@CAMPROJ_PAGE_SCRIPT@,0.1,0.1,2,550,450\n' >"$work/key_id.csv"
+    expect_exit 0 "$bin" view "$data/projector/truth.json" "$work/key_id.csv" -o "$work/keys.html" \
+        --title '@CAMPROJ_DATA@'
+    grep -q '<title>@CAMPROJ_DATA@</title>' "$work/keys.html" || fail "the title is not kept as text"
+    grep -q '"id":"@CAMPROJ_PAGE_SCRIPT@"' "$work/keys.html" || fail "the id is not kept as text"
+    grep -q '<script type="text/plain" id="page-script">[A-Za-z0-9+/=]\{1000,\}</script>' \
+        "$work/keys.html" || fail "the page script is not in the page"
     expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/photo.jpg"
     printf 'o box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf -4/1 -3/2 -2/3\n' >"$work/box.obj"
     expect_exit 0 "$bin" view "$data/projector/truth.json" "$data/projector/points.csv" \

@@ -232,10 +232,31 @@ std::string ScriptSafeJson(const json& value) {
   return out;
 }
 
-void ReplaceOnce(std::string& text, const std::string& key, const std::string& value) {
-  const size_t at = text.find(key);
-  if (at == std::string::npos) throw std::logic_error("web/view.html lacks " + key);
-  text.replace(at, key.size(), value);
+// The template with each key (found once in it) replaced by its value, in one pass over the
+// template: a value is never searched for keys (an id, a title or a camera name that reads
+// "@CAMPROJ_PAGE_SCRIPT@" took that key's place in the page before session 37).
+std::string FillTemplate(const std::string& page_template,
+                         const std::vector<std::pair<std::string, std::string>>& keys_and_values) {
+  std::vector<std::pair<size_t, size_t>> places;  // (position in the template, key index)
+  for (size_t k = 0; k < keys_and_values.size(); ++k) {
+    const std::string& key = keys_and_values[k].first;
+    const size_t at = page_template.find(key);
+    if (at == std::string::npos) throw std::logic_error("web/view.html lacks " + key);
+    if (page_template.find(key, at + key.size()) != std::string::npos) {
+      throw std::logic_error("web/view.html has " + key + " twice");
+    }
+    places.emplace_back(at, k);
+  }
+  std::sort(places.begin(), places.end());
+  std::string page;
+  size_t copied = 0;
+  for (const auto& [at, k] : places) {
+    page.append(page_template, copied, at - copied);
+    page += keys_and_values[k].second;
+    copied = at + keys_and_values[k].first.size();
+  }
+  page.append(page_template, copied, std::string::npos);
+  return page;
 }
 
 }  // namespace
@@ -263,15 +284,16 @@ std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_te
   const internal::ViewAssets& assets = internal::EmbeddedViewAssets();
   data["three_version"] = std::string(assets.three_version);
 
-  std::string page(assets.page_template);
   const std::string title =
       options.title.empty() ? "camproj view: " + camera_name : options.title;
-  ReplaceOnce(page, "@CAMPROJ_TITLE@", internal::MarkupEscape(title));
-  ReplaceOnce(page, "@CAMPROJ_DATA@", ScriptSafeJson(data));
-  ReplaceOnce(page, "@CAMPROJ_THREE_CORE@", Base64(assets.three_core));
-  ReplaceOnce(page, "@CAMPROJ_THREE_MODULE@", Base64(assets.three_module));
-  ReplaceOnce(page, "@CAMPROJ_ORBIT_CONTROLS@", Base64(assets.orbit_controls));
-  ReplaceOnce(page, "@CAMPROJ_PAGE_SCRIPT@", Base64(assets.page_script));
+  const std::string page =
+      FillTemplate(std::string(assets.page_template),
+                   {{"@CAMPROJ_TITLE@", internal::MarkupEscape(title)},
+                    {"@CAMPROJ_DATA@", ScriptSafeJson(data)},
+                    {"@CAMPROJ_THREE_CORE@", Base64(assets.three_core)},
+                    {"@CAMPROJ_THREE_MODULE@", Base64(assets.three_module)},
+                    {"@CAMPROJ_ORBIT_CONTROLS@", Base64(assets.orbit_controls)},
+                    {"@CAMPROJ_PAGE_SCRIPT@", Base64(assets.page_script)}});
   stats.page_bytes = page.size();
   if (stats_out) *stats_out = stats;
   return page;
