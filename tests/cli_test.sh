@@ -1280,6 +1280,16 @@ PY
     expect_in err "--model k2: k2 needs k1 too"
     expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model opencv --fix k3 -o "$work/bad.json"
     expect_in err "--model opencv --fix k3: k3 is both freed and fixed"
+    # A view named by a file name with a comma and a quote: its poses row is quoted (RFC 4180),
+    # 22 fields like every other (23 before session 37).
+    mkdir "$work/odd" && cp "$boards"/left0[3-6].csv "$work/odd/" && cp "$boards/left01.csv" "$work/odd/a,b \"q\".csv"
+    expect_exit 0 "$bin" calibrate "$work/odd" --image-size 640x480 -o "$work/odd.json" --poses "$work/odd.csv"
+    py -c '
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1], newline="")))
+assert all(len(r) == 22 for r in rows), [len(r) for r in rows]
+assert "a,b \"q\"" in [r[0] for r in rows], [r[0] for r in rows]
+' "$work/odd.csv" || fail "the poses CSV does not parse:\n$(cat "$work/odd.csv")"
     [[ ! -e "$work/bad.json" ]] || fail "a bad --model wrote a file"
     expect_not_in out "^refused view"
     ;;

@@ -82,6 +82,23 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   return file.dump(2) + "\n";
 }
 
+namespace {
+
+// A CSV field as RFC 4180 writes it: quoted, its quotes doubled, where it holds a comma, a quote
+// or a line break (a view named by its file, "a,b.csv", made a row of 23 fields before session
+// 37); as it is otherwise.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+}  // namespace
+
 std::string CalibrationPosesCsvText(const Calibration& calibration,
                                     const CameraFileOptions& options) {
   options.Check();
@@ -91,7 +108,7 @@ std::string CalibrationPosesCsvText(const Calibration& calibration,
   for (const CalibratedView& view : calibration.views) {
     const Rigid3& pose = view.camera.cam_from_world;
     const LookAt look_at = LookAtFromCamFromWorld(pose, options.target_distance);
-    out << view.name;
+    out << CsvField(view.name);
     for (const Eigen::Vector3d* v : {&look_at.eye, &look_at.target, &look_at.up}) {
       for (int i = 0; i < 3; ++i) out << ',' << ShortestDouble((*v)(i));
     }

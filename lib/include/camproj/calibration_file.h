@@ -19,7 +19,8 @@ std::string CalibrationToJsonText(const Calibration& calibration,
 
 // The poses table: a header line, then per view: view, eye (3), target (3, at
 // options.target_distance along the gaze), up (3), cam_from_world rotation (9, row-major) and
-// translation (3). Comma-separated, doubles at full precision.
+// translation (3). Comma-separated (RFC 4180: a view name with a comma, a quote or a line break
+// is quoted), doubles at full precision.
 std::string CalibrationPosesCsvText(const Calibration& calibration,
                                     const CameraFileOptions& options = {});
 
