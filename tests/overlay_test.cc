@@ -11,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "camproj/camera_file.h"
+#include "camproj/errors.h"
+#include "camproj/file_io.h"
 #include "camproj/points_file.h"
 
 namespace camproj {
@@ -161,6 +163,42 @@ TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
     EXPECT_GT(ClosestColourDistance(image, {u, 399.5}, background, 0), 30) << "u " << u;
   }
   EXPECT_NEAR(picture.stats.labels[0].residual_px, 268435956.0 - 300.0, 1.0);
+}
+
+// A JPEG background cut short is refused (libjpeg decoded it with a warning and garbage below
+// the cut, exit 0, before session 37); baseline, progressive and restart-interval JPEGs, and one
+// with data after its end (a phone's motion photo), are drawn on.
+TEST(OverlayTest, TruncatedJpegBackgroundIsRefused) {
+  Scene scene = Projector();
+  const int w = scene.camera.image_size.width;
+  const int h = scene.camera.image_size.height;
+  cv::Mat photo(h, w, CV_8UC3);
+  cv::randu(photo, cv::Scalar::all(0), cv::Scalar::all(255));
+  const std::vector<std::vector<int>> encodings = {
+      {}, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}, {cv::IMWRITE_JPEG_RST_INTERVAL, 1}};
+  for (const std::vector<int>& parameters : encodings) {
+    std::vector<uchar> jpeg;
+    ASSERT_TRUE(cv::imencode(".jpg", photo, jpeg, parameters));
+    const std::string whole(jpeg.begin(), jpeg.end());
+    auto draw_on = [&](const std::string& bytes) {
+      const std::string path = Output("background.jpg").string();
+      WriteFileAtomically(path, bytes);
+      OverlayOptions options;
+      options.background_path = path;
+      return DrawOverlayImage(scene.camera, scene.points, options, ImageFormat::kPng);
+    };
+    EXPECT_NO_THROW(draw_on(whole));
+    EXPECT_NO_THROW(draw_on(whole + std::string(5000, 'x')));  // data after the end
+    for (const double kept : {0.3, 0.9, 0.999}) {
+      const std::string cut = whole.substr(0, static_cast<size_t>(kept * whole.size()));
+      try {
+        draw_on(cut);
+        ADD_FAILURE() << "a JPEG cut at " << kept << " of its bytes was drawn on";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("the file is truncated"), std::string::npos) << e.what();
+      }
+    }
+  }
 }
 
 TEST(OverlayTest, OutlierIndexBeyondThePointsIsRefused) {
