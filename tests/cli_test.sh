@@ -1458,6 +1458,25 @@ PY
     # Kept on request, it is the worst view by far.
     expect_exit 0 "$bin" calibrate "$work/left.csv" "$work/zoomed03.csv" --image-size 640x480 --keep-all-views --keep-all-points -o "$work/kept.json"
     expect_in out "^calibrated 14 views, 756 points"
+    # A view whose correspondences are shuffled (row i's pixel from row 13 i mod 54) fits no
+    # image of a plane: left out by name before anything else, the rest calibrated exactly as
+    # without it (it broke the joint refinement, "please report it", before session 37); kept
+    # on request, the refusal says what to do.
+    awk -F, 'NR == 1 { print; next } { p[NR - 2] = $1 "," $2 "," $3; q[NR - 2] = $4 "," $5; n = NR - 1 }
+             END { for (i = 0; i < n; i++) print p[i] "," q[(i * 13) % n] }' "$boards/left02.csv" >"$work/shuffled02.csv"
+    mkdir "$work/shuffled" && cp "$boards"/left0[13456].csv "$work/shuffled02.csv" "$work/shuffled/"
+    mkdir "$work/clean" && cp "$boards"/left0[13456].csv "$work/clean/"
+    expect_exit 0 "$bin" calibrate "$work/shuffled" --image-size 640x480 -o "$work/shuffled.json"
+    expect_in out "^refused view shuffled02 (54 points): its points fit no view of a plane: the best homography leaves .* px RMS, the views' median 1.7 px"
+    expect_exit 0 "$bin" calibrate "$work/clean" --image-size 640x480 -o "$work/clean.json"
+    py - "$work/shuffled.json" "$work/clean.json" <<'PY' || fail "the shuffled view changed the calibration"
+import json, sys
+shuffled, clean = (json.load(open(p)) for p in sys.argv[1:])
+assert shuffled["intrinsics"] == clean["intrinsics"], (shuffled["intrinsics"], clean["intrinsics"])
+PY
+    expect_exit 3 "$bin" calibrate "$work/shuffled" --image-size 640x480 -o "$work/kept2.json" --keep-all-views
+    expect_in err "cannot fit: the joint refinement cannot start: points of a view are behind its start camera"
+    expect_not_in err "report"
     ;;
   calibrate_many_views)
     # A 504-view calibration (the 12 left views that fit, 42 times under other names, from one

@@ -238,6 +238,52 @@ std::optional<PlanarView> PlanarViewOf(const CalibrationView& view, const Spread
   return plane;
 }
 
+// A planar view whose points fit no image of a plane: the RMS (px) its best homography leaves
+// is above kScrambledHomographyPx and kScrambledHomographyFactor times the median over the
+// planar views (at least 3). A real board through a lens fits one to its distortion: OpenCV's
+// 26 chessboard views leave 0.8-2.3 px; one whose correspondences were shuffled 176 px, and it
+// broke the joint refinement's evaluation ("please report it") or the closed-form start, with
+// no view named (before session 37).
+constexpr double kScrambledHomographyPx = 10.0;
+constexpr double kScrambledHomographyFactor = 10.0;
+
+double HomographyRmsPx(const PlanarView& plane, const std::vector<Eigen::Vector2d>& pixels) {
+  double sum = 0.0;
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    const Eigen::Vector3d q = plane.homography * plane.coordinates[i].homogeneous();
+    sum += (q.hnormalized() - pixels[i]).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(pixels.size()));
+}
+
+// Why each planar view is left out as fitting no image of a plane (nullopt: kept).
+std::vector<std::optional<std::string>> ScrambledPlanarViews(const std::vector<CalibrationView>& views) {
+  std::vector<std::optional<std::string>> why(views.size());
+  std::vector<std::pair<size_t, double>> rms;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const Spread spread = SpreadOf(views[i].points_in_world);
+    if (Collinear(spread)) continue;
+    if (const std::optional<PlanarView> plane = PlanarViewOf(views[i], spread)) {
+      rms.emplace_back(i, HomographyRmsPx(*plane, views[i].pixels));
+    }
+  }
+  if (rms.size() < 3) return why;
+  std::vector<double> values;
+  for (const auto& r : rms) values.push_back(r.second);
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double median = values[values.size() / 2];
+  for (const auto& [i, value] : rms) {
+    if (value > kScrambledHomographyPx && value > kScrambledHomographyFactor * median) {
+      char numbers[96];
+      std::snprintf(numbers, sizeof numbers, "%.3g px RMS, the views' median %.3g px", value, median);
+      why[i] = std::string("its points fit no view of a plane: the best homography leaves ") +
+               numbers + " (wrong or shuffled correspondences, or another board; "
+                         "--keep-all-views keeps it)";
+    }
+  }
+  return why;
+}
+
 // A planar view's pose from its homography and K (Zhang, section 3.1): K^-1 H = lambda [r1 r2 t]
 // up to sign, the sign that puts the board's centroid in front; the rotation the nearest to
 // [r1 r2 r1 x r2]. The refinement starts from it, as cv::calibrateCamera's does: it costs a 3x3
@@ -653,6 +699,16 @@ struct JointProblem {
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     for (size_t i = 0; i < free_slots.size(); ++i) k(free_slots[i]) = free_k[i];
+    if (summary.termination_type == ceres::FAILURE &&
+        summary.message.find("Residual and Jacobian evaluation failed") != std::string::npos) {
+      // A residual block refused its point: behind its view's camera from the start (a view
+      // whose correspondences fit no camera), not a numerical failure.
+      throw SceneError(SceneError::Reason::kDegenerate,
+                       "the joint refinement cannot start: points of a view are behind its "
+                       "start camera (a view whose correspondences fit no camera)",
+                       "Check the views' correspondences, or leave out --keep-all-views so that "
+                       "such a view is left out by name");
+    }
     if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
       throw SceneError(SceneError::Reason::kNumerical,
                        "the joint refinement failed: " + summary.message,
@@ -1124,6 +1180,12 @@ CalibrateOptions SelectCalibrationModel(const std::vector<CalibrationView>& view
 
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options) {
   options.Check();
+  if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
+  for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
+  // Before the model selection, whose fits would carry such a view (they do not refuse views).
+  if (options.refuse_inconsistent_views) {
+    if (auto rest = CalibrateWithout(views, ScrambledPlanarViews(views), options)) return *rest;
+  }
   if (options.select_model) {
     std::vector<CalibrationModelChoice> choice;
     double sigma = 0.0;
@@ -1135,8 +1197,6 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     return result;
   }
 
-  if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
-  for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
   // A view whose points lie on a line has no pose: left out by name before it enters the
   // closed-form start (its homography is degenerate), the rest calibrated.
   std::vector<Spread> spreads;
