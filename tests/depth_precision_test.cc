@@ -296,5 +296,21 @@ TEST(DepthPrecisionTest, TableShowsTheIssueFiguresAndTheAdvice) {
   EXPECT_EQ(infinite.find("nan"), std::string::npos) << infinite;
 }
 
+// Ranges near the doubles' limits: the advice says "overflow" / "resolves no depth" and never
+// prints nan or inf (it read "resolves only nan world units" before session 37).
+TEST(DepthPrecisionTest, ExtremeRangesPrintNoNonFiniteNumber) {
+  for (const auto& [z_near, z_far] : {std::pair{1.198, 1e308}, std::pair{1e-300, 1.973},
+                                      std::pair{1e-300, 1e300}}) {
+    for (const GlDepth depth : {GlDepth{}, GlDepth{ClipDepth::kZeroToOne, true}}) {
+      const DepthAdvice advice = AdviseDepth(z_near, z_far, depth);
+      std::string text = advice.table + advice.advice;
+      for (const std::string& w : advice.warnings) text += w;
+      for (const char* bad : {"nan", "inf "}) {
+        EXPECT_EQ(text.find(bad), std::string::npos) << z_near << " " << z_far << ":\n" << text;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace camproj

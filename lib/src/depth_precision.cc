@@ -130,9 +130,11 @@ double DepthStepAt(double z, double z_near, double z_far, const GlDepth& depth,
 
 namespace {
 
-// Two significant digits: "0.15", "1.8e-05", "370" (not "3.7e+02").
+// Two significant digits: "0.15", "1.8e-05", "370" (not "3.7e+02"); "overflow" where the step
+// is beyond a double (a far/near ratio near the doubles' range: the arithmetic gives inf or
+// NaN, which read "resolves only nan world units" before session 37).
 std::string TwoDigits(double value) {
-  if (std::isinf(value)) return "inf";
+  if (!std::isfinite(value)) return "overflow";
   char text[32];
   std::snprintf(text, sizeof(text), "%.2g", value);
   if (std::string(text).find("e+") != std::string::npos && value < 1e9) {
@@ -141,7 +143,16 @@ std::string TwoDigits(double value) {
   return text;
 }
 
+// What a 24-bit buffer resolves at z: "resolves only X world units", or where the step
+// overflows a double, "resolves no depth".
+std::string ResolvesText(double z, double z_near, double z_far, const GlDepth& depth) {
+  const double step = DepthStepAt(z, z_near, z_far, depth, DepthBuffer::kFixed24);
+  if (!std::isfinite(step)) return "resolves no depth (its step there is beyond a double)";
+  return "resolves only " + TwoDigits(step) + " world units";
+}
+
 std::string Ratio(double value) {
+  if (!std::isfinite(value)) return "beyond a double";
   char text[32];
   std::snprintf(text, sizeof(text), "%.2g", value);
   return text;
@@ -213,9 +224,8 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
     advice.warnings.push_back(Concat(
         "far/near = ", Ratio(z_far / z_near), " (near ", Distance(z_near), ", far ",
         Distance(z_far), ") is above ", Ratio(kDepthRatioWarning),
-        ": a 24-bit depth buffer resolves only ",
-        TwoDigits(DepthStepAt(z_far, z_near, z_far, standard_no, DepthBuffer::kFixed24)),
-        " world units at the far plane; ", Remedy(depth, target), ", or raise near"));
+        ": a 24-bit depth buffer ", ResolvesText(z_far, z_near, z_far, standard_no),
+        " at the far plane; ", Remedy(depth, target), ", or raise near"));
   }
   if (infinite && !IsZoReversed(depth)) {
     const double z = 1000.0 * z_near;

@@ -69,7 +69,8 @@ struct DepthAdvice {
   // once; near, 10 near, 100 near, 1000 near for an infinite far) with the columns 24-bit NO,
   // float32 NO, float32 ZO reversed-Z, and float32 with `depth` when that is none of those
   // (NO reversed-Z, ZO). Steps in world units with two significant digits ("0.15", "1.8e-05",
-  // "370"), "~0" where the stored float is 0 (reversed-Z at far); a '*' marks steps finer than
+  // "370"), "~0" where the stored float is 0 (reversed-Z at far), "overflow" where the step is
+  // beyond a double (far/near near the doubles' range); a '*' marks steps finer than
   // the float32 spacing of z itself (see DepthStepAt), explained by a footnote line.
   std::string table;
   // One line: use reversed-Z with ZO, glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE),
