@@ -156,6 +156,12 @@ TEST(PointsFileTest, MalformedFilesNameTheSourceLineAndColumn) {
                     {"pts.csv", "line 2, column 3 (Z): \"nan\" is not finite"});
   ExpectContainsAll(ParseError(header + "-inf,2,3,4,5\n"),
                     {"pts.csv", "line 2, column 1 (X): \"-inf\" is not finite"});
+  // Lines ended by CR alone (classic Mac OS): one line with CRs inside, said as such (it read
+  // "header lacks column v" before session 37).
+  ExpectContainsAll(ParseError("X,Y,Z,u,v\r1,2,3,4,5\r"),
+                    {"pts.csv", "line 1: a carriage return (CR) inside the line", "LF or CRLF"});
+  ExpectContainsAll(ParseError(header + "1,2,3,4,5\r1,2,3,4,5\n"),
+                    {"pts.csv", "line 2: a carriage return (CR) inside the line"});
   ExpectContainsAll(ParseError(header + "1e400,2,3,4,5\n"),
                     {"pts.csv", "line 2, column 1 (X): \"1e400\" is out of the range of a double"});
   ExpectContainsAll(ParseError("X,Y,Z,u\n1,2,3,4\n"),

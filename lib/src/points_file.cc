@@ -100,10 +100,17 @@ class CsvParser {
                      std::to_string(limits_.max_line_bytes) + " bytes");
   }
 
+  // Lines ended by CR alone (classic Mac OS) read as one line with CRs inside.
+  [[noreturn]] void FailCarriageReturn(int64_t line) const {
+    FailLine(line, "a carriage return (CR) inside the line: lines that end in CR alone (classic "
+                   "Mac OS) are not read; save the file with LF or CRLF line ends");
+  }
+
   // `line` has no '\n'; a trailing '\r' is still there.
   void AddLine(std::string_view line) {
     ++line_;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.find('\r') != std::string_view::npos) FailCarriageReturn(line_);
     if (line.size() > limits_.max_line_bytes) FailLongLine(line_);
     if (line_ > INT_MAX) FailLine(line_, "more than " + std::to_string(INT_MAX) + " lines");
     if (line_ == 1 && line.substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark) {
@@ -372,6 +379,10 @@ void ParseFile(const std::string& path, const CorrespondencesLimits& limits, Csv
       const size_t end = newline == std::string_view::npos ? chunk.size() : newline;
       const std::string_view piece = chunk.substr(begin, end - begin);
       if (pending.size() + piece.size() > limits.max_line_bytes + 1) {
+        const size_t cr = piece.find('\r');
+        if (cr != std::string_view::npos && cr + 1 < piece.size()) {
+          parser.FailCarriageReturn(parser.next_line());
+        }
         parser.FailLongLine(parser.next_line());
       }
       if (newline == std::string_view::npos) {
