@@ -141,6 +141,17 @@ TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {
   EXPECT_NE(ExpectInputError("{\n\"image_size\": [640,\n 480,,]}").find("line 3"), std::string::npos);
   EXPECT_NE(ExpectInputError("").find("cam.json"), std::string::npos);
   EXPECT_NE(ExpectInputError(R"({"image_size": [640]})").find("image_size"), std::string::npos);
+  // A key twice in one object (the last was kept silently before session 37), at any depth.
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "image_size": [10, 10]})")
+                .find("cam.json: key \"image_size\" appears twice in one object"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "intrinsics": {"fx": 1, "fx": 2}})")
+                .find("key \"fx\" appears twice"),
+            std::string::npos);
+  // The same key in two objects is no duplicate.
+  EXPECT_EQ(ExpectInputError(R"({"image_size": [640, 480], "a": {"fx": 1}, "b": {"fx": 2}})")
+                .find("appears twice"),
+            std::string::npos);
   EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480]})").find("intrinsics: missing"),
             std::string::npos);
   EXPECT_NE(ExpectInputError(good_prefix + R"("frustum": {"near": 1, "far": 2}})").find("look_at: missing"),

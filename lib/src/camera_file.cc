@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -173,8 +176,22 @@ void RequireShallowJson(const std::string& text, const std::string& source) {
 
 json ParseJson(const std::string& text, const std::string& source) {
   RequireShallowJson(text, source);
+  // A key given twice in one object: the parser keeps the last silently, so a file edited by
+  // hand ("image_size" twice) would be read as the writer did not mean. Refused, naming it.
+  std::vector<std::set<std::string>> keys_of_open_objects;
+  const json::parser_callback_t refuse_duplicate_keys = [&](int /*depth*/, json::parse_event_t event,
+                                                            json& parsed) {
+    if (event == json::parse_event_t::object_start) keys_of_open_objects.emplace_back();
+    if (event == json::parse_event_t::object_end) keys_of_open_objects.pop_back();
+    if (event == json::parse_event_t::key &&
+        !keys_of_open_objects.back().insert(parsed.get<std::string>()).second) {
+      throw InputError(source + ": key \"" + parsed.get<std::string>() +
+                       "\" appears twice in one object: keep one");
+    }
+    return true;
+  };
   try {
-    return json::parse(text);
+    return json::parse(text, refuse_duplicate_keys);
   } catch (const json::parse_error& e) {
     // nlohmann's message names the line and column of the syntax error.
     throw InputError(source + ": not valid JSON: " + e.what());
