@@ -201,6 +201,31 @@ TEST(OverlayTest, TruncatedJpegBackgroundIsRefused) {
   }
 }
 
+// A PNG background cut short is refused by its own chunk walk, before libpng prints anything.
+TEST(OverlayTest, TruncatedPngBackgroundIsRefused) {
+  Scene scene = Projector();
+  cv::Mat photo(scene.camera.image_size.height, scene.camera.image_size.width, CV_8UC3,
+                cv::Scalar(40, 80, 120));
+  std::vector<uchar> png;
+  ASSERT_TRUE(cv::imencode(".png", photo, png));
+  const std::string whole(png.begin(), png.end());
+  const std::string path = Output("background.png").string();
+  OverlayOptions options;
+  options.background_path = path;
+  WriteFileAtomically(path, whole);
+  EXPECT_NO_THROW(DrawOverlayImage(scene.camera, scene.points, options, ImageFormat::kPng));
+  for (const size_t cut : {size_t{40}, whole.size() / 2, whole.size() - 1}) {
+    WriteFileAtomically(path, whole.substr(0, cut));
+    try {
+      DrawOverlayImage(scene.camera, scene.points, options, ImageFormat::kPng);
+      ADD_FAILURE() << "a PNG cut at " << cut << " bytes was drawn on";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the PNG ends before its IEND chunk"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(OverlayTest, OutlierIndexBeyondThePointsIsRefused) {
   const Scene scene = Projector();
   OverlayOptions options;

@@ -82,6 +82,21 @@ bool JpegReachesItsEnd(const std::string& bytes) {
   return false;
 }
 
+// Whether a PNG's chunks (length, type, data, CRC) run whole from its signature to IEND. A cut
+// file was refused by libpng too, but with its own "libpng error" line on stderr.
+bool PngReachesItsEnd(const std::string& bytes) {
+  const auto at = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
+  size_t i = 8;  // the signature (ReadImageHeader checked it)
+  while (i + 12 <= bytes.size()) {
+    const size_t length = (size_t{at(i)} << 24) | (size_t{at(i + 1)} << 16) |
+                          (size_t{at(i + 2)} << 8) | at(i + 3);
+    if (length > bytes.size() - i - 12) return false;
+    if (bytes.compare(i + 4, 4, "IEND") == 0) return true;
+    i += 12 + length;
+  }
+  return false;
+}
+
 // The background, decoded only after its header states the camera's size (for a JPEG, either
 // way round: OpenCV turns it by its EXIF orientation while decoding).
 cv::Mat ReadBackground(const std::string& path, int w, int h) {
@@ -96,6 +111,9 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
   if (header.format == ImageFormat::kJpeg && !JpegReachesItsEnd(bytes)) {
     throw InputError(path + ": the JPEG ends before its end-of-image marker: the file is "
                             "truncated");
+  }
+  if (header.format == ImageFormat::kPng && !PngReachesItsEnd(bytes)) {
+    throw InputError(path + ": the PNG ends before its IEND chunk: the file is truncated");
   }
   cv::Mat image;
   try {
