@@ -977,6 +977,23 @@ INNER
     # And the same file fits where the memory is there (the limit is not what refused it).
     expect_exit 0 bash -c 'ulimit -v $1; exec "$2" fit "$3" --image-size 1920x1080 -o "$4"' _ \
       $((base + 409600)) "$bin" "$work/big.csv" "$work/big.json"
+    # An export too large for the memory (a 16000 x 16000 ST map, 2 GB of floats) says so in
+    # words, writing nothing ("std::bad_alloc" before session 37).
+    py - "$work/t6.json" "$work/huge.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["image_size"] = [16000, 16000]
+c["intrinsics"].update(fx=9000, fy=9000, cx=7999.5, cy=7999.5, k1=-0.01)
+for key in ("gl", "look_at", "perspective", "frustum", "fit"):
+    c.pop(key, None)
+c["frustum"] = {"near": 0.5, "far": 10}
+json.dump(c, open(sys.argv[2], "w"))
+PY
+    expect_exit 2 bash -c 'ulimit -v $1; exec "$2" export "$3" --to stmap -o "$4"' _ \
+      $((base + 409600)) "$bin" "$work/huge.json" "$work/huge.exr"
+    expect_in err "camproj: error: out of memory: what this command builds does not fit"
+    expect_not_in err "bad_alloc"
+    [[ ! -e "$work/huge.exr" ]] || fail "an export out of memory wrote its output"
     ;;
   exit2_messages_name_the_file)
     # The audit of exit 2 (bad input): every file slot of every command, given a file that is

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <new>
 #include <vector>
 
 #include "camproj/file_io.h"
@@ -82,6 +83,11 @@ int Run(int argc, char** argv) {
     const std::string fix = e.fix();
     if (!fix.empty()) std::cerr << "camproj: to fix: " << camproj::TerminalSafe(fix) << '\n';
     return kExitScene;
+  } catch (const std::bad_alloc&) {
+    // What a command builds (an export, a picture) did not fit: said in words, not as the type.
+    std::cerr << "camproj: error: out of memory: what this command builds does not fit in the "
+                 "memory this process may use (see ulimit -v)\n";
+    return kExitBadInput;
   } catch (const std::exception& e) {
     // InputError (a file), std::invalid_argument (a value the library refused), or anything
     // else a library call threw: bad input, never an abort.

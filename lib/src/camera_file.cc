@@ -399,10 +399,11 @@ Camera ReadCameraFile(const std::string& path) {
   return CameraFromJsonText(ReadWholeFile(path, size_t{1} << 20), path);
 }
 
-std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options,
-                             const FitRecord* fit) {
-  options.Check();
-  RequireFiniteViews(camera, options.depth);
+namespace {
+
+// The camera's own part of the file: image, intrinsics in options.pixel_origin, pose, look-at,
+// frustum or ortho box, perspective, GL matrices, world origin.
+json CameraJson(const Camera& camera, const CameraFileOptions& options) {
   const CameraViews views = ViewsOfCamera(camera, options.target_distance, options.depth);
   const Intrinsics k =
       ConvertPixelOrigin(camera.intrinsics, PixelOrigin::kCenter, options.pixel_origin);
@@ -459,75 +460,89 @@ std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& opti
     document["gl"]["note"] = "the projection matrix is the pinhole part: the lens (" +
                              DistortionText(k) + ") is not in it";
   }
-  if (fit != nullptr) {
-    json record;
-    record["rms_px"] = fit->rms_px;
-    record["median_px"] = fit->median_px;
-    record["max_px"] = fit->max_px;
-    record["num_points"] = fit->num_points;
-    if (!fit->outliers.empty()) {
-      record["outliers"] = fit->outliers;
-      record["outlier_method"] = fit->outlier_method;
-      json points = json::array();
-      for (const FitRecord::OutlierPoint& p : fit->outlier_points) {
-        // A left-out point behind the camera has no pixel, so no residual: said, not written
-        // as a non-finite number.
-        points.push_back({{"index", p.index}});
-        if (std::isfinite(p.residual_px)) {
-          points.back()["residual_px"] = p.residual_px;
-        } else {
-          points.back()["behind_camera"] = true;
-        }
-        if (p.rms_with_px > 0.0 && std::isfinite(p.rms_with_px)) {
-          points.back()["rms_with_px"] = p.rms_with_px;
-        }
+  return document;
+}
+
+// The camera file's `fit` record: residuals, left-out points, the checks, the model and its
+// selection, the parameters' sigmas, the linearity check, the time.
+json FitRecordJson(const FitRecord& fit) {
+  json record;
+  record["rms_px"] = fit.rms_px;
+  record["median_px"] = fit.median_px;
+  record["max_px"] = fit.max_px;
+  record["num_points"] = fit.num_points;
+  if (!fit.outliers.empty()) {
+    record["outliers"] = fit.outliers;
+    record["outlier_method"] = fit.outlier_method;
+    json points = json::array();
+    for (const FitRecord::OutlierPoint& p : fit.outlier_points) {
+      // A left-out point behind the camera has no pixel, so no residual: said, not written
+      // as a non-finite number.
+      points.push_back({{"index", p.index}});
+      if (std::isfinite(p.residual_px)) {
+        points.back()["residual_px"] = p.residual_px;
+      } else {
+        points.back()["behind_camera"] = true;
       }
-      if (!points.empty()) record["outlier_points"] = points;
-    }
-    if (!fit->consistency.empty()) record["consistency"] = fit->consistency;
-    if (!fit->determination.empty()) record["determination"] = fit->determination;
-    if (!fit->reliability.empty()) record["reliability"] = fit->reliability;
-    record["start"] = fit->start;
-    record["model"] = fit->model;
-    if (!fit->candidates.empty()) {
-      json selection;
-      selection["criterion"] = fit->criterion;
-      selection["sigma_px"] = fit->selection_sigma_px;
-      selection["candidates"] = json::array();
-      for (const FitRecord::Candidate& c : fit->candidates) {
-        json candidate = {{"name", c.name}, {"verdict", c.verdict}};
-        if (c.num_params > 0) {
-          candidate["num_params"] = c.num_params;
-          candidate["rms_px"] = c.rms_px;
-          candidate["criterion"] = c.criterion;
-        }
-        selection["candidates"].push_back(candidate);
+      if (p.rms_with_px > 0.0 && std::isfinite(p.rms_with_px)) {
+        points.back()["rms_with_px"] = p.rms_with_px;
       }
-      record["selection"] = selection;
     }
-    record["free"] = fit->free;
-    record["fixed"] = json::array();
-    for (const auto& [name, value] : fit->fixed) record["fixed"].push_back({{"name", name}, {"value", value}});
-    record["left_out"] = json::array();
-    for (const auto& [name, why] : fit->left_out) record["left_out"].push_back({{"name", name}, {"why", why}});
-    record["sigma"] = json::object();
-    for (const auto& [name, sigma] : fit->sigma) record["sigma"][name] = sigma;
-    record["pixel_sigma"] = fit->pixel_sigma;
-    record["pixel_sigma_estimated"] = fit->pixel_sigma_estimated;
-    record["iterations"] = fit->iterations;
-    record["jacobian_condition"] = fit->jacobian_condition;
-    if (fit->linearity.checked) {
-      const LinearityCheck& l = fit->linearity;
-      // An unbounded deviation (a point crosses behind the camera within the region) is said
-      // as "unbounded": true, without the number: the file holds no non-finite number.
-      record["linearity"] = {{"linear", l.linear}, {"level", l.level}, {"bound", l.bound},
-                             {"worst_direction", l.worst_direction},
-                             {"unbounded", !std::isfinite(l.worst_deviation)}};
-      if (std::isfinite(l.worst_deviation)) record["linearity"]["worst_deviation"] = l.worst_deviation;
-    }
-    record["time_ms"] = fit->time_ms;
-    document["fit"] = record;
+    if (!points.empty()) record["outlier_points"] = points;
   }
+  if (!fit.consistency.empty()) record["consistency"] = fit.consistency;
+  if (!fit.determination.empty()) record["determination"] = fit.determination;
+  if (!fit.reliability.empty()) record["reliability"] = fit.reliability;
+  record["start"] = fit.start;
+  record["model"] = fit.model;
+  if (!fit.candidates.empty()) {
+    json selection;
+    selection["criterion"] = fit.criterion;
+    selection["sigma_px"] = fit.selection_sigma_px;
+    selection["candidates"] = json::array();
+    for (const FitRecord::Candidate& c : fit.candidates) {
+      json candidate = {{"name", c.name}, {"verdict", c.verdict}};
+      if (c.num_params > 0) {
+        candidate["num_params"] = c.num_params;
+        candidate["rms_px"] = c.rms_px;
+        candidate["criterion"] = c.criterion;
+      }
+      selection["candidates"].push_back(candidate);
+    }
+    record["selection"] = selection;
+  }
+  record["free"] = fit.free;
+  record["fixed"] = json::array();
+  for (const auto& [name, value] : fit.fixed) record["fixed"].push_back({{"name", name}, {"value", value}});
+  record["left_out"] = json::array();
+  for (const auto& [name, why] : fit.left_out) record["left_out"].push_back({{"name", name}, {"why", why}});
+  record["sigma"] = json::object();
+  for (const auto& [name, sigma] : fit.sigma) record["sigma"][name] = sigma;
+  record["pixel_sigma"] = fit.pixel_sigma;
+  record["pixel_sigma_estimated"] = fit.pixel_sigma_estimated;
+  record["iterations"] = fit.iterations;
+  record["jacobian_condition"] = fit.jacobian_condition;
+  if (fit.linearity.checked) {
+    const LinearityCheck& l = fit.linearity;
+    // An unbounded deviation (a point crosses behind the camera within the region) is said
+    // as "unbounded": true, without the number: the file holds no non-finite number.
+    record["linearity"] = {{"linear", l.linear}, {"level", l.level}, {"bound", l.bound},
+                           {"worst_direction", l.worst_direction},
+                           {"unbounded", !std::isfinite(l.worst_deviation)}};
+    if (std::isfinite(l.worst_deviation)) record["linearity"]["worst_deviation"] = l.worst_deviation;
+  }
+  record["time_ms"] = fit.time_ms;
+  return record;
+}
+
+}  // namespace
+
+std::string CameraToJsonText(const Camera& camera, const CameraFileOptions& options,
+                             const FitRecord* fit) {
+  options.Check();
+  RequireFiniteViews(camera, options.depth);
+  json document = CameraJson(camera, options);
+  if (fit != nullptr) document["fit"] = FitRecordJson(*fit);
   return document.dump(2) + "\n";
 }
 
