@@ -179,7 +179,7 @@ int RunCalibrate(const CalibrateArgs& args) {
   options.remove_outliers = !args.keep_all_points;
   const PixelOrigin origin = PixelOriginFromString(args.pixel_origin);
   const std::vector<std::string> inputs = ExpandInputs(args.view_paths);
-  RequireDistinctOutputs({{"-o", args.output_path}, {"--poses", args.poses_path}});
+  RequireDistinctOptionOutputs({{"-o", args.output_path}, {"--poses", args.poses_path}});
   RequireOutputIsNotAnInput(args.output_path, inputs);
   if (!args.poses_path.empty()) RequireOutputIsNotAnInput(args.poses_path, inputs);
 

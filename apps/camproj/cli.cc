@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 
 #include "camproj/file_io.h"
 
@@ -94,15 +95,11 @@ std::vector<double> ParseNumbers(const std::string& text, size_t count, const st
   return numbers;
 }
 
-void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
-          SameFile(outputs[i].second, outputs[j].second)) {
-        throw UsageError(outputs[j].first + " and " + outputs[i].first + " both name " +
-                         outputs[i].second + ": give each output its own path");
-      }
-    }
+void RequireDistinctOptionOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  try {
+    RequireDistinctOutputs(outputs);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
   }
 }
 

@@ -40,9 +40,9 @@ const CLI::Validator& FiniteNumber();
 const CLI::Validator& PositiveFinite();
 const CLI::Validator& NonNegativeFinite();
 
-// Throws UsageError if two of the outputs (option, path) name one file (SameFile, file_io.h):
-// the second write would destroy the first. Call it before any work. Empty paths are skipped.
-void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+// RequireDistinctOutputs (file_io.h) on the outputs (option, path), as a UsageError: the second
+// write would destroy the first. Call it before any work.
+void RequireDistinctOptionOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // Files named on the command line, a folder standing for its *.csv files (sorted); throws
 // UsageError for a folder without any.

@@ -445,7 +445,7 @@ void PrintNotes(const FitRequest& request, const FitResult& fit) {
 int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest& request,
                const FitArgs& args) {
   const auto begin = std::chrono::steady_clock::now();
-  RequireDistinctOutputs({{"-o", args.output_path}, {"--report", args.report_path}});
+  RequireDistinctOptionOutputs({{"-o", args.output_path}, {"--report", args.report_path}});
   if (!args.output_path.empty()) {
     RequireOutputIsNotAnInput(args.output_path, {input, args.intrinsics_path,
                                                  args.object_points_path, args.bounds_mesh_path});

@@ -52,7 +52,7 @@ Command AddOverlayCommand(CLI::App& root) {
   app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
       ->check(CLI::IsMember({"center", "corner"}));
   return {app, [args]() {
-            RequireDistinctOutputs({{"-o", args->output_path}, {"--labels", args->labels_path}});
+            RequireDistinctOptionOutputs({{"-o", args->output_path}, {"--labels", args->labels_path}});
             RequireOutputIsNotAnInput(args->output_path,
                                       {args->camera_path, args->points_path, args->image_path});
             if (!args->labels_path.empty()) {

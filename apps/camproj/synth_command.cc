@@ -66,7 +66,7 @@ Command AddSynthCommand(CLI::App& root) {
             } catch (const std::invalid_argument& e) {
               throw UsageError(e.what());
             }
-            RequireDistinctOutputs({{"-o", args->output_path}, {"--truth", args->truth_path}});
+            RequireDistinctOptionOutputs({{"-o", args->output_path}, {"--truth", args->truth_path}});
             const SynthScene scene = SynthesizeScene(options);
             const std::string csv =
                 "# camproj synth --seed " + std::to_string(args->seed) + " --points " +

@@ -415,15 +415,22 @@ bool SameFile(const std::string& a, const std::string& b) {
          info_a.st_dev == info_b.st_dev && info_a.st_ino == info_b.st_ino;
 }
 
-void WriteFilesAtomically(const std::vector<OutputFile>& files) {
-  for (size_t i = 0; i < files.size(); ++i) {
+void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
     for (size_t j = 0; j < i; ++j) {
-      if (SameFile(files[i].path, files[j].path)) {
-        throw std::invalid_argument(files[j].what + " and " + files[i].what + " both name " +
-                                    files[i].path + ": give each output its own path");
+      if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
+          SameFile(outputs[i].second, outputs[j].second)) {
+        throw std::invalid_argument(outputs[j].first + " and " + outputs[i].first + " both name " +
+                                    outputs[i].second + ": give each output its own path");
       }
     }
   }
+}
+
+void WriteFilesAtomically(const std::vector<OutputFile>& files) {
+  std::vector<std::pair<std::string, std::string>> named_paths;
+  for (const OutputFile& file : files) named_paths.emplace_back(file.what, file.path);
+  RequireDistinctOutputs(named_paths);
   std::vector<std::unique_ptr<PreparedWrite>> writes;
   for (const OutputFile& file : files) writes.push_back(PrepareWrite(file.path, file.contents));
   for (const std::unique_ptr<PreparedWrite>& write : writes) CommitWrite(write.get());

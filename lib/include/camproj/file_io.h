@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace camproj {
@@ -42,6 +43,10 @@ void WriteFilesAtomically(const std::vector<OutputFile>& files);
 // Whether two paths name one file: the same path once symbolic links and "." / ".." are
 // resolved (the file need not exist), or two existing hard links to one inode.
 bool SameFile(const std::string& a, const std::string& b);
+
+// Throws std::invalid_argument ("-o and --truth both name X: give each output its own path") if
+// two of the outputs (what names it, path) name one file (SameFile); empty paths are skipped.
+void RequireDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // Installs handlers that remove the temporary of a WriteFileAtomically in progress on SIGINT,
 // SIGTERM and SIGHUP, then die of the signal as before; ignores SIGXFSZ so that a write beyond
