@@ -30,6 +30,24 @@ TEST(ImageHeaderTest, SizeOfImagesOpenCvEncoded) {
   EXPECT_EQ(jpeg.height, 11);
 }
 
+// Every prefix of an encoded file is short of its end; the whole file, or with bytes after it,
+// reaches it. An APP1 segment holding a thumbnail's EOI (FF D9) is skipped with its length.
+TEST(ImageHeaderTest, ReachesItsEndOnlyWhenWhole) {
+  for (const auto& [extension, format] : {std::pair{".png", ImageFormat::kPng},
+                                          std::pair{".jpg", ImageFormat::kJpeg}}) {
+    const std::string whole = Encoded(extension, 37, 11);
+    EXPECT_TRUE(ImageReachesItsEnd(whole, format)) << extension;
+    EXPECT_TRUE(ImageReachesItsEnd(whole + "appended", format)) << extension;
+    for (size_t cut = 0; cut < whole.size(); ++cut) {
+      EXPECT_FALSE(ImageReachesItsEnd(whole.substr(0, cut), format)) << extension << " " << cut;
+    }
+  }
+  const std::string jpeg = Encoded(".jpg", 37, 11);
+  const std::string app1("\xff\xe1\x00\x06\xff\xd9\x00\x00", 8);  // length 6: FF D9 inside
+  EXPECT_TRUE(ImageReachesItsEnd(jpeg.substr(0, 2) + app1 + jpeg.substr(2), ImageFormat::kJpeg));
+  EXPECT_FALSE(ImageReachesItsEnd(jpeg.substr(0, 2) + app1 + jpeg.substr(2, 100), ImageFormat::kJpeg));
+}
+
 // Hand-made: SOI, an APP1 segment of 4 bytes, fill bytes, then SOF2 (progressive) 4000 x 3000.
 TEST(ImageHeaderTest, JpegFrameAfterOtherSegmentsAndFillBytes) {
   const std::string bytes("\xFF\xD8" "\xFF\xE1\x00\x04\xAB\xCD" "\xFF\xFF"

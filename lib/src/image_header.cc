@@ -51,7 +51,58 @@ ImageHeader JpegHeader(std::string_view bytes, const std::string& source) {
   throw InputError(source + ": a JPEG without a readable frame header (cut short or corrupt)");
 }
 
+bool PngReachesItsEnd(std::string_view bytes) {
+  size_t at = 8;  // the signature
+  while (at + 12 <= bytes.size()) {
+    const size_t length = BigEndian(bytes, at, 4);
+    if (length > bytes.size() - at - 12) return false;
+    if (bytes.substr(at + 4, 4) == "IEND") return true;
+    at += 12 + length;
+  }
+  return false;
+}
+
+bool JpegReachesItsEnd(std::string_view bytes) {
+  const auto byte = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
+  const size_t n = bytes.size();
+  if (n < 4 || byte(0) != 0xff || byte(1) != 0xd8) return false;
+  size_t at = 2;
+  bool in_scan = false;
+  while (at < n) {
+    if (in_scan) {
+      // Entropy-coded data until a marker other than a restart.
+      if (byte(at) != 0xff) {
+        ++at;
+        continue;
+      }
+      if (at + 1 >= n) return false;
+      const unsigned char next = byte(at + 1);
+      if (next == 0x00 || (next >= 0xd0 && next <= 0xd7) || next == 0xff) {
+        at += next == 0xff ? 1 : 2;
+        continue;
+      }
+      in_scan = false;  // a marker: read below
+    }
+    if (byte(at) != 0xff) return false;
+    while (at < n && byte(at) == 0xff) ++at;  // fill bytes before a marker
+    if (at >= n) return false;
+    const unsigned char marker = byte(at++);
+    if (marker == 0xd9) return true;
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) continue;  // no length
+    if (at + 2 > n) return false;
+    const size_t length = BigEndian(bytes, at, 2);
+    if (length < 2 || at + length > n) return false;
+    at += length;
+    in_scan = marker == 0xda;  // SOS: its scan's data follows the header
+  }
+  return false;
+}
+
 }  // namespace
+
+bool ImageReachesItsEnd(std::string_view bytes, ImageFormat format) {
+  return format == ImageFormat::kPng ? PngReachesItsEnd(bytes) : JpegReachesItsEnd(bytes);
+}
 
 ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source) {
   static constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);

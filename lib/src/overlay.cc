@@ -42,61 +42,6 @@ namespace {
 // A PNG or JPEG of kMaxImagePixels is far smaller than this; a bigger file is not a photo.
 constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
 
-// Whether a JPEG's marker structure reaches its end-of-image marker (FF D9): the segments from
-// SOI to each scan skipped by their lengths (an EXIF thumbnail's own EOI inside APP1 is not
-// taken for it), each scan's entropy-coded data walked over its stuffed FF 00 bytes, restart
-// markers and fill bytes. Data after the EOI (a phone's appended motion video) is allowed.
-bool JpegReachesItsEnd(const std::string& bytes) {
-  const auto at = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
-  const size_t n = bytes.size();
-  if (n < 4 || at(0) != 0xFF || at(1) != 0xD8) return false;
-  size_t i = 2;
-  bool in_scan = false;
-  while (i < n) {
-    if (in_scan) {
-      // Entropy-coded data until a marker other than a restart.
-      if (at(i) != 0xFF) {
-        ++i;
-        continue;
-      }
-      if (i + 1 >= n) return false;
-      const unsigned char next = at(i + 1);
-      if (next == 0x00 || (next >= 0xD0 && next <= 0xD7) || next == 0xFF) {
-        i += next == 0xFF ? 1 : 2;
-        continue;
-      }
-      in_scan = false;  // a marker: read below
-    }
-    if (at(i) != 0xFF) return false;
-    while (i < n && at(i) == 0xFF) ++i;  // fill bytes before a marker
-    if (i >= n) return false;
-    const unsigned char marker = at(i++);
-    if (marker == 0xD9) return true;
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // no length
-    if (i + 2 > n) return false;
-    const size_t length = (size_t{at(i)} << 8) | at(i + 1);
-    if (length < 2 || i + length > n) return false;
-    i += length;
-    in_scan = marker == 0xDA;  // SOS: its scan's data follows the header
-  }
-  return false;
-}
-
-// Whether a PNG's chunks (length, type, data, CRC) run whole from its signature to IEND. A cut
-// file was refused by libpng too, but with its own "libpng error" line on stderr.
-bool PngReachesItsEnd(const std::string& bytes) {
-  const auto at = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
-  size_t i = 8;  // the signature (ReadImageHeader checked it)
-  while (i + 12 <= bytes.size()) {
-    const size_t length = (size_t{at(i)} << 24) | (size_t{at(i + 1)} << 16) |
-                          (size_t{at(i + 2)} << 8) | at(i + 3);
-    if (length > bytes.size() - i - 12) return false;
-    if (bytes.compare(i + 4, 4, "IEND") == 0) return true;
-    i += 12 + length;
-  }
-  return false;
-}
-
 // The background, decoded only after its header states the camera's size (for a JPEG, either
 // way round: OpenCV turns it by its EXIF orientation while decoding).
 cv::Mat ReadBackground(const std::string& path, int w, int h) {
@@ -107,13 +52,13 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
     throw InputError(internal::Concat(path, ": image is ", header.width, "x", header.height,
                                       " but the camera's image size is ", w, "x", h));
   }
-  // libjpeg decodes a truncated file with a warning, filling the rest with garbage.
-  if (header.format == ImageFormat::kJpeg && !JpegReachesItsEnd(bytes)) {
-    throw InputError(path + ": the JPEG ends before its end-of-image marker: the file is "
-                            "truncated");
-  }
-  if (header.format == ImageFormat::kPng && !PngReachesItsEnd(bytes)) {
-    throw InputError(path + ": the PNG ends before its IEND chunk: the file is truncated");
+  // libjpeg decodes a truncated file with a warning, filling the rest with garbage; libpng
+  // refuses one, but prints its own error line.
+  if (!ImageReachesItsEnd(bytes, header.format)) {
+    throw InputError(path + (header.format == ImageFormat::kJpeg
+                                 ? ": the JPEG ends before its end-of-image marker"
+                                 : ": the PNG ends before its IEND chunk") +
+                     ": the file is truncated");
   }
   cv::Mat image;
   try {

@@ -26,6 +26,14 @@ struct ImageHeader {
 // size. Reads only the header: cost and memory do not depend on the stated size.
 ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source);
 
+// Whether the file's structure runs whole to its end marker, walked without decoding: a PNG's
+// chunks (length, type, data, CRC) from the signature to IEND; a JPEG's segments from SOI
+// skipped by their lengths (an EXIF thumbnail's own EOI inside APP1 is not taken for the end),
+// each scan's entropy-coded data walked over stuffed FF 00 bytes, restart markers and fill
+// bytes, to EOI (FF D9). Data after the end (a phone's appended motion video) is allowed. False
+// for a file cut short. `bytes` begin with the signature ReadImageHeader found for `format`.
+bool ImageReachesItsEnd(std::string_view bytes, ImageFormat format);
+
 // The image format an output path asks for by its extension (case-insensitive): .png, or .jpg /
 // .jpeg. Throws std::invalid_argument naming the path and the extensions accepted otherwise.
 ImageFormat ImageFormatOfPath(const std::string& path);
