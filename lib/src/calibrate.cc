@@ -241,9 +241,11 @@ std::optional<PlanarView> PlanarViewOf(const CalibrationView& view, const Spread
 // A planar view whose points fit no image of a plane: the RMS (px) its best homography leaves
 // is above kScrambledHomographyPx and kScrambledHomographyFactor times the median over the
 // planar views (at least 3). A real board through a lens fits one to its distortion: OpenCV's
-// 26 chessboard views leave 0.8-2.3 px; one whose correspondences were shuffled 176 px, and it
-// broke the joint refinement's evaluation ("please report it") or the closed-form start, with
-// no view named (before session 37).
+// 26 chessboard views leave 0.8-2.3 px; one whose correspondences were shuffled 5.7e4 px (the
+// homography then sends points near infinity), and it broke the joint refinement's evaluation
+// ("please report it") or the closed-form start, with no view named (before session 37). Runs
+// on every call that may refuse views: the top-level one, the chosen model's and each rest's
+// (a homography per view, small beside the calibration; not shared between the calls).
 constexpr double kScrambledHomographyPx = 10.0;
 constexpr double kScrambledHomographyFactor = 10.0;
 
