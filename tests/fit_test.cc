@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "camproj/camera_file.h"
+#include "camproj/fit_request.h"
 #include "camproj/model_select.h"
 #include "camproj/synth.h"
 #include "seeds.h"
@@ -392,8 +394,68 @@ TEST(FitTest, ExtremeWorldScalesGiveTheSameCameraBitForBit) {
       EXPECT_EQ(scaled.camera.cam_from_world.translation,
                 std::ldexp(1.0, k) * unit.camera.cam_from_world.translation) << k;
       EXPECT_EQ(scaled.rms_px, unit.rms_px) << k;
+      // The camera file too: its look-at target distance (|target - eye|, ~2^k) once squared
+      // overflowed at 2^1000 (1e301), and `camproj fit` ended in exit 2 after its fit.
+      const Camera read = CameraFromJsonText(FitCameraFileText(scaled, PixelOrigin::kCenter), "fit");
+      EXPECT_EQ(read.cam_from_world.translation, scaled.camera.cam_from_world.translation) << k;
+      EXPECT_EQ(read.intrinsics.fx, b.fx) << k;
+    }
+    // Near 2^1017 (1.4e306) the fit is still exact but its GL frustum overflows a double:
+    // refused as too large, with the advice to change units (was kNumerical, "frustum left must
+    // be finite").
+    std::vector<Eigen::Vector3d> points = scene.points_in_world;
+    for (auto& x : points) x = std::ldexp(1.0, 1017) * x;
+    try {
+      FitCamera(points, scene.observed_pixels, camera.size, options);
+      if (projection == Projection::kPerspective) ADD_FAILURE() << "2^1017 was not refused";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.reason(), SceneError::Reason::kNonFiniteInput) << e.what();
+      EXPECT_NE(e.why().find("too large for double precision"), std::string::npos) << e.what();
     }
   }
+}
+
+// A given near plane beyond every point (or far plane before every point) leaves no depth range
+// that holds a point once the other plane is fitted: a refusal that says so, naming the points'
+// depths, never a numerical failure (was "near (5) must be less than far (2.75)", kNumerical
+// from FitCameraAuto). Both planes given are the user's range, taken as given.
+TEST(FitTest, AGivenNearOrFarPastEveryPointIsRefused) {
+  std::mt19937_64 rng(testing::Seed(79));
+  const RandomCamera camera = ProjectorLikeCamera(rng);
+  const Scene scene = MakeScene(rng, camera, SceneOptions{});
+  const FitResult free = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size);
+  const double nearest = free.camera.z_near * 1.1;
+  const double farthest = free.camera.z_far / 1.1;
+  for (const bool near_given : {true, false}) {
+    FitOptions options;
+    if (near_given) options.z_near = 2.0 * farthest;
+    else options.z_far = 0.5 * nearest;
+    try {
+      FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
+      ADD_FAILURE() << "not refused";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.reason(), SceneError::Reason::kPointsBehindCamera) << e.what();
+      EXPECT_NE(e.why().find(near_given ? "nearer than the given near plane"
+                                        : "beyond the given far plane"), std::string::npos)
+          << e.what();
+      EXPECT_NE(e.why().find("at depths"), std::string::npos) << e.what();
+      EXPECT_NE(e.fix().find(near_given ? "--near" : "--far"), std::string::npos) << e.what();
+    }
+    AutoFitOptions auto_options;
+    auto_options.fit = options;
+    try {
+      FitCameraAuto(scene.points_in_world, scene.observed_pixels, camera.size, auto_options);
+      ADD_FAILURE() << "not refused";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.reason(), SceneError::Reason::kPointsBehindCamera) << e.what();
+    }
+  }
+  FitOptions both;
+  both.z_near = 2.0 * farthest;
+  both.z_far = 4.0 * farthest;
+  const FitResult given = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, both);
+  EXPECT_EQ(given.camera.z_near, *both.z_near);
+  EXPECT_EQ(given.camera.z_far, *both.z_far);
 }
 
 // A plane and one point off it: the DLT's solutions form a plane (10 equations for 11 unknowns),

@@ -394,7 +394,7 @@ std::vector<Eigen::Vector3d> ReadMeshVertices(const std::string& path) {
 std::string FitCameraFileText(const FitResult& fit, PixelOrigin pixel_origin) {
   CameraFileOptions file_options;
   file_options.pixel_origin = pixel_origin;
-  file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).norm();
+  file_options.target_distance = (fit.views.look_at.target - fit.views.look_at.eye).stableNorm();
   const FitRecord record = FitRecordOf(fit);
   return CameraToJsonText(fit.camera, file_options, &record);
 }

@@ -711,8 +711,7 @@ void RequireRepresentableCamera(const Camera& camera) {
   try {
     RequireFiniteViews(camera);
   } catch (const std::invalid_argument& e) {
-    const SceneError refusal = internal::TooLargeForDouble();
-    throw SceneError(refusal.reason(), refusal.why() + " (" + e.what() + ")", refusal.fix());
+    throw internal::TooLargeForDouble(e.what());
   }
 }
 

@@ -134,7 +134,8 @@ struct FitOptions {
   double parameter_tolerance = 1e-10;  // relative step
 
   // Depth range of the result's GL matrices. Unset: tight around the points' depths, near =
-  // min depth / (1 + depth_margin), far = max depth * (1 + depth_margin).
+  // min depth / (1 + depth_margin), far = max depth * (1 + depth_margin). One given beyond every
+  // point (near) or before every point (far), the other unset: refused (kPointsBehindCamera).
   std::optional<double> z_near;
   std::optional<double> z_far;
   double depth_margin = 0.1;
@@ -158,7 +159,7 @@ class SceneError : public std::runtime_error {
     kCollinearPoints,
     kPlanarUnderdetermined,  // a plane determines at most 2 intrinsics (besides distortion)
     kNonFiniteInput,
-    kPointsBehindCamera,
+    kPointsBehindCamera,     // or every point past a given near / far plane (the other unset)
     kMirroredWorld,          // left-handed world frame
     kDegenerate,             // no unique solution (e.g. a plane seen head-on with free focal)
     // FitCameraAuto (model_select.h) only, but kAmbiguous:

@@ -14,6 +14,7 @@
 #include <Eigen/QR>
 
 #include "camproj/camera.h"
+#include "camproj/number_text.h"
 #include "camproj/pose.h"
 #include "check.h"
 #include "fit/common.h"
@@ -340,11 +341,10 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
 
   // Depth range and views.
   const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
-  camera.z_near = options.z_near.value_or(*min_depth / (1.0 + options.depth_margin));
-  camera.z_far = options.z_far.value_or(*max_depth * (1.0 + options.depth_margin));
-  Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
-          camera.z_far, ")");
-  if (effort.describe) result.views = ViewsOfCamera(camera, Median(depths));
+  const DepthRange range = DepthRangeOfPoints(options, *min_depth, *max_depth);
+  camera.z_near = range.z_near;
+  camera.z_far = range.z_far;
+  if (effort.describe) result.views = ViewsOfFittedCamera(camera, Median(depths));
 
   const std::vector<std::string> names = ParameterNames(model);
   result.free_parameters = names;
@@ -383,6 +383,41 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
     }
   }
   return result;
+}
+
+CameraViews ViewsOfFittedCamera(const Camera& camera, double target_distance) {
+  camera.Check();  // outside the try: an invalid camera is a bug, not an overflow
+  try {
+    return ViewsOfCamera(camera, target_distance);
+  } catch (const std::invalid_argument& e) {
+    throw TooLargeForDouble(e.what());
+  }
+}
+
+DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, double max_depth) {
+  DepthRange range;
+  range.z_near = options.z_near.value_or(min_depth / (1.0 + options.depth_margin));
+  range.z_far = options.z_far.value_or(max_depth * (1.0 + options.depth_margin));
+  if (range.z_far > range.z_near) return range;
+  // FitOptions::Check orders two given planes, so one is unset here and the given one is past
+  // every point: the tight plane would fall on its wrong side.
+  const std::string depths = Concat(": the fitted camera sees the points at depths ",
+                                    GeneralDouble(min_depth, 6), " to ",
+                                    GeneralDouble(max_depth, 6), ", so its frustum would clip "
+                                    "them all");
+  if (options.z_near) {
+    throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                     Concat("every point is nearer than the given near plane ",
+                            ShortestDouble(*options.z_near), depths),
+                     Concat("Give a near plane below the nearest point's depth (--near), or a "
+                            "far plane beyond ", ShortestDouble(*options.z_near),
+                            " as well (--far)"));
+  }
+  throw SceneError(SceneError::Reason::kPointsBehindCamera,
+                   Concat("every point is beyond the given far plane ",
+                          ShortestDouble(*options.z_far), depths),
+                   Concat("Give a far plane beyond the farthest point's depth (--far), or a near "
+                          "plane below ", ShortestDouble(*options.z_far), " as well (--near)"));
 }
 
 }  // namespace internal

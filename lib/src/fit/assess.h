@@ -20,10 +20,24 @@ namespace internal {
 // start_method: FitResult::start_method. Throws SceneError kPointsBehindCamera (a point behind
 // the camera), kDegenerate (reciprocal condition of the Jacobi-scaled normal equations at most
 // 1e-12, naming the parameters along the undetermined direction and the intrinsic to fix), and
-// std::invalid_argument when the given near / far leave no depth range. FitResult::linearity
-// is checked where there is a covariance and `effort` asks for it.
+// DepthRange's refusal. FitResult::linearity is checked where there is a covariance and
+// `effort` asks for it.
 FitResult AssessFit(const Scene& scene, const std::string& start_method, RefinedCamera refined,
                     const FitOptions& options, const FitEffort& effort);
+
+// ViewsOfCamera of a fitted camera (valid: Camera::Check passes), refusing (TooLargeForDouble)
+// one whose GL matrices or frustum overflow a double (a world scaled by 1e307).
+CameraViews ViewsOfFittedCamera(const Camera& camera, double target_distance);
+
+struct DepthRange {
+  double z_near;
+  double z_far;
+};
+// The depth range of a fitted camera whose points lie at depths min_depth..max_depth: a given
+// FitOptions::z_near / z_far as given, an unset one tight around the points (widened by
+// depth_margin). Throws SceneError kPointsBehindCamera where a given plane has every point on
+// its far side and the other plane is unset (no range could then hold a point).
+DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, double max_depth);
 
 }  // namespace internal
 }  // namespace camproj

@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 
 #include "check.h"
+#include "fit/assess.h"
 #include "fit/common.h"
 #include "fit/scene.h"
 
@@ -359,13 +360,12 @@ double DescribeOrthographic(const AffineScene& scene, const FitOptions& options,
   }
   result->max_px = *std::max_element(norms.begin(), norms.end());
   const auto [near_it, far_it] = std::minmax_element(depths.begin(), depths.end());
-  camera.z_near = options.z_near.value_or(*near_it / (1.0 + options.depth_margin));
-  camera.z_far = options.z_far.value_or(*far_it * (1.0 + options.depth_margin));
-  Require(camera.z_far > camera.z_near, "near (", camera.z_near, ") must be less than far (",
-          camera.z_far, ")");
+  const DepthRange range = DepthRangeOfPoints(options, *near_it, *far_it);
+  camera.z_near = range.z_near;
+  camera.z_far = range.z_far;
   std::vector<double> depths_sorted = depths;
   std::nth_element(depths_sorted.begin(), depths_sorted.begin() + n / 2, depths_sorted.end());
-  result->views = ViewsOfCamera(camera, depths_sorted[n / 2]);
+  result->views = ViewsOfFittedCamera(camera, depths_sorted[n / 2]);
   result->start_method = "affine";
   result->planar = false;
   result->free_parameters = linearization.names;

@@ -74,6 +74,14 @@ SceneError TooLargeForDouble() {
                     "Divide every coordinate by a common factor (change units) and refit");
 }
 
+SceneError TooLargeForDouble(const std::string& overflow) {
+  const SceneError refusal = TooLargeForDouble();
+  return SceneError(refusal.reason(),
+                    "the 3D points' coordinates are too large for double precision: the fitted "
+                    "camera's GL matrices overflow (" + overflow + ")",
+                    refusal.fix());
+}
+
 void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double scale,
                  const std::vector<Eigen::Vector2d>& pixels) {
   double largest = 0.0;

@@ -59,6 +59,8 @@ void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
 // The refusal of finite coordinates whose centroid or spread overflows a double (|X| near
 // 1e308): kNonFiniteInput, with the advice to change units.
 SceneError TooLargeForDouble();
+// The same, for a fitted camera whose GL matrices overflow (`overflow`: what overflowed).
+SceneError TooLargeForDouble(const std::string& overflow);
 
 // Refuses (kNonFiniteInput) points so far from the origin against their spread (`scale`, their
 // RMS distance from their centroid) that double precision's rounding of their coordinates moves
