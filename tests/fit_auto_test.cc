@@ -1425,6 +1425,28 @@ TEST(FitAutoTest, KeepAllRefusesAContaminatedSceneNamingTheWorstPoint) {
   }
 }
 
+// A non-finite point is named as the user named it (its id in the points file), or numbered from
+// 1 when the points have no names.
+TEST(FitAutoTest, ANonFinitePointIsNamedByItsId) {
+  SynthScene scene = Clicks(3, 10);
+  std::vector<Eigen::Vector3d> points = scene.correspondences.points_in_world;
+  points[4].z() = std::numeric_limits<double>::infinity();
+  AutoFitOptions options;
+  options.point_names = {"a", "b", "c", "d", "corner-e", "f", "g", "h", "i", "j"};
+  for (const bool named : {true, false}) {
+    if (!named) options.point_names.clear();
+    try {
+      Auto(points, scene.correspondences.pixels, options);
+      ADD_FAILURE() << "answered";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.reason(), SceneError::Reason::kNonFiniteInput);
+      const std::string name = named ? "corner-e" : "point 5";
+      EXPECT_NE(std::string(e.what()).find(name + " is not finite"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // Regression (FitAutoStress at seed offsets 3, 11 and 123: its scene 1588, large-offset): ten
 // clean points 8.7e7 scene sizes from the origin, where double precision moves their pixels by
 // 1.1e-5 px, above CheckOffset's 1e-5. The screen refused them for it, and the outlier stage then

@@ -601,7 +601,9 @@ TEST_F(RefusalTest, NonFiniteInputNamesThePoint) {
   points[7].y() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(RefusalOf(points, scene_.observed_pixels, camera_.size, {}, &message_),
             SceneError::Reason::kNonFiniteInput);
-  EXPECT_NE(message_.find("point 7"), std::string::npos) << message_;
+  // Numbered from 1, as the points file's rows and the summary number them.
+  EXPECT_NE(message_.find("point 8 is not finite"), std::string::npos) << message_;
+  EXPECT_NE(message_.find("Remove or fix point 8"), std::string::npos) << message_;
 }
 
 // Finite coordinates whose sum overflows (|X| ~ 1e308) cannot be centred: refused as input a

@@ -342,7 +342,8 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
   if (!options.z_far) camera.z_far = range.z_far;
   internal::Require(camera.z_far > camera.z_near, "--bounds: far ", camera.z_far,
                     " (the box's farthest corner) is not beyond --near ", camera.z_near);
-  result.views = ViewsOfCamera(camera, (result.views.look_at.target - result.views.look_at.eye).norm());
+  result.views =
+      ViewsOfCamera(camera, (result.views.look_at.target - result.views.look_at.eye).stableNorm());
   return result;
 }
 

@@ -750,11 +750,10 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
   const Clock::time_point start = Clock::now();
   options.Check();
   image_size.Check();
-  Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
-          " 3D points but ", observed_pixels.size(), " pixels");
   Require(options.point_names.empty() || options.point_names.size() == points_in_world.size(),
           "got ", options.point_names.size(), " point names for ", points_in_world.size(),
           " points");
+  internal::CheckCorrespondences(points_in_world, observed_pixels, options.point_names);
   try {
     FitResult result = Pipeline(points_in_world, observed_pixels, image_size, options).Run(start);
     RequireRepresentableCamera(result.camera);

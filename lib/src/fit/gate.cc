@@ -13,13 +13,6 @@ namespace internal {
 
 std::string Px(double value) { return GeneralDouble(value, 3) + " px"; }
 
-std::string PointName(const std::string& name) {
-  const bool number = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c)) != 0;
-  });
-  return number ? "point " + name : name;
-}
-
 std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin) {
   const Eigen::Vector2d u = ConvertPixelOrigin(pixel_center, PixelOrigin::kCenter, origin);
   return "(" + std::to_string(static_cast<long>(std::lround(u.x()))) + ", " +

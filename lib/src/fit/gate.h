@@ -14,16 +14,13 @@
 #include "camproj/conventions.h"
 #include "camproj/fit.h"
 #include "camproj/model_select.h"
+#include "fit/scene.h"
 
 namespace camproj {
 namespace internal {
 
 // "3.14 px": a pixel distance in messages.
 std::string Px(double value);
-
-// A point's name in messages: "point 5" for a bare number (a points file without ids numbers
-// its rows so), else the name itself ("c4", or FitCameraAuto's own "point 5").
-std::string PointName(const std::string& name);
 
 // "(505, 714)": a pixel (kCenter) in messages, rounded, in `origin`'s convention.
 std::string PixelText(const Eigen::Vector2d& pixel_center, PixelOrigin origin);

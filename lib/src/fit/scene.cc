@@ -1,6 +1,7 @@
 #include "fit/scene.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <memory>
@@ -106,17 +107,29 @@ void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double sca
   }
 }
 
+std::string PointName(const std::string& name) {
+  const bool number = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  });
+  return number ? "point " + name : name;
+}
+
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
-                          const std::vector<Eigen::Vector2d>& observed_pixels) {
+                          const std::vector<Eigen::Vector2d>& observed_pixels,
+                          const std::vector<std::string>& point_names) {
   Require(points_in_world.size() == observed_pixels.size(), "got ", points_in_world.size(),
           " 3D points but ", observed_pixels.size(), " pixels");
   const int n = static_cast<int>(points_in_world.size());
   for (int i = 0; i < n; ++i) {
     if (!points_in_world[i].allFinite() || !observed_pixels[i].allFinite()) {
+      // Numbered from 1, as the summary and the points file's rows number them.
+      const std::string name = i < static_cast<int>(point_names.size())
+                                   ? PointName(point_names[i])
+                                   : Concat("point ", i + 1);
       throw SceneError(SceneError::Reason::kNonFiniteInput,
-                       Concat("point ", i, " is not finite (X = ", points_in_world[i].transpose(),
+                       Concat(name, " is not finite (X = ", points_in_world[i].transpose(),
                               ", pixel = ", observed_pixels[i].transpose(), ")"),
-                       Concat("Remove or fix point ", i));
+                       Concat("Remove or fix ", name));
     }
   }
 }

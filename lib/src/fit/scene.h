@@ -10,6 +10,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -51,10 +52,16 @@ struct Scene {
   int NumPoints() const { return static_cast<int>(points.size()); }
 };
 
+// A point's name in messages: "point 5" for a bare number (a points file without ids numbers
+// its rows so), else the name itself ("c4", or FitCameraAuto's own "point 5").
+std::string PointName(const std::string& name);
+
 // Throws std::invalid_argument when the numbers of points and pixels differ, and SceneError
-// kNonFiniteInput naming the first point with a non-finite coordinate (X or pixel).
+// kNonFiniteInput naming the first point with a non-finite coordinate (X or pixel): by
+// PointName(point_names[i]), or "point i + 1" without names.
 void CheckCorrespondences(const std::vector<Eigen::Vector3d>& points_in_world,
-                          const std::vector<Eigen::Vector2d>& observed_pixels);
+                          const std::vector<Eigen::Vector2d>& observed_pixels,
+                          const std::vector<std::string>& point_names = {});
 
 // The refusal of finite coordinates whose centroid or spread overflows a double (|X| near
 // 1e308): kNonFiniteInput, with the advice to change units.
