@@ -7,10 +7,12 @@ clip_from_gl_eye). Python specifics: image sizes are (width, height) tuples; mat
 arrays indexed M[row, column] (upload a GL matrix M as M.T with transpose=GL_FALSE, or M with
 GL_TRUE); pixel_origin and depth are the strings "center" | "corner" and "no" | "zo".
 
-Errors: ``ValueError`` for a bad argument (the message names it), ``InputError`` (a ValueError)
+Errors: ``TypeError`` / ``ValueError`` for an argument of the wrong type / value (the message
+names it), ``InputError`` (a ValueError)
 for a malformed file (names the file, line and column), ``SceneError`` (one subclass per reason)
 when the points cannot determine the requested camera, with the command line's message.
 """
+import os
 from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -30,17 +32,33 @@ class SceneError(RuntimeError):
     why: str  # what the points show
     fix: str  # what to do about it, standing alone ("" where the refusal says it within `why`)
 
-class TooFewPointsError(SceneError): ...
-class CollinearPointsError(SceneError): ...
-class PlanarUnderdeterminedError(SceneError): ...
-class NonFiniteInputError(SceneError): ...
-class PointsBehindCameraError(SceneError): ...
-class MirroredWorldError(SceneError): ...
-class DegenerateError(SceneError): ...
-class ContaminatedError(SceneError): ...
-class InconsistentError(SceneError): ...
-class AmbiguousError(SceneError): ...
-class NumericalError(SceneError): ...
+class TooFewPointsError(SceneError):
+    """Too few points: fewer equations (2 per distinct point) than the requested camera has
+    unknowns, or fewer than its start needs."""
+class CollinearPointsError(SceneError):
+    """The points lie on one line: no camera is determined."""
+class PlanarUnderdeterminedError(SceneError):
+    """Coplanar points determine at most 2 intrinsics (besides distortion); more are free."""
+class NonFiniteInputError(SceneError):
+    """A point or pixel is NaN or infinite, or the coordinates are too large for double
+    precision (the message names the point, or says which units to change)."""
+class PointsBehindCameraError(SceneError):
+    """The camera that fits has points behind it, or a given near / far plane is past every
+    point."""
+class MirroredWorldError(SceneError):
+    """The points fit only a camera seen through a mirror: the world frame is left-handed
+    (flip one axis)."""
+class DegenerateError(SceneError):
+    """The points admit no unique camera (e.g. a plane seen head-on with the focal free)."""
+class ContaminatedError(SceneError):
+    """Some points disagree with the rest, and the rest cannot say which (default path)."""
+class InconsistentError(SceneError):
+    """The best camera's residuals are larger than the pixel noise allows; the message names
+    the worst points (default path)."""
+class AmbiguousError(SceneError):
+    """Two different cameras explain the points about equally well."""
+class NumericalError(SceneError):
+    """The fit failed numerically (a bug if it happens on well-formed input: please report)."""
 
 class InputError(ValueError):
     """A malformed input file: the message names the file, the line and column or the key."""
@@ -140,7 +158,7 @@ class FitReport:
 
 class Camera:
     """A camera: image size, intrinsics (cx, cy in OpenCV's origin), the cam_from_world pose and
-    the GL depth range (near, far)."""
+    the GL depth range (near, far). target_distance (> 0, finite) places the look-at target."""
     def __init__(self, image_size: ImageSize, K: ArrayLike, R: ArrayLike, t: ArrayLike,
                  k1: float = 0.0, k2: float = 0.0, near: float = 0.1, far: float = 100.0,
                  target_distance: float = 1.0) -> None: ...
@@ -178,10 +196,12 @@ class Camera:
         """The camera's up (-y of cam) in world, unit."""
     @property
     def frustum(self) -> Optional[Frustum]:
-        """glFrustum of the image at (near, far); None with skew."""
+        """glFrustum of the image at (near, far); None with skew or for an orthographic
+        camera."""
     @property
     def perspective(self) -> Optional[Perspective]:
-        """gluPerspective when the frustum is symmetric, else None."""
+        """gluPerspective when the frustum is symmetric, else None (also for an orthographic
+        camera)."""
     @property
     def report(self) -> Optional[FitReport]:
         """The fit's report; None for a camera not made by fit()."""
@@ -202,13 +222,14 @@ class Camera:
         """gl_eye_from_world (4x4), the view matrix."""
     def project(self, points_in_world: ArrayLike) -> Mat:
         """(N, 3) -> (N, 2) pixels (OpenCV origin), distortion included; NaN rows for points
-        not in front of the camera."""
+        not in front of the camera; ValueError naming a row that is not finite."""
     def summary(self) -> str:
-        """The summary `camproj fit` prints (fitted cameras only)."""
+        """The summary `camproj fit` prints, without the "note:" lines it prints after it
+        (fitted cameras only; ValueError for another)."""
     def to_json(self, pixel_origin: Optional[str] = None) -> str:
         """The camera file (docs/camera-file.md); for a fitted camera the text `camproj fit -o`
         writes, in the fit's pixel origin unless given."""
-    def write(self, path: str, pixel_origin: Optional[str] = None) -> None:
+    def write(self, path: PathLike, pixel_origin: Optional[str] = None) -> None:
         """to_json() written atomically to path."""
     def export(self, format: str, depth: str = "no", reversed_z: bool = False,
                row_major: bool = False, pixel_origin: str = "center",
@@ -216,41 +237,51 @@ class Camera:
         """`camproj export --to FORMAT`: one of EXPORT_FORMATS (docs/exports.md); near/far
         replace the camera's depth range (far=math.inf: infinite)."""
 
+PathLike = Union[str, bytes, "os.PathLike[str]"]
+
 def fit(points_in_world: ArrayLike, pixels: ArrayLike, image_size: ImageSize, *,
-        ids: Optional[Sequence[str]] = None, model: str = "auto", criterion: str = "bic",
-        free: Sequence[str] = ..., fix: Sequence[str] = ..., focal: Optional[float] = None,
+        ids: Optional[Sequence[Union[str, int]]] = None, model: str = "auto",
+        criterion: str = "bic", free: Union[str, Sequence[str]] = ...,
+        fix: Union[str, Sequence[str]] = ..., focal: Optional[float] = None,
         fovy_deg: Optional[float] = None, aspect: Optional[float] = None,
         principal_point: Optional[ArrayLike] = None, skew: Optional[float] = None,
         k1: Optional[float] = None, k2: Optional[float] = None,
-        intrinsics: Union[str, Intrinsics, None] = None, pixel_origin: str = "center",
+        intrinsics: Union[PathLike, Intrinsics, None] = None, pixel_origin: str = "center",
         loss: str = "none", refiner: str = "lm", keep_all: bool = False,
         ransac_px: Optional[float] = None,
         sigma: Optional[float] = None, max_uncertainty: Optional[float] = None,
-        object_points_in_world: Optional[ArrayLike] = None, near: Optional[float] = None,
-        far: Optional[float] = None, bounds: Optional[Sequence[float]] = None,
+        object_points_in_world: Union[PathLike, ArrayLike, None] = None,
+        near: Optional[float] = None, far: Optional[float] = None,
+        bounds: Optional[Sequence[float]] = None,
+        bounds_mesh: Union[PathLike, ArrayLike, None] = None,
         origin: Union[str, Sequence[float], None] = None,
         max_iterations: int = 100) -> Camera:
     """`camproj fit` on arrays: points_in_world (N, 3) seen at pixels (N, 2); every option is
     the command line's (`camproj fit --help`), with '-' as '_' (fovy -> fovy_deg, ransac ->
     ransac_px, intrinsics: a camera-file path or an Intrinsics in OpenCV's origin; bounds: the
-    6 numbers of --bounds; origin: "auto" or [X, Y, Z], as --origin). Same
-    camera, same report, same refusals (SceneError subclasses) as the command line. Releases
-    the GIL while fitting."""
+    6 numbers of --bounds; bounds_mesh: an OBJ / PLY path or (M, 3) vertices, as
+    --bounds-mesh; object_points_in_world: (M, 3) or a points file, as --object-points; origin:
+    "auto" or [X, Y, Z], as --origin; free / fix: names, or one string split at commas; ids:
+    strings or integers that a points file could hold). None is "not given". Every value is
+    checked as the command line checks it: TypeError for the wrong type, ValueError for a wrong
+    value (not finite, not positive, an unknown name), naming the option. Same camera, same
+    report, same refusals (SceneError subclasses) as the command line. Releases the GIL while
+    fitting (also in daemon threads at the interpreter's exit)."""
 
-def fit_file(path: str, image_size: ImageSize, **options: Any) -> Camera:
+def fit_file(path: PathLike, image_size: ImageSize, **options: Any) -> Camera:
     """fit() on a points CSV (ids from its id column)."""
 
-def read_camera(path: str) -> Camera: ...
+def read_camera(path: PathLike) -> Camera: ...
 def camera_from_json(text: str, source: str = "<string>") -> Camera: ...
-def read_points(path: str) -> Tuple[Mat, Mat, list[str]]:
+def read_points(path: PathLike) -> Tuple[Mat, Mat, list[str]]:
     """(points_in_world (N, 3), pixels (N, 2), ids) of a points CSV."""
 def points_from_csv(text: str, source: str = "<string>") -> Tuple[Mat, Mat, list[str]]: ...
 def points_to_csv(points_in_world: ArrayLike, pixels: ArrayLike,
-                  ids: Optional[Sequence[str]] = None) -> str: ...
-def write_points(path: str, points_in_world: ArrayLike, pixels: ArrayLike,
-                 ids: Optional[Sequence[str]] = None) -> None: ...
+                  ids: Optional[Sequence[Union[str, int]]] = None) -> str: ...
+def write_points(path: PathLike, points_in_world: ArrayLike, pixels: ArrayLike,
+                 ids: Optional[Sequence[Union[str, int]]] = None) -> None: ...
 
-def write_file_atomically(path: str, contents: str) -> None:
+def write_file_atomically(path: PathLike, contents: str) -> None:
     """Writes text as `camproj fit -o` does: readers see the old file or the new one, never a
     partial one; flushed to disk before the rename (file_io.h)."""
 

@@ -3,6 +3,9 @@
 // converts numpy arrays, strings and exceptions. Conventions: docs/conventions.md; the Python
 // API, with units, is in camproj.pyi.
 #include <cmath>
+#include <exception>
+#include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -13,6 +16,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "camproj/camera.h"
 #include "camproj/camera_file.h"
@@ -27,6 +31,7 @@
 #include "camproj/gl.h"
 #include "camproj/library_logging.h"
 #include "camproj/look_at.h"
+#include "camproj/number_text.h"
 #include "camproj/points_file.h"
 #include "camproj/pose.h"
 
@@ -47,9 +52,37 @@ struct PyCamera {
   PixelOrigin input_origin = PixelOrigin::kCenter;  // of the fitted pixels (the camera file's)
 };
 
-// (N, columns) float64 -> N vectors; ValueError naming `name` and the shape otherwise.
+// `value`'s Python type, for messages: "str", "numpy.ndarray".
+std::string TypeName(const py::handle& value) {
+  const py::handle type = py::type::handle_of(value);
+  const std::string module = py::str(type.attr("__module__"));
+  const std::string name = py::str(type.attr("__qualname__"));
+  return module == "builtins" ? name : module + "." + name;
+}
+
+// "'1500' (str)": a value as a message shows it.
+std::string Shown(const py::handle& value) {
+  std::string text = py::repr(value);
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text + " (" + TypeName(value) + ")";
+}
+
+// An (N, columns) array of real numbers (numpy array or nested sequences, any real dtype) -> N
+// vectors. ValueError naming `name` and the shape; TypeError for None, booleans, complex numbers
+// or text, which a cast to float64 would take silently or with only a warning.
 template <int kColumns>
-std::vector<Eigen::Matrix<double, kColumns, 1>> Rows(const Array& array, const char* name) {
+std::vector<Eigen::Matrix<double, kColumns, 1>> Rows(const py::handle& value, const char* name) {
+  if (value.is_none()) {
+    throw py::type_error(std::string(name) + ": expected an (N, " + std::to_string(kColumns) +
+                         ") array, got None");
+  }
+  const py::array any = py::module_::import("numpy").attr("asarray")(value);
+  const char kind = any.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    throw py::type_error(std::string(name) + ": expected real numbers, got an array of " +
+                         std::string(py::str(any.dtype())));
+  }
+  const Array array = Array::ensure(any);
   if (array.ndim() != 2 || array.shape(1) != kColumns) {
     std::string shape = "(";
     for (py::ssize_t i = 0; i < array.ndim(); ++i) {
@@ -65,6 +98,34 @@ std::vector<Eigen::Matrix<double, kColumns, 1>> Rows(const Array& array, const c
     for (int j = 0; j < kColumns; ++j) rows[i][j] = data[i * kColumns + j];
   }
   return rows;
+}
+
+// A path given as str, bytes or os.PathLike, or nullopt for anything else.
+std::optional<std::string> PathOf(const py::handle& value) {
+  if (!py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value) &&
+      !py::hasattr(value, "__fspath__")) {
+    return std::nullopt;
+  }
+  return py::module_::import("os").attr("fsdecode")(value).cast<std::string>();
+}
+
+// Runs `work` with the GIL released, so fits in threads of one process run in parallel.
+// Not py::gil_scoped_release: its destructor takes the GIL back, and a daemon thread that does
+// so while the interpreter exits is ended by pthread_exit, whose forced unwind through a noexcept
+// destructor aborts the process. Here the GIL is taken back in plain code, outside the try.
+template <class Work>
+auto WithoutGil(Work&& work) -> decltype(work()) {
+  std::optional<decltype(work())> result;
+  std::exception_ptr error;
+  PyThreadState* const state = PyEval_SaveThread();
+  try {
+    result.emplace(work());
+  } catch (...) {
+    error = std::current_exception();
+  }
+  PyEval_RestoreThread(state);
+  if (error) std::rethrow_exception(error);
+  return std::move(*result);
 }
 
 template <int kColumns>
@@ -95,83 +156,207 @@ Rigid3 PoseOf(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
 
 CameraViews ViewsOf(const PyCamera& c) { return ViewsOfCamera(c.camera, c.target_distance); }
 
-// fit()'s keyword arguments -> the command line's FitArguments (fit_request.h).
+// fit()'s option values, each checked as the command line checks its option: TypeError naming
+// the option for a value of the wrong type, ValueError for a wrong value.
+class OptionValue {
+ public:
+  OptionValue(const std::string& name, const py::handle& value) : name_(name), value_(value) {}
+
+  const py::handle& value() const { return value_; }
+  // Throws Error("NAME: expected EXPECTED, got GOT").
+  template <class Error>
+  [[noreturn]] void Fail(const std::string& expected, const std::string& got) const {
+    throw Error(name_ + ": expected " + expected + ", got " + got);
+  }
+
+  // A finite real number (int, float, numpy scalar; not bool).
+  double Number() const { return NumberAt(value_, name_); }
+  double Positive() const {
+    const double v = Number();
+    if (!(v > 0.0)) Fail<std::invalid_argument>("a positive number", ShortestDouble(v));
+    return v;
+  }
+  // Exactly `count` numbers, as a sequence (list, tuple, array).
+  std::vector<double> Numbers(size_t count) const {
+    if (py::isinstance<py::str>(value_) || !py::isinstance<py::sequence>(value_)) {
+      Fail<py::type_error>(std::to_string(count) + " numbers", Shown(value_));
+    }
+    const py::sequence sequence = py::reinterpret_borrow<py::sequence>(value_);
+    if (sequence.size() != count) {
+      Fail<std::invalid_argument>(std::to_string(count) + " numbers",
+                                  std::to_string(sequence.size()));
+    }
+    std::vector<double> numbers;
+    for (size_t i = 0; i < count; ++i) {
+      numbers.push_back(NumberAt(sequence[i], name_ + "[" + std::to_string(i) + "]"));
+    }
+    return numbers;
+  }
+  int NonNegativeInteger() const {
+    long long v = 0;
+    try {
+      if (py::isinstance<py::bool_>(value_)) throw py::cast_error();
+      v = value_.cast<long long>();  // refuses floats; numpy integers convert
+    } catch (const py::cast_error&) {
+      if (!py::isinstance<py::int_>(value_)) Fail<py::type_error>("an integer", Shown(value_));
+      v = -1;  // an int beyond 64 bits
+    }
+    if (v < 0 || v > std::numeric_limits<int>::max()) {
+      Fail<std::invalid_argument>("an integer from 0 to 2147483647",
+                                  std::string(py::repr(value_)));
+    }
+    return static_cast<int>(v);
+  }
+  bool Bool() const {
+    if (!py::isinstance<py::bool_>(value_) && TypeName(value_) != "numpy.bool_") {
+      Fail<py::type_error>("True or False", Shown(value_));
+    }
+    return value_.cast<bool>();
+  }
+  std::string String() const {
+    if (!py::isinstance<py::str>(value_)) Fail<py::type_error>("a string", Shown(value_));
+    return value_.cast<std::string>();
+  }
+  // Names, as a sequence of strings or one string split at commas (as the command line's
+  // --free focal,aspect).
+  std::vector<std::string> Names() const {
+    std::vector<std::string> names;
+    if (py::isinstance<py::str>(value_)) {
+      std::string text = value_.cast<std::string>();
+      for (size_t begin = 0;;) {
+        const size_t comma = text.find(',', begin);
+        names.push_back(text.substr(begin, comma - begin));
+        if (comma == std::string::npos) return names;
+        begin = comma + 1;
+      }
+    }
+    if (!py::isinstance<py::sequence>(value_)) {
+      Fail<py::type_error>("a sequence of names", Shown(value_));
+    }
+    for (const py::handle item : py::reinterpret_borrow<py::sequence>(value_)) {
+      if (!py::isinstance<py::str>(item)) {
+        Fail<py::type_error>("a sequence of names", "an item " + Shown(item));
+      }
+      names.push_back(item.cast<std::string>());
+    }
+    return names;
+  }
+
+ private:
+  double NumberAt(const py::handle& value, const std::string& name) const {
+    double v = 0.0;
+    try {
+      if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value)) throw py::cast_error();
+      v = value.cast<double>();
+    } catch (const py::cast_error&) {
+      throw py::type_error(name + ": expected a number, got " + Shown(value));
+    }
+    if (!std::isfinite(v)) {
+      throw std::invalid_argument(name + ": expected a finite number, got " + ShortestDouble(v));
+    }
+    return v;
+  }
+
+  std::string name_;
+  py::handle value_;
+};
+
+// Reads one fit() option into the command line's arguments.
+using OptionReader = void (*)(const OptionValue& v, FitArguments& a);
+
+// fit()'s options, by name (the command line's with '-' as '_'; camproj.pyi lists them).
+const std::map<std::string, OptionReader>& OptionReaders() {
+  static const auto& readers = *new std::map<std::string, OptionReader>{
+      {"model", [](const OptionValue& v, FitArguments& a) { a.model = v.String(); }},
+      {"criterion", [](const OptionValue& v, FitArguments& a) { a.criterion = v.String(); }},
+      {"free", [](const OptionValue& v, FitArguments& a) { a.free = v.Names(); }},
+      {"fix", [](const OptionValue& v, FitArguments& a) { a.fix = v.Names(); }},
+      {"focal", [](const OptionValue& v, FitArguments& a) { a.focal = v.Positive(); }},
+      {"fovy_deg", [](const OptionValue& v, FitArguments& a) { a.fovy_deg = v.Positive(); }},
+      {"aspect", [](const OptionValue& v, FitArguments& a) { a.aspect = v.Positive(); }},
+      {"principal_point",
+       [](const OptionValue& v, FitArguments& a) {
+         const std::vector<double> c = v.Numbers(2);
+         a.principal_point = Eigen::Vector2d(c[0], c[1]);
+       }},
+      {"skew", [](const OptionValue& v, FitArguments& a) { a.skew = v.Number(); }},
+      {"k1", [](const OptionValue& v, FitArguments& a) { a.k1 = v.Number(); }},
+      {"k2", [](const OptionValue& v, FitArguments& a) { a.k2 = v.Number(); }},
+      {"intrinsics",
+       [](const OptionValue& v, FitArguments& a) {
+         if (const auto path = PathOf(v.value())) {
+           a.known_intrinsics = ReadIntrinsicsFile(*path);
+         } else if (py::isinstance<Intrinsics>(v.value())) {
+           a.known_intrinsics = v.value().cast<Intrinsics>();
+         } else {
+           v.Fail<py::type_error>("a camproj.Intrinsics or the path of a camera file",
+                                  Shown(v.value()));
+         }
+       }},
+      {"pixel_origin", [](const OptionValue& v, FitArguments& a) { a.pixel_origin = v.String(); }},
+      {"loss", [](const OptionValue& v, FitArguments& a) { a.loss = v.String(); }},
+      {"refiner", [](const OptionValue& v, FitArguments& a) { a.refiner = v.String(); }},
+      {"keep_all", [](const OptionValue& v, FitArguments& a) { a.keep_all = v.Bool(); }},
+      {"ransac_px", [](const OptionValue& v, FitArguments& a) { a.ransac_px = v.Positive(); }},
+      {"sigma", [](const OptionValue& v, FitArguments& a) { a.sigma = v.Positive(); }},
+      {"max_uncertainty",
+       [](const OptionValue& v, FitArguments& a) { a.max_uncertainty = v.Positive(); }},
+      {"object_points_in_world",
+       [](const OptionValue& v, FitArguments& a) {
+         if (const auto path = PathOf(v.value())) {
+           CorrespondencesLimits limits;  // as --object-points reads its file: pixels optional
+           limits.require_pixels = false;
+           a.object_points_in_world = ReadCorrespondencesFile(*path, limits).points_in_world;
+         } else {
+           a.object_points_in_world = Rows<3>(v.value(), "object_points_in_world");
+         }
+       }},
+      {"near", [](const OptionValue& v, FitArguments& a) { a.z_near = v.Positive(); }},
+      {"far", [](const OptionValue& v, FitArguments& a) { a.z_far = v.Positive(); }},
+      {"bounds",
+       [](const OptionValue& v, FitArguments& a) {
+         const std::vector<double> b = v.Numbers(6);
+         a.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
+       }},
+      {"bounds_mesh",
+       [](const OptionValue& v, FitArguments& a) {
+         const auto path = PathOf(v.value());
+         a.mesh_vertices_in_world =
+             path ? ReadMeshVertices(*path) : Rows<3>(v.value(), "bounds_mesh");
+         // An empty mesh file is refused by its reader; so is an empty array (not "no mesh").
+         if (a.mesh_vertices_in_world.empty()) {
+           throw std::invalid_argument("bounds_mesh: no vertices");
+         }
+       }},
+      {"origin",
+       [](const OptionValue& v, FitArguments& a) {
+         if (!py::isinstance<py::str>(v.value())) {
+           const std::vector<double> o = v.Numbers(3);
+           a.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
+         } else if (v.String() == "auto") {
+           a.auto_world_origin = true;
+         } else {
+           v.Fail<std::invalid_argument>("\"auto\" or 3 numbers X, Y, Z", Shown(v.value()));
+         }
+       }},
+      {"max_iterations",
+       [](const OptionValue& v, FitArguments& a) { a.max_iterations = v.NonNegativeInteger(); }},
+  };
+  return readers;
+}
+
+// fit()'s keyword arguments -> the command line's FitArguments (fit_request.h); None is "not
+// given". The name is checked first, so that a misspelled option is never ignored.
 FitArguments ArgumentsOf(const py::kwargs& kwargs) {
   FitArguments a;
-  for (const auto& [key_handle, value] : kwargs) {
-    const std::string key = py::str(key_handle);
-    if (value.is_none()) continue;
-    if (key == "model") a.model = value.cast<std::string>();
-    else if (key == "criterion") a.criterion = value.cast<std::string>();
-    else if (key == "free") a.free = value.cast<std::vector<std::string>>();
-    else if (key == "fix") a.fix = value.cast<std::vector<std::string>>();
-    else if (key == "focal") a.focal = value.cast<double>();
-    else if (key == "fovy_deg") a.fovy_deg = value.cast<double>();
-    else if (key == "aspect") a.aspect = value.cast<double>();
-    else if (key == "principal_point") a.principal_point = value.cast<Eigen::Vector2d>();
-    else if (key == "skew") a.skew = value.cast<double>();
-    else if (key == "k1") a.k1 = value.cast<double>();
-    else if (key == "k2") a.k2 = value.cast<double>();
-    else if (key == "intrinsics") {
-      a.known_intrinsics = py::isinstance<py::str>(value)
-                               ? ReadIntrinsicsFile(value.cast<std::string>())
-                               : value.cast<Intrinsics>();
-    } else if (key == "pixel_origin") a.pixel_origin = value.cast<std::string>();
-    else if (key == "loss") a.loss = value.cast<std::string>();
-    else if (key == "refiner") a.refiner = value.cast<std::string>();
-    else if (key == "keep_all") a.keep_all = value.cast<bool>();
-    else if (key == "ransac_px") a.ransac_px = value.cast<double>();
-    else if (key == "sigma") a.sigma = value.cast<double>();
-    else if (key == "max_uncertainty") a.max_uncertainty = value.cast<double>();
-    else if (key == "object_points_in_world") {
-      a.object_points_in_world = Rows<3>(value.cast<Array>(), "object_points_in_world");
-    } else if (key == "near") a.z_near = value.cast<double>();
-    else if (key == "far") a.z_far = value.cast<double>();
-    else if (key == "bounds") {
-      const auto b = value.cast<std::vector<double>>();
-      if (b.size() != 6) {
-        throw std::invalid_argument("bounds: expected 6 numbers X0,Y0,Z0,X1,Y1,Z1, got " +
-                                    std::to_string(b.size()));
-      }
-      a.bounds_in_world = BoxInWorld{{b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
+  for (const auto& [key, value] : kwargs) {
+    const std::string name = py::str(key);
+    const auto reader = OptionReaders().find(name);
+    if (reader == OptionReaders().end()) {
+      throw std::invalid_argument("fit: unknown option \"" + name + "\" (see help(camproj.fit))");
     }
-    else if (key == "bounds_mesh") {
-      a.mesh_vertices_in_world = py::isinstance<py::str>(value)
-                                     ? ReadMeshVertices(value.cast<std::string>())
-                                     : Rows<3>(value.cast<Array>(), "bounds_mesh");
-      // An empty mesh file is refused by its reader; so is an empty array (not "no mesh").
-      if (a.mesh_vertices_in_world.empty()) {
-        throw std::invalid_argument("bounds_mesh: no vertices");
-      }
-    } else if (key == "origin") {
-      if (py::isinstance<py::str>(value)) {
-        if (value.cast<std::string>() != "auto") {
-          throw std::invalid_argument("origin: expected \"auto\" or 3 numbers X, Y, Z, got \"" +
-                                      value.cast<std::string>() + "\"");
-        }
-        a.auto_world_origin = true;
-      } else {
-        const auto o = value.cast<std::vector<double>>();
-        if (o.size() != 3) {
-          throw std::invalid_argument("origin: expected \"auto\" or 3 numbers X, Y, Z, got " +
-                                      std::to_string(o.size()) + " numbers");
-        }
-        a.world_origin = Eigen::Vector3d(o[0], o[1], o[2]);
-      }
-    }
-    else if (key == "max_iterations") a.max_iterations = value.cast<int>();
-    else throw std::invalid_argument("fit: unknown option \"" + key + "\" (see help(camproj.fit))");
+    if (!value.is_none()) reader->second(OptionValue(name, value), a);
   }
-  // The command line refuses non-positive values of these options before they reach the library.
-  const std::pair<const char*, double> positive[] = {
-      {"focal", a.focal}, {"fovy_deg", a.fovy_deg}, {"aspect", a.aspect}, {"ransac_px", a.ransac_px},
-      {"sigma", a.sigma}, {"max_uncertainty", a.max_uncertainty}, {"near", a.z_near}, {"far", a.z_far}};
-  for (const auto& [name, v] : positive) {
-    if (kwargs.contains(name) && !kwargs[name].is_none() && !(v > 0.0)) {
-      throw std::invalid_argument(std::string(name) + ": expected a positive number, got " + std::to_string(v));
-    }
-  }
-  if (a.max_iterations < 0) throw std::invalid_argument("max_iterations: expected >= 0");
   return a;
 }
 
@@ -179,24 +364,42 @@ PyCamera Fit(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen
              const std::vector<std::string>& ids, const ImageSize& size, const FitArguments& arguments) {
   const FitRequest request = FitRequestFrom(arguments, size);
   PyCamera result;
-  {
-    py::gil_scoped_release release;  // fits in threads of one process run in parallel
-    auto fit = std::make_shared<FitResult>(RunFitRequest(points, pixels, ids, size, request));
-    result.fit = fit;
-  }
+  result.fit = WithoutGil([&] {
+    return std::make_shared<const FitResult>(RunFitRequest(points, pixels, ids, size, request));
+  });
   result.camera = result.fit->camera;
-  result.target_distance = (result.fit->views.look_at.target - result.fit->views.look_at.eye).norm();
+  result.target_distance =
+      (result.fit->views.look_at.target - result.fit->views.look_at.eye).stableNorm();
   result.ids = ids;
   result.input_origin = request.options().pixel_origin;
   return result;
 }
 
+// Point ids: strings (or integers, written as text), one per point, that a points file could
+// hold (CheckPointIds); none: the points are numbered from 1.
 std::vector<std::string> IdsOf(const py::object& ids, size_t count) {
   if (ids.is_none()) return {};
-  auto list = ids.cast<std::vector<std::string>>();
+  if (py::isinstance<py::str>(ids) || !py::isinstance<py::sequence>(ids)) {
+    throw py::type_error("ids: expected a sequence of strings, got " + Shown(ids));
+  }
+  std::vector<std::string> list;
+  for (const py::handle id : py::reinterpret_borrow<py::sequence>(ids)) {
+    if (py::isinstance<py::str>(id)) {
+      list.push_back(id.cast<std::string>());
+    } else if (!py::isinstance<py::bool_>(id) && py::hasattr(id, "__index__")) {
+      list.push_back(py::str(py::int_(py::reinterpret_borrow<py::object>(id))));
+    } else {
+      throw py::type_error("ids: expected strings or integers, got " + Shown(id));
+    }
+  }
   if (list.size() != count) {
     throw std::invalid_argument("ids: expected one per point (" + std::to_string(count) + "), got " +
                                 std::to_string(list.size()));
+  }
+  try {
+    CheckPointIds(list);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("ids: ") + e.what());
   }
   return list;
 }
@@ -393,6 +596,10 @@ PYBIND11_MODULE(camproj, m) {
              c.camera.z_near = z_near;
              c.camera.z_far = z_far;
              c.camera.Check();
+             if (!(std::isfinite(target_distance) && target_distance > 0.0)) {
+               throw std::invalid_argument("target_distance: expected a positive finite number, got " +
+                                           ShortestDouble(target_distance));
+             }
              c.target_distance = target_distance;
              return c;
            }),
@@ -431,7 +638,7 @@ PYBIND11_MODULE(camproj, m) {
       .def_property_readonly("far", [](const PyCamera& c) { return c.camera.z_far; })
       .def_property_readonly("world_origin", [](const PyCamera& c) { return c.camera.world_origin; },
                              "The world origin GL exports' view matrix is relative to (3,), or None "
-                             "(docs/conventions.md, section 11).")
+                             "(docs/conventions.md, section 12).")
       .def_property_readonly("projection", [](const PyCamera& c) {
         return c.camera.projection == Projection::kPerspective ? "perspective" : "orthographic";
       })
@@ -469,10 +676,17 @@ PYBIND11_MODULE(camproj, m) {
       .def("gl_view", [](const PyCamera& c) { return GlEyeFromWorld(c.camera.cam_from_world); },
            "gl_eye_from_world (4x4): the GL view matrix (docs/conventions.md).")
       .def("project",
-           [](const PyCamera& c, const Array& points) {
+           [](const PyCamera& c, const py::object& points) {
              const auto rows = Rows<3>(points, "points_in_world");
              std::vector<Eigen::Vector2d> pixels(rows.size());
              for (size_t i = 0; i < rows.size(); ++i) {
+               // A NaN row out means "not in front of the camera"; a NaN row in is a mistake.
+               if (!rows[i].allFinite()) {
+                 throw std::invalid_argument("points_in_world[" + std::to_string(i) +
+                                             "] is not finite: " + ShortestDouble(rows[i].x()) +
+                                             ", " + ShortestDouble(rows[i].y()) + ", " +
+                                             ShortestDouble(rows[i].z()));
+               }
                pixels[i] = PixelFromWorld(c.camera, rows[i])
                                .value_or(Eigen::Vector2d::Constant(std::nan("")));
              }
@@ -513,7 +727,7 @@ PYBIND11_MODULE(camproj, m) {
            py::arg("row_major") = false, py::arg("pixel_origin") = "center",
            py::arg("near") = py::none(), py::arg("far") = py::none())
       .def("write",
-           [](const PyCamera& c, const std::string& path, std::optional<std::string> origin) {
+           [](const PyCamera& c, const std::filesystem::path& path, std::optional<std::string> origin) {
              const PixelOrigin o = origin ? PixelOriginFromString(*origin) : c.input_origin;
              CameraFileOptions options;
              options.pixel_origin = o;
@@ -530,17 +744,17 @@ PYBIND11_MODULE(camproj, m) {
       });
 
   m.def("fit",
-        [](const Array& points, const Array& pixels, std::pair<int, int> size, const py::object& ids,
+        [](const py::object& points, const py::object& pixels, std::pair<int, int> size, const py::object& ids,
            const py::kwargs& kwargs) {
           const auto p = Rows<3>(points, "points_in_world");
           const auto q = Rows<2>(pixels, "pixels");
           return Fit(p, q, IdsOf(ids, q.size()), SizeOf(size), ArgumentsOf(kwargs));
         },
-        "fit(points_in_world, pixels, image_size, *, ids=None, **options) -> Camera\n\n`camproj fit` on arrays: points_in_world (N, 3) in world units seen at pixels (N, 2) in px (OpenCV origin unless pixel_origin=\"corner\"); image_size (width, height) px. Options are the command line's with '-' as '_' (model, criterion, free, fix, focal [px], fovy_deg, aspect, principal_point, skew, k1, k2, intrinsics, pixel_origin, loss, keep_all, ransac_px, sigma [px], max_uncertainty [px], object_points_in_world, near, far, bounds (6 numbers), bounds_mesh (an OBJ / PLY path or (M, 3) vertices: near and far cover them and the camera is judged at them), origin, max_iterations). Raises a SceneError subclass with the command line's message when the points cannot determine the camera, ValueError for a bad argument. Conventions: docs/conventions.md.",
+        "fit(points_in_world, pixels, image_size, *, ids=None, **options) -> Camera\n\n`camproj fit` on arrays: points_in_world (N, 3) in world units seen at pixels (N, 2) in px (OpenCV origin unless pixel_origin=\"corner\"); image_size (width, height) px. Options are the command line's with '-' as '_' (model, criterion, free, fix, focal [px], fovy_deg, aspect, principal_point, skew, k1, k2, intrinsics, pixel_origin, loss, refiner, keep_all, ransac_px, sigma [px], max_uncertainty [px], object_points_in_world, near, far, bounds (6 numbers), bounds_mesh (an OBJ / PLY path or (M, 3) vertices: near and far cover them and the camera is judged at them), origin, max_iterations). Raises a SceneError subclass with the command line's message when the points cannot determine the camera, ValueError for a bad argument. Conventions: docs/conventions.md.",
         py::arg("points_in_world"), py::arg("pixels"), py::arg("image_size"), py::kw_only(),
         py::arg("ids") = py::none());
   m.def("fit_file",
-        [](const std::string& path, std::pair<int, int> size, const py::kwargs& kwargs) {
+        [](const std::filesystem::path& path, std::pair<int, int> size, const py::kwargs& kwargs) {
           const FitArguments arguments = ArgumentsOf(kwargs);
           const Correspondences data = ReadCorrespondencesFile(path);
           return Fit(data.points_in_world, data.pixels, data.ids, SizeOf(size), arguments);
@@ -548,7 +762,7 @@ PYBIND11_MODULE(camproj, m) {
         "fit_file(path, image_size, **options) -> Camera: fit() on a points CSV (ids from its id column).",
         py::arg("path"), py::arg("image_size"));
 
-  m.def("read_camera", [](const std::string& path) {
+  m.def("read_camera", [](const std::filesystem::path& path) {
     PyCamera c;
     c.camera = ReadCameraFile(path);
     return c;
@@ -559,7 +773,7 @@ PYBIND11_MODULE(camproj, m) {
     return c;
   }, py::arg("text"), py::arg("source") = "<string>");
 
-  m.def("read_points", [](const std::string& path) {
+  m.def("read_points", [](const std::filesystem::path& path) {
     const Correspondences d = ReadCorrespondencesFile(path);
     return py::make_tuple(ToArray<3>(d.points_in_world), ToArray<2>(d.pixels), d.ids);
   }, py::arg("path"));
@@ -567,14 +781,14 @@ PYBIND11_MODULE(camproj, m) {
     const Correspondences d = CorrespondencesFromCsvText(text, source);
     return py::make_tuple(ToArray<3>(d.points_in_world), ToArray<2>(d.pixels), d.ids);
   }, py::arg("text"), py::arg("source") = "<string>");
-  m.def("points_to_csv", [](const Array& points, const Array& pixels, const py::object& ids) {
+  m.def("points_to_csv", [](const py::object& points, const py::object& pixels, const py::object& ids) {
     Correspondences d;
     d.points_in_world = Rows<3>(points, "points_in_world");
     d.pixels = Rows<2>(pixels, "pixels");
     d.ids = IdsOf(ids, d.pixels.size());
     return CorrespondencesToCsvText(d);
   }, py::arg("points_in_world"), py::arg("pixels"), py::arg("ids") = py::none());
-  m.def("write_points", [](const std::string& path, const Array& points, const Array& pixels,
+  m.def("write_points", [](const std::filesystem::path& path, const py::object& points, const py::object& pixels,
                            const py::object& ids) {
     Correspondences d;
     d.points_in_world = Rows<3>(points, "points_in_world");
@@ -661,7 +875,11 @@ PYBIND11_MODULE(camproj, m) {
           return PixelOriginShift(PixelOriginFromString(from), PixelOriginFromString(to));
         },
         py::arg("from_origin"), py::arg("to_origin"));
-  m.def("write_file_atomically", &WriteFileAtomically, py::arg("path"), py::arg("contents"),
+  m.def("write_file_atomically",
+        [](const std::filesystem::path& path, const std::string& contents) {
+          WriteFileAtomically(path, contents);
+        },
+        py::arg("path"), py::arg("contents"),
         "Writes text as camproj fit -o does (file_io.h): readers see the old file or the new one, "
         "never a partial one; flushed to disk before the rename.");
   m.attr("EXPORT_FORMATS") = py::make_tuple("gl", "glm", "opencv-yaml", "colmap", "three", "json",

@@ -176,6 +176,16 @@ TEST(FileIoTest, SameFileResolvesDotsLinksAndHardLinks) {
   fs::current_path(before);
 }
 
+// An empty path is refused as such, not with the errno of open("") or link("").
+TEST(FileIoTest, AnEmptyPathIsRefusedAsEmpty) {
+  try {
+    WriteFileAtomically("", "x");
+    ADD_FAILURE() << "wrote";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "cannot write a file with an empty path");
+  }
+}
+
 TEST(FileIoTest, WriteFilesAtomicallyWritesAllOrNone) {
   const TemporaryFolder folder("camproj_write_files");
   const fs::path& d = folder.path();

@@ -293,6 +293,34 @@ TEST(PointsFileTest, WritingRefusesWhatWouldNotReadBack) {
   }
 }
 
+// Points numbered from 1, as the file's rows are; the first problem is named.
+TEST(PointsFileTest, CheckPointIdsNamesTheIdAndThePoint) {
+  const auto message = [](const std::vector<std::string>& ids) {
+    try {
+      CheckPointIds(ids);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message({"a", "b", "c1"}), "accepted");
+  EXPECT_EQ(message({}), "accepted");
+  EXPECT_EQ(message({"a", ""}), "id \"\" (point 2) is empty");
+  EXPECT_EQ(message({"a", "b", "c,d"}), "id \"c,d\" (point 3) contains a comma or line break");
+  EXPECT_EQ(message({"a\r"}), "id \"a\\x0d\" (point 1) contains a comma or line break");
+  EXPECT_EQ(message({"a", "b "}), "id \"b \" (point 2) has surrounding spaces or tabs");
+  EXPECT_EQ(message({"x", "a", "b", "a"}), "id \"a\" is repeated (points 2 and 4)");
+  Correspondences c;
+  c.points_in_world = {Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(4, 5, 6)};
+  c.pixels = {Eigen::Vector2d(1, 2), Eigen::Vector2d(3, std::nan(""))};
+  try {
+    CorrespondencesToCsvText(c);
+    ADD_FAILURE() << "wrote a NaN";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("point 2 is not finite", 0), 0u) << e.what();
+  }
+}
+
 TEST(PointsFileTest, StreamedFileMatchesTextAcrossBufferBoundaries) {
   const TempDir dir("stream");
   // CRLF rows spanning well over one 64 KiB read, so lines straddle the buffer edge.

@@ -284,6 +284,8 @@ struct PreparedWrite {
 // Everything of a write but giving the file its name: the temporary in the target's folder,
 // the contents, the replaced file's owner and permissions, fsync.
 std::unique_ptr<PreparedWrite> PrepareWrite(const std::string& path, const std::string& contents) {
+  // An empty path names no file (open("") fails with a message about links and folders).
+  if (path.empty()) throw InputError("cannot write a file with an empty path");
   auto write = std::make_unique<PreparedWrite>();
   write->path = path;
   write->target = ResolveLinks(path);

@@ -13,7 +13,6 @@
 #include <string_view>
 #include <system_error>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
@@ -434,6 +433,18 @@ std::vector<CorrespondencesView> ReadCorrespondencesViewsFile(
   return parser.FinishViews();
 }
 
+void CheckPointIds(const std::vector<std::string>& ids) {
+  std::unordered_map<std::string_view, size_t> index_of_id;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const std::string problem = IdProblem(ids[i]);
+    // Points numbered from 1, as the file's rows and the summary number them.
+    internal::Require(problem.empty(), "id ", Quoted(ids[i]), " (point ", i + 1, ") ", problem);
+    const auto [it, inserted] = index_of_id.emplace(ids[i], i);
+    internal::Require(inserted, "id ", Quoted(ids[i]), " is repeated (points ", it->second + 1,
+                      " and ", i + 1, ")");
+  }
+}
+
 std::string CorrespondencesToCsvText(const Correspondences& correspondences) {
   const Correspondences& c = correspondences;
   const size_t n = c.points_in_world.size();
@@ -442,17 +453,14 @@ std::string CorrespondencesToCsvText(const Correspondences& correspondences) {
                     c.pixels.size());
   internal::Require(c.ids.empty() || c.ids.size() == n, "points_in_world has ", n,
                     " entries but ids has ", c.ids.size());
+  CheckPointIds(c.ids);
   bool write_ids = false;
-  std::unordered_set<std::string_view> seen;
   for (size_t i = 0; i < c.ids.size(); ++i) {
-    const std::string problem = IdProblem(c.ids[i]);
-    internal::Require(problem.empty(), "id ", i, " ", Quoted(c.ids[i]), " ", problem);
-    internal::Require(seen.insert(c.ids[i]).second, "id ", Quoted(c.ids[i]), " is repeated");
     write_ids = write_ids || c.ids[i] != std::to_string(i + 1);
   }
   std::string text = write_ids ? "X,Y,Z,u,v,id\n" : "X,Y,Z,u,v\n";
   for (size_t i = 0; i < n; ++i) {
-    internal::Require(c.points_in_world[i].allFinite() && c.pixels[i].allFinite(), "point ", i,
+    internal::Require(c.points_in_world[i].allFinite() && c.pixels[i].allFinite(), "point ", i + 1,
                       " is not finite: X,Y,Z = ", c.points_in_world[i].transpose(),
                       ", u,v = ", c.pixels[i].transpose());
     const double values[] = {c.points_in_world[i].x(), c.points_in_world[i].y(),

@@ -21,7 +21,8 @@ namespace camproj {
 //  - after the rename, temporaries of this function in the folder last modified over an hour ago
 //    (left by a kill in the instant before a rename) are removed.
 // Throws InputError naming `path` and the reason (e.g. "File too large" under `ulimit -f`, when
-// SIGXFSZ is ignored as InstallTemporaryFileCleanup arranges) and removes the temporary.
+// SIGXFSZ is ignored as InstallTemporaryFileCleanup arranges) and removes the temporary; also
+// for an empty path.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 // One output of a command that writes several: the path, the bytes, and what names it in

@@ -93,11 +93,15 @@ std::vector<CorrespondencesView> CorrespondencesViewsFromCsvText(
 std::vector<CorrespondencesView> ReadCorrespondencesViewsFile(
     const std::string& path, const CorrespondencesLimits& limits = {});
 
+// Throws std::invalid_argument naming the first id that would not read back from a points file:
+// one that is empty, repeated, contains a comma or line break, or has surrounding spaces or tabs
+// ("id \"a,b\" (point 3) contains a comma or line break"; points numbered from 1).
+void CheckPointIds(const std::vector<std::string>& ids);
+
 // The file text: header "X,Y,Z,u,v", plus ",id" when `ids` is non-empty and differs from the
 // default numbering "1", "2", ...; one row per point; doubles in the shortest form that reads back
 // bit for bit. line_numbers is ignored. Throws std::invalid_argument when the sizes disagree,
-// there are no points, a value is not finite, or an id would not read back (empty, repeated,
-// containing a comma or line break, or with surrounding spaces or tabs).
+// there are no points, a value is not finite, or an id would not read back (CheckPointIds).
 std::string CorrespondencesToCsvText(const Correspondences& correspondences);
 
 }  // namespace camproj
