@@ -285,7 +285,8 @@ const std::map<std::string, OptionReader>& OptionReaders() {
       {"intrinsics",
        [](const OptionValue& v, FitArguments& a) {
          if (const auto path = PathOf(v.value())) {
-           a.known_intrinsics = ReadIntrinsicsFile(*path);
+           a.known_intrinsics = ReadIntrinsicsFile(*path, &a.known_intrinsics_image_size);
+           a.known_intrinsics_path = *path;
          } else if (py::isinstance<Intrinsics>(v.value())) {
            a.known_intrinsics = v.value().cast<Intrinsics>();
          } else {

@@ -146,18 +146,9 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
     arguments.principal_point = Eigen::Vector2d(c[0], c[1]);
   }
   if (!args.intrinsics_path.empty()) {
-    std::optional<ImageSize> calibrated_size;
-    arguments.known_intrinsics = ReadIntrinsicsFile(args.intrinsics_path, &calibrated_size);
-    // Intrinsics are in pixels of one image size: at another (a calibration at 1920x1080 used
-    // on a 640x480 capture) every pixel would be misread.
-    if (calibrated_size && (calibrated_size->width != size.width || calibrated_size->height != size.height)) {
-      throw UsageError("--intrinsics " + args.intrinsics_path + " is for a " +
-                       std::to_string(calibrated_size->width) + "x" +
-                       std::to_string(calibrated_size->height) + " image, but --image-size is " +
-                       std::to_string(size.width) + "x" + std::to_string(size.height) +
-                       ": give the size the intrinsics were calibrated at (or scale fx, fy, cx, "
-                       "cy to this size in a file of its own)");
-    }
+    arguments.known_intrinsics =
+        ReadIntrinsicsFile(args.intrinsics_path, &arguments.known_intrinsics_image_size);
+    arguments.known_intrinsics_path = args.intrinsics_path;
   }
   if (!args.bounds.empty()) {
     const std::vector<double> b = ParseNumbers(args.bounds, 6, "--bounds");

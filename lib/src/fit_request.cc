@@ -154,6 +154,18 @@ void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool au
       throw std::invalid_argument("--intrinsics gives every intrinsic (the pose alone is fitted): "
                                   "leave out " + list + ", or leave out --intrinsics");
     }
+    // Intrinsics are in pixels of one image size: at another (a calibration at 1920x1080 used
+    // on a 640x480 capture) every pixel would be misread.
+    const std::optional<ImageSize>& calibrated = args.known_intrinsics_image_size;
+    if (calibrated && (calibrated->width != size.width || calibrated->height != size.height)) {
+      throw std::invalid_argument(
+          "--intrinsics " + args.known_intrinsics_path + (args.known_intrinsics_path.empty() ? "" : " ") +
+          "is for a " + std::to_string(calibrated->width) + "x" +
+          std::to_string(calibrated->height) + " image, but --image-size is " +
+          std::to_string(size.width) + "x" + std::to_string(size.height) +
+          ": give the size the intrinsics were calibrated at (or scale fx, fy, cx, cy to this "
+          "size in a file of its own)");
+    }
   }
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {

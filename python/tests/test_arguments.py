@@ -185,3 +185,18 @@ def test_fits_in_daemon_threads_do_not_abort_the_exit(data_dir):
         done = subprocess.run([sys.executable, "-c", script, os.path.join(data_dir, "projector/points.csv")],
                               capture_output=True, text=True, timeout=60)
         assert done.returncode == 0 and "terminate" not in done.stderr, (run, done.returncode, done.stderr)
+
+
+# Intrinsics are in pixels of the image they were calibrated at: a file for 1920x1080 used on a
+# 640x480 fit is refused here as `camproj fit --intrinsics` refuses it, with the same message.
+def test_intrinsics_of_another_image_size_are_refused_as_by_the_command_line(cli, data_dir, tmp_path, clicks):
+    from conftest import run_cli
+    truth = os.path.join(data_dir, "projector/truth.json")
+    with pytest.raises(ValueError) as raised:
+        camproj.fit(*clicks, (640, 480), intrinsics=truth)
+    message = str(raised.value)
+    assert message.startswith(f"--intrinsics {truth} is for a 1920x1080 image, but --image-size is 640x480"), message
+    csv = tmp_path / "p.csv"
+    camproj.write_points(csv, *clicks)
+    done = run_cli(cli, "fit", csv, "--image-size", "640x480", "--intrinsics", truth)
+    assert done.returncode != 0 and message in done.stderr, done.stderr

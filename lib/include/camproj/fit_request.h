@@ -35,6 +35,10 @@ struct FitArguments {
   double k1 = NAN;
   double k2 = NAN;
   std::optional<Intrinsics> known_intrinsics;  // in kCenter (as ReadIntrinsicsFile returns them)
+  // The image the known intrinsics are for (their file's image_size; ReadIntrinsicsFile) and
+  // that file, named in the message: another --image-size is refused.
+  std::optional<ImageSize> known_intrinsics_image_size;
+  std::string known_intrinsics_path;
   std::string pixel_origin = "center";         // of the pixels and of the values above
   std::string loss = "none";                   // none | huber:SCALE | cauchy:SCALE (px)
   std::string refiner = "lm";                  // lm | ceres: FitOptions::refiner
