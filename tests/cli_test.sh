@@ -723,6 +723,11 @@ open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.c
     expect_exit 2 "$bin" view "$work/small.json" --image "$work/photo.png" -o "$work/s.html"
     expect_in err "photo.png: image is 1920x1080 but the camera's image size is 960x540"
     [[ ! -e "$work/s.html" ]] || fail "wrote a page for a photo of the wrong size"
+    # A photo cut short: refused, as overlay refuses it, not embedded with its end missing.
+    head -c 20000 "$work/photo.png" >"$work/cut.png"
+    expect_exit 2 "$bin" view "$data/projector/truth.json" --image "$work/cut.png" -o "$work/s.html"
+    expect_in err "cut.png: the PNG ends before its IEND chunk: the file is truncated"
+    [[ ! -e "$work/s.html" ]] || fail "wrote a page for a truncated photo"
     cp "$data/projector/truth.json" "$work/cam.html"
     expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
     expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"

@@ -104,6 +104,14 @@ bool ImageReachesItsEnd(std::string_view bytes, ImageFormat format) {
   return format == ImageFormat::kPng ? PngReachesItsEnd(bytes) : JpegReachesItsEnd(bytes);
 }
 
+void RequireWholeImage(std::string_view bytes, ImageFormat format, const std::string& path) {
+  if (ImageReachesItsEnd(bytes, format)) return;
+  throw InputError(path + (format == ImageFormat::kJpeg
+                               ? ": the JPEG ends before its end-of-image marker"
+                               : ": the PNG ends before its IEND chunk") +
+                   ": the file is truncated");
+}
+
 ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source) {
   static constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
   if (bytes.substr(0, 8) == kPngSignature) {

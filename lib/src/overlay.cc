@@ -52,14 +52,8 @@ cv::Mat ReadBackground(const std::string& path, int w, int h) {
     throw InputError(internal::Concat(path, ": image is ", header.width, "x", header.height,
                                       " but the camera's image size is ", w, "x", h));
   }
-  // libjpeg decodes a truncated file with a warning, filling the rest with garbage; libpng
-  // refuses one, but prints its own error line.
-  if (!ImageReachesItsEnd(bytes, header.format)) {
-    throw InputError(path + (header.format == ImageFormat::kJpeg
-                                 ? ": the JPEG ends before its end-of-image marker"
-                                 : ": the PNG ends before its IEND chunk") +
-                     ": the file is truncated");
-  }
+  // libpng refuses a truncated file too, but prints its own error line first.
+  RequireWholeImage(bytes, header.format, path);
   cv::Mat image;
   try {
     image = internal::DecodeImage(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,

@@ -201,6 +201,7 @@ json ImageJson(const std::string& path, const Camera& camera) {
                             " but the camera's image size is ", camera.image_size.width, "x",
                             camera.image_size.height));
   }
+  RequireWholeImage(bytes, header.format, path);  // a browser would show the rest grey
   const char* mime = header.format == ImageFormat::kPng ? "image/png" : "image/jpeg";
   return {{"name", path}, {"data_url", std::string("data:") + mime + ";base64," + Base64(bytes)}};
 }

@@ -34,6 +34,11 @@ ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source);
 // for a file cut short. `bytes` begin with the signature ReadImageHeader found for `format`.
 bool ImageReachesItsEnd(std::string_view bytes, ImageFormat format);
 
+// Throws InputError ("photo.jpg: the JPEG ends before its end-of-image marker: the file is
+// truncated") unless ImageReachesItsEnd: libjpeg decodes a truncated file with only a warning,
+// filling the rest with grey, and a browser shows it the same way.
+void RequireWholeImage(std::string_view bytes, ImageFormat format, const std::string& path);
+
 // The image format an output path asks for by its extension (case-insensitive): .png, or .jpg /
 // .jpeg. Throws std::invalid_argument naming the path and the extensions accepted otherwise.
 ImageFormat ImageFormatOfPath(const std::string& path);

@@ -49,7 +49,7 @@ struct ViewStats {
 // (pixels in kCenter) may be null: the camera alone. Throws InputError naming the file and line
 // for a bad OBJ (a field that is not a number, a face index out of range, a face of fewer than 3
 // vertices, more than 5e6 vertices or triangles) or a bad photo (not PNG/JPEG, another size than
-// the camera's); std::invalid_argument for an invalid camera.
+// the camera's, cut short: RequireWholeImage); std::invalid_argument for an invalid camera.
 std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_text,
                          const std::string& camera_name, const Correspondences* correspondences,
                          const ViewOptions& options, ViewStats* stats = nullptr);
