@@ -64,156 +64,191 @@ std::string FitReportFormatOfPath(const std::string& path) {
   throw std::invalid_argument("a report is .svg or .html, got \"" + path + "\"");
 }
 
+namespace {
+
+// The residuals the report draws: their lengths, which points the fit left out, the largest
+// kept one (the colour scale's top).
+struct ReportResiduals {
+  std::vector<bool> outlier;
+  std::vector<double> length;  // px; inf for a point behind the camera
+  double largest = 0.0;        // px, over the kept points with a finite residual
+  double colour_top = 1e-12;   // what the colour scale's top stands for (> 0)
+};
+
+ReportResiduals ResidualsOf(const FitResult& fit) {
+  const size_t n = fit.residuals_px.size();
+  ReportResiduals r;
+  r.outlier.assign(n, false);
+  for (int i : fit.outliers) {
+    if (i >= 0 && static_cast<size_t>(i) < n) r.outlier[i] = true;
+  }
+  r.length.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    r.length[i] = fit.residuals_px[i].norm();
+    if (!r.outlier[i] && std::isfinite(r.length[i])) r.largest = std::max(r.largest, r.length[i]);
+  }
+  r.colour_top = std::max(r.largest, 1e-12);
+  return r;
+}
+
+constexpr double kPlotWidth = kWidth - 2 * kMargin;
+
+// The panels, each drawn into `body` below height `y`; each returns the height below it.
+
+// 1. Residual per point: a bar per point in input order, the RMS as a line.
+double DrawResidualBars(const FitResult& fit, const ReportResiduals& residuals,
+                        const std::vector<std::string>& ids, std::ostream& body) {
+  const size_t n = fit.residuals_px.size();
+  const std::vector<bool>& outlier = residuals.outlier;
+  const std::vector<double>& length = residuals.length;
+  const double largest = residuals.largest, colour_top = residuals.colour_top;
+  const double top = 34, h = 200;
+  const double axis_max = std::max(largest * 1.15, 1e-3);
+  const double step = NiceStep(axis_max, 5);
+  body << "<text x='" << kMargin << "' y='" << top - 12
+       << "' class='title'>Residual per point (px), input order; RMS " << Num(fit.rms_px, 3)
+       << " px, the fit's outliers in vermillion</text>\n";
+  for (double v = 0; v <= axis_max + 1e-12; v += step) {
+    const double yy = top + h - v / axis_max * h;
+    body << "<line x1='" << kMargin << "' x2='" << kMargin + kPlotWidth << "' y1='" << yy << "' y2='"
+         << yy << "' class='grid'/><text x='" << kMargin - 6 << "' y='" << yy + 4
+         << "' class='tick' text-anchor='end'>" << Num(v, step < 0.1 ? 2 : step < 1 ? 1 : 0)
+         << "</text>\n";
+  }
+  const double slot = kPlotWidth / std::max<size_t>(n, 1);
+  const bool show_ids = slot >= 9;
+  for (size_t i = 0; i < n; ++i) {
+    const double x = kMargin + i * slot;
+    const bool beyond = !std::isfinite(length[i]) || length[i] > axis_max;
+    const double v = beyond ? axis_max : length[i];
+    const double bar_h = v / axis_max * h;
+    const std::string colour = outlier[i] ? kOutlier : Viridis(length[i] / colour_top);
+    body << "<rect x='" << x + slot * 0.15 << "' y='" << top + h - bar_h << "' width='"
+         << slot * 0.7 << "' height='" << bar_h << "' fill='" << colour << "'><title>"
+         << MarkupEscape(ids[i]) << ": " << Num(length[i], 3) << " px" << (outlier[i] ? " (outlier)" : "")
+         << "</title></rect>\n";
+    if (beyond) {
+      body << "<text x='" << x + slot / 2 << "' y='" << top - 2
+           << "' class='tick' text-anchor='middle' fill='" << kOutlier << "'>"
+           << (std::isfinite(length[i]) ? Num(length[i], 0) : std::string("inf")) << "</text>\n";
+    }
+    if (show_ids) {
+      body << "<text transform='translate(" << x + slot / 2 + 3 << "," << top + h + 8
+           << ") rotate(-90)' class='tick' text-anchor='end'>" << MarkupEscape(ids[i].substr(0, 12))
+           << "</text>\n";
+    }
+  }
+  const double rms_y = top + h - std::min(fit.rms_px, axis_max) / axis_max * h;
+  body << "<line x1='" << kMargin << "' x2='" << kMargin + kPlotWidth << "' y1='" << rms_y
+       << "' y2='" << rms_y << "' class='rms'/><text x='" << kMargin + kPlotWidth << "' y='"
+       << rms_y - 4 << "' class='tick' text-anchor='end'>RMS</text>\n";
+  return top + h + (show_ids ? 64 : 20);
+}
+
+// 2. Residuals over the image: an arrow per kept point (magnified), a cross per left-out one.
+double DrawResidualsOverImage(const FitResult& fit, const ReportResiduals& residuals,
+                              const std::vector<Eigen::Vector2d>& observed_pixels,
+                              const std::vector<std::string>& ids, double y, std::ostream& body) {
+  const size_t n = fit.residuals_px.size();
+  const std::vector<bool>& outlier = residuals.outlier;
+  const std::vector<double>& length = residuals.length;
+  const double largest = residuals.largest, colour_top = residuals.colour_top;
+  const double w_img = fit.camera.image_size.width, h_img = fit.camera.image_size.height;
+  const double scale = std::min(kPlotWidth / w_img, 420.0 / h_img);
+  const double x0 = kMargin, y0 = y + 30;
+  const double magnify =
+      largest > 0 ? NiceFloor(0.15 * std::min(w_img, h_img) / largest) : 1.0;
+  char title[160];
+  std::snprintf(title, sizeof title,
+                "Residuals over the image (%gx%g px): arrows x %g, the largest (%s px) drawn %s px",
+                w_img, h_img, magnify, Num(largest, 2).c_str(), Num(largest * magnify, 0).c_str());
+  body << "<text x='" << kMargin << "' y='" << y0 - 12 << "' class='title'>" << title << "</text>\n";
+  body << "<rect x='" << x0 << "' y='" << y0 << "' width='" << w_img * scale << "' height='"
+       << h_img * scale << "' class='image'/>\n";
+  // kCenter pixel p lies at (p + 0.5) * scale from the image's outer corner.
+  const auto sx = [&](double u) { return x0 + (u + 0.5) * scale; };
+  const auto sy = [&](double v) { return y0 + (v + 0.5) * scale; };
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& o = observed_pixels[i];
+    const std::string id = MarkupEscape(ids[i]);
+    if (outlier[i] || !std::isfinite(length[i])) {
+      const double r = 4;
+      body << "<g stroke='" << kOutlier << "' stroke-width='2'><line x1='" << sx(o.x()) - r
+           << "' y1='" << sy(o.y()) - r << "' x2='" << sx(o.x()) + r << "' y2='" << sy(o.y()) + r
+           << "'/><line x1='" << sx(o.x()) - r << "' y1='" << sy(o.y()) + r << "' x2='"
+           << sx(o.x()) + r << "' y2='" << sy(o.y()) - r << "'/><title>" << id << ": "
+           << Num(length[i], 1) << " px, left out</title></g>\n";
+      body << "<text x='" << sx(o.x()) + 6 << "' y='" << sy(o.y()) - 6 << "' class='tick' fill='"
+           << kOutlier << "'>" << id << "</text>\n";
+      continue;
+    }
+    const Eigen::Vector2d tip = o + magnify * fit.residuals_px[i];
+    const std::string colour = Viridis(length[i] / colour_top);
+    body << "<line x1='" << sx(o.x()) << "' y1='" << sy(o.y()) << "' x2='" << sx(tip.x())
+         << "' y2='" << sy(tip.y()) << "' stroke='" << colour
+         << "' stroke-width='2' marker-end='url(#head)'><title>" << id << ": "
+         << Num(length[i], 3) << " px</title></line>\n";
+    body << "<circle cx='" << sx(o.x()) << "' cy='" << sy(o.y()) << "' r='2.2' fill='#222'/>"
+         << "<text x='" << sx(o.x()) + 5 << "' y='" << sy(o.y()) + 12 << "' class='id'>" << id
+         << "</text>\n";
+  }
+  return y0 + h_img * scale + 20;
+}
+
+// 3. The model-selection ladder: each model tried, its criterion as a bar, or why it was not.
+double DrawLadder(const FitResult& fit, double y, std::ostream& body) {
+  const double top = y + 30, row = 22;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const ModelCandidate& c : fit.candidates) {
+    if (c.fitted && std::isfinite(c.criterion)) {
+      lo = std::min(lo, c.criterion);
+      hi = std::max(hi, c.criterion);
+    }
+  }
+  if (!(hi > lo)) {
+    hi = lo + 1;
+    lo -= 1;
+  }
+  const double label_w = 300, bar_x = kMargin + label_w, bar_w = kPlotWidth - label_w - 150;
+  body << "<text x='" << kMargin << "' y='" << top - 12 << "' class='title'>Models tried, in order: "
+       << MarkupEscape(fit.criterion) << " (lower is better; chosen: " << MarkupEscape(fit.model)
+       << ")</text>\n";
+  for (size_t k = 0; k < fit.candidates.size(); ++k) {
+    const ModelCandidate& c = fit.candidates[k];
+    const double yy = top + k * row;
+    const bool chosen = c.name == fit.model;
+    body << "<text x='" << kMargin << "' y='" << yy + 14 << "' class='" << (chosen ? "chosen" : "model")
+         << "'>" << MarkupEscape(c.name) << "</text>\n";
+    if (c.fitted && std::isfinite(c.criterion)) {
+      const double x = bar_x + (c.criterion - lo) / (hi - lo) * bar_w;
+      body << "<line x1='" << bar_x << "' x2='" << x << "' y1='" << yy + 10 << "' y2='" << yy + 10
+           << "' class='ladder'/><circle cx='" << x << "' cy='" << yy + 10 << "' r='5' fill='"
+           << (chosen ? "#2f6fb0" : "#888") << "'><title>" << MarkupEscape(c.verdict)
+           << "</title></circle><text x='" << x + 9 << "' y='" << yy + 14 << "' class='tick'>"
+           << Num(c.criterion, 1) << ", RMS " << Num(c.rms_px, 2) << " px</text>\n";
+    } else {
+      body << "<text x='" << bar_x << "' y='" << yy + 14 << "' class='refused'>"
+           << MarkupEscape(c.verdict.substr(0, 90)) << "</text>\n";
+    }
+  }
+  return top + fit.candidates.size() * row + 10;
+}
+
+}  // namespace
+
 std::string FitReportSvg(const FitResult& fit, const std::vector<Eigen::Vector2d>& observed_pixels,
                          const std::vector<std::string>& ids) {
   const size_t n = fit.residuals_px.size();
   internal::Require(observed_pixels.size() == n && ids.size() == n, "the report needs ", n,
                     " observed pixels and ids (one per residual), got ", observed_pixels.size(),
                     " and ", ids.size());
-  std::vector<bool> outlier(n, false);
-  for (int i : fit.outliers) {
-    if (i >= 0 && static_cast<size_t>(i) < n) outlier[i] = true;
-  }
-  std::vector<double> length(n);
-  double largest = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    length[i] = fit.residuals_px[i].norm();
-    if (!outlier[i] && std::isfinite(length[i])) largest = std::max(largest, length[i]);
-  }
-  const double colour_top = std::max(largest, 1e-12);
-  std::ostringstream svg;
-  double y = 0;
-  const double plot_w = kWidth - 2 * kMargin;
+  const ReportResiduals residuals = ResidualsOf(fit);
   std::ostringstream body;
+  double y = DrawResidualBars(fit, residuals, ids, body);
+  y = DrawResidualsOverImage(fit, residuals, observed_pixels, ids, y, body);
+  if (!fit.candidates.empty()) y = DrawLadder(fit, y, body);
 
-  // 1. Residual per point.
-  {
-    const double top = 34, h = 200;
-    const double axis_max = std::max(largest * 1.15, 1e-3);
-    const double step = NiceStep(axis_max, 5);
-    body << "<text x='" << kMargin << "' y='" << top - 12
-         << "' class='title'>Residual per point (px), input order; RMS " << Num(fit.rms_px, 3)
-         << " px, the fit's outliers in vermillion</text>\n";
-    for (double v = 0; v <= axis_max + 1e-12; v += step) {
-      const double yy = top + h - v / axis_max * h;
-      body << "<line x1='" << kMargin << "' x2='" << kMargin + plot_w << "' y1='" << yy << "' y2='"
-           << yy << "' class='grid'/><text x='" << kMargin - 6 << "' y='" << yy + 4
-           << "' class='tick' text-anchor='end'>" << Num(v, step < 0.1 ? 2 : step < 1 ? 1 : 0)
-           << "</text>\n";
-    }
-    const double slot = plot_w / std::max<size_t>(n, 1);
-    const bool show_ids = slot >= 9;
-    for (size_t i = 0; i < n; ++i) {
-      const double x = kMargin + i * slot;
-      const bool beyond = !std::isfinite(length[i]) || length[i] > axis_max;
-      const double v = beyond ? axis_max : length[i];
-      const double bar_h = v / axis_max * h;
-      const std::string colour = outlier[i] ? kOutlier : Viridis(length[i] / colour_top);
-      body << "<rect x='" << x + slot * 0.15 << "' y='" << top + h - bar_h << "' width='"
-           << slot * 0.7 << "' height='" << bar_h << "' fill='" << colour << "'><title>"
-           << MarkupEscape(ids[i]) << ": " << Num(length[i], 3) << " px" << (outlier[i] ? " (outlier)" : "")
-           << "</title></rect>\n";
-      if (beyond) {
-        body << "<text x='" << x + slot / 2 << "' y='" << top - 2
-             << "' class='tick' text-anchor='middle' fill='" << kOutlier << "'>"
-             << (std::isfinite(length[i]) ? Num(length[i], 0) : std::string("inf")) << "</text>\n";
-      }
-      if (show_ids) {
-        body << "<text transform='translate(" << x + slot / 2 + 3 << "," << top + h + 8
-             << ") rotate(-90)' class='tick' text-anchor='end'>" << MarkupEscape(ids[i].substr(0, 12))
-             << "</text>\n";
-      }
-    }
-    const double rms_y = top + h - std::min(fit.rms_px, axis_max) / axis_max * h;
-    body << "<line x1='" << kMargin << "' x2='" << kMargin + plot_w << "' y1='" << rms_y
-         << "' y2='" << rms_y << "' class='rms'/><text x='" << kMargin + plot_w << "' y='"
-         << rms_y - 4 << "' class='tick' text-anchor='end'>RMS</text>\n";
-    y = top + h + (show_ids ? 64 : 20);
-  }
-
-  // 2. Residuals over the image.
-  {
-    const double w_img = fit.camera.image_size.width, h_img = fit.camera.image_size.height;
-    const double scale = std::min(plot_w / w_img, 420.0 / h_img);
-    const double x0 = kMargin, y0 = y + 30;
-    const double magnify =
-        largest > 0 ? NiceFloor(0.15 * std::min(w_img, h_img) / largest) : 1.0;
-    char title[160];
-    std::snprintf(title, sizeof title,
-                  "Residuals over the image (%gx%g px): arrows x %g, the largest (%s px) drawn %s px",
-                  w_img, h_img, magnify, Num(largest, 2).c_str(), Num(largest * magnify, 0).c_str());
-    body << "<text x='" << kMargin << "' y='" << y0 - 12 << "' class='title'>" << title << "</text>\n";
-    body << "<rect x='" << x0 << "' y='" << y0 << "' width='" << w_img * scale << "' height='"
-         << h_img * scale << "' class='image'/>\n";
-    // kCenter pixel p lies at (p + 0.5) * scale from the image's outer corner.
-    const auto sx = [&](double u) { return x0 + (u + 0.5) * scale; };
-    const auto sy = [&](double v) { return y0 + (v + 0.5) * scale; };
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector2d& o = observed_pixels[i];
-      const std::string id = MarkupEscape(ids[i]);
-      if (outlier[i] || !std::isfinite(length[i])) {
-        const double r = 4;
-        body << "<g stroke='" << kOutlier << "' stroke-width='2'><line x1='" << sx(o.x()) - r
-             << "' y1='" << sy(o.y()) - r << "' x2='" << sx(o.x()) + r << "' y2='" << sy(o.y()) + r
-             << "'/><line x1='" << sx(o.x()) - r << "' y1='" << sy(o.y()) + r << "' x2='"
-             << sx(o.x()) + r << "' y2='" << sy(o.y()) - r << "'/><title>" << id << ": "
-             << Num(length[i], 1) << " px, left out</title></g>\n";
-        body << "<text x='" << sx(o.x()) + 6 << "' y='" << sy(o.y()) - 6 << "' class='tick' fill='"
-             << kOutlier << "'>" << id << "</text>\n";
-        continue;
-      }
-      const Eigen::Vector2d tip = o + magnify * fit.residuals_px[i];
-      const std::string colour = Viridis(length[i] / colour_top);
-      body << "<line x1='" << sx(o.x()) << "' y1='" << sy(o.y()) << "' x2='" << sx(tip.x())
-           << "' y2='" << sy(tip.y()) << "' stroke='" << colour
-           << "' stroke-width='2' marker-end='url(#head)'><title>" << id << ": "
-           << Num(length[i], 3) << " px</title></line>\n";
-      body << "<circle cx='" << sx(o.x()) << "' cy='" << sy(o.y()) << "' r='2.2' fill='#222'/>"
-           << "<text x='" << sx(o.x()) + 5 << "' y='" << sy(o.y()) + 12 << "' class='id'>" << id
-           << "</text>\n";
-    }
-    y = y0 + h_img * scale + 20;
-  }
-
-  // 3. The model-selection ladder.
-  if (!fit.candidates.empty()) {
-    const double top = y + 30, row = 22;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const ModelCandidate& c : fit.candidates) {
-      if (c.fitted && std::isfinite(c.criterion)) {
-        lo = std::min(lo, c.criterion);
-        hi = std::max(hi, c.criterion);
-      }
-    }
-    if (!(hi > lo)) {
-      hi = lo + 1;
-      lo -= 1;
-    }
-    const double label_w = 300, bar_x = kMargin + label_w, bar_w = plot_w - label_w - 150;
-    body << "<text x='" << kMargin << "' y='" << top - 12 << "' class='title'>Models tried, in order: "
-         << MarkupEscape(fit.criterion) << " (lower is better; chosen: " << MarkupEscape(fit.model)
-         << ")</text>\n";
-    for (size_t k = 0; k < fit.candidates.size(); ++k) {
-      const ModelCandidate& c = fit.candidates[k];
-      const double yy = top + k * row;
-      const bool chosen = c.name == fit.model;
-      body << "<text x='" << kMargin << "' y='" << yy + 14 << "' class='" << (chosen ? "chosen" : "model")
-           << "'>" << MarkupEscape(c.name) << "</text>\n";
-      if (c.fitted && std::isfinite(c.criterion)) {
-        const double x = bar_x + (c.criterion - lo) / (hi - lo) * bar_w;
-        body << "<line x1='" << bar_x << "' x2='" << x << "' y1='" << yy + 10 << "' y2='" << yy + 10
-             << "' class='ladder'/><circle cx='" << x << "' cy='" << yy + 10 << "' r='5' fill='"
-             << (chosen ? "#2f6fb0" : "#888") << "'><title>" << MarkupEscape(c.verdict)
-             << "</title></circle><text x='" << x + 9 << "' y='" << yy + 14 << "' class='tick'>"
-             << Num(c.criterion, 1) << ", RMS " << Num(c.rms_px, 2) << " px</text>\n";
-      } else {
-        body << "<text x='" << bar_x << "' y='" << yy + 14 << "' class='refused'>"
-             << MarkupEscape(c.verdict.substr(0, 90)) << "</text>\n";
-      }
-    }
-    y = top + fit.candidates.size() * row + 10;
-  }
-
+  std::ostringstream svg;
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidth << "' height='" << y + 10
       << "' viewBox='0 0 " << kWidth << " " << y + 10
       << "' font-family='system-ui, sans-serif' font-size='12'>\n"
