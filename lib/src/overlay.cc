@@ -335,6 +335,162 @@ Box DrawLegend(cv::Mat& image, const OverlayStats& stats, const std::vector<Eige
              static_cast<double>(corner.x + legend_w), static_cast<double>(corner.y + legend_h)};
 }
 
+// What the overlay draws for one point.
+struct OverlayPoint {
+  std::optional<Eigen::Vector2d> predicted;  // its reprojection (kCenter); none behind the camera
+  double residual_px = -1.0;                 // |predicted - observed|; -1 without a reprojection
+  std::string kind;                          // as OverlayLabel::kind
+  cv::Scalar colour;
+  Eigen::Vector2d anchor;  // where its label goes: the observed pixel, or its border arrow's tip
+  std::pair<Eigen::Vector2d, Eigen::Vector2d> arrow;  // kind "outside" only
+};
+
+// Each point's reprojection, residual, kind and colour, and the counts and magnification of
+// `stats` (the largest residual: over the kept points observed inside the image).
+std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Correspondences& correspondences,
+                                        const std::vector<bool>& outlier,
+                                        const OverlayOptions& options, const Style& s,
+                                        OverlayStats* stats_out) {
+  OverlayStats& stats = *stats_out;
+  const int w = camera.image_size.width;
+  const int h = camera.image_size.height;
+  const size_t n = correspondences.pixels.size();
+  const auto inside = [&](const Eigen::Vector2d& p) {
+    return p.x() >= -0.5 && p.x() <= w - 0.5 && p.y() >= -0.5 && p.y() <= h - 0.5;
+  };
+  std::vector<OverlayPoint> points(n);
+  for (size_t i = 0; i < n; ++i) {
+    OverlayPoint& point = points[i];
+    const Eigen::Vector2d& observed = correspondences.pixels[i];
+    point.predicted = PixelFromWorld(camera, correspondences.points_in_world[i]);
+    if (point.predicted) point.residual_px = (*point.predicted - observed).norm();
+    if (point.predicted && !outlier[i] && inside(observed)) {
+      stats.largest_residual_px = std::max(stats.largest_residual_px, point.residual_px);
+    }
+  }
+  stats.magnify = options.magnify > 0.0
+                      ? options.magnify
+                      : internal::NiceFloor(stats.largest_residual_px > 0.0
+                                      ? options.residual_fraction * std::min(w, h) /
+                                            stats.largest_residual_px
+                                      : 1.0);
+  const double colour_top = std::max(stats.largest_residual_px, 1e-12);
+  for (size_t i = 0; i < n; ++i) {
+    OverlayPoint& point = points[i];
+    const Eigen::Vector2d& observed = correspondences.pixels[i];
+    point.anchor = observed;
+    if (!point.predicted) {
+      point.kind = "behind";
+      point.colour = kBehindColour;
+      ++stats.behind;
+    } else if (outlier[i]) {
+      point.kind = "outlier";
+      point.colour = kOutlierColour;
+      ++stats.outliers;
+    } else {
+      point.kind = "point";
+      point.colour = Viridis(point.residual_px / colour_top);
+      ++stats.drawn;
+    }
+    if (!inside(observed)) {
+      point.kind = "outside";
+      ++stats.outside;
+      point.arrow = BorderArrow(observed, w, h, s);
+      point.anchor = point.arrow.first;
+    }
+  }
+  return points;
+}
+
+// The markers: a ring at each observed pixel, with the magnified residual and a cross at the
+// reprojection for a kept point, a cross inside the ring for an outlier, an arrow at the border
+// for a point outside the image.
+void DrawMarkers(cv::Mat& image, const std::vector<OverlayPoint>& points,
+                 const Correspondences& correspondences, double magnify, const Style& s) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const OverlayPoint& point = points[i];
+    const Eigen::Vector2d& observed = correspondences.pixels[i];
+    if (point.kind == "outside") {
+      DrawArrow(image, point.arrow, s, point.colour);
+    } else if (point.kind == "point") {
+      HaloLine(image, observed, observed + magnify * (*point.predicted - observed), s,
+               point.colour);
+      Cross(image, *point.predicted, 0.8 * s.ring, s, kWhite, false);
+      Ring(image, observed, s, point.colour);
+    } else if (point.kind == "outlier") {
+      Ring(image, observed, s, point.colour);
+      Cross(image, observed, 0.7 * s.ring, s, point.colour, true);
+    } else {
+      Ring(image, observed, s, point.colour);
+    }
+  }
+}
+
+// A point's label: its id (printable, cut to 24 characters), and for an outlier how far off it
+// is, for a point outside the image where it is.
+std::string LabelText(const OverlayPoint& point, const std::string& id,
+                      const Eigen::Vector2d& observed) {
+  std::string text = id;
+  if (text.size() > 24) text = text.substr(0, 23) + "~";
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  }
+  if (point.kind == "outlier") text += " (" + FormatPx(point.residual_px) + " px off)";
+  if (point.kind == "behind") text += " (behind)";
+  if (point.kind == "outside") {
+    char at[64];
+    std::snprintf(at, sizeof at, " (at %.0f, %.0f)", observed.x(), observed.y());
+    text += at;
+  }
+  return text;
+}
+
+// The labels, placed around their anchors clear of each other and of the legend (the outliers
+// first, then the points outside, then by residual), drawn, and listed in stats.labels.
+void DrawLabels(cv::Mat& image, const std::vector<OverlayPoint>& points,
+                const Correspondences& correspondences, const Box& legend_box, const Style& s,
+                OverlayStats* stats) {
+  const int w = image.cols;
+  const int h = image.rows;
+  const size_t n = points.size();
+  std::vector<std::string> texts(n);
+  std::vector<cv::Size> sizes(n);
+  std::vector<Eigen::Vector2d> anchors(n);
+  for (size_t i = 0; i < n; ++i) {
+    texts[i] = LabelText(points[i], correspondences.ids[i], correspondences.pixels[i]);
+    int baseline = 0;
+    const cv::Size size =
+        cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
+    sizes[i] = cv::Size(size.width + 2 * s.line, size.height + baseline + 2 * s.line);
+    anchors[i] = points[i].anchor;
+  }
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = i;
+  const auto rank = [&](size_t i) {
+    const std::string& kind = points[i].kind;
+    return kind == "outlier" ? 2e300 : kind == "outside" ? 1e300 : points[i].residual_px;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(a) > rank(b); });
+  const std::vector<Box> boxes = PlaceLabels(anchors, sizes, order, w, h, s, {legend_box});
+  for (size_t i = 0; i < n; ++i) {
+    const OverlayPoint& point = points[i];
+    const Box& b = boxes[i];
+    int baseline = 0;
+    cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
+    HaloText(image, texts[i],
+             cv::Point(static_cast<int>(std::lround(b.x0 + s.line)),
+                       static_cast<int>(std::lround(b.y1 - baseline - s.line))),
+             s, point.kind == "point" ? kWhite : point.colour);
+    OverlayLabel label;
+    label.id = correspondences.ids[i];
+    label.kind = point.kind;
+    label.anchor = point.kind == "outside" ? correspondences.pixels[i] : point.anchor;
+    label.box = Eigen::Vector4d(b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
+    label.residual_px = point.residual_px;
+    stats->labels.push_back(label);
+  }
+}
+
 }  // namespace
 
 OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& correspondences,
@@ -363,119 +519,15 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
   }
   const Style s = StyleFor(w, h);
   OverlayStats stats;
-
-  std::vector<std::optional<Eigen::Vector2d>> predicted(n);
-  std::vector<double> residual(n, -1.0);
-  for (size_t i = 0; i < n; ++i) {
-    predicted[i] = PixelFromWorld(camera, correspondences.points_in_world[i]);
-    if (predicted[i]) residual[i] = (*predicted[i] - correspondences.pixels[i]).norm();
-    const Eigen::Vector2d& o = correspondences.pixels[i];
-    const bool observed_inside = o.x() >= -0.5 && o.x() <= w - 0.5 && o.y() >= -0.5 && o.y() <= h - 0.5;
-    if (predicted[i] && !outlier[i] && observed_inside) {
-      stats.largest_residual_px = std::max(stats.largest_residual_px, residual[i]);
-    }
-  }
-  stats.magnify = options.magnify > 0.0
-                      ? options.magnify
-                      : internal::NiceFloor(stats.largest_residual_px > 0.0
-                                      ? options.residual_fraction * std::min(w, h) /
-                                            stats.largest_residual_px
-                                      : 1.0);
-  const double colour_top = std::max(stats.largest_residual_px, 1e-12);
-  const auto inside = [&](const Eigen::Vector2d& p) {
-    return p.x() >= -0.5 && p.x() <= w - 0.5 && p.y() >= -0.5 && p.y() <= h - 0.5;
-  };
-
-  // What each point is; then the legend (first, so that markers and ids stay on top of it),
-  // the markers, and the ids placed around them.
+  const std::vector<OverlayPoint> points =
+      MeasurePoints(camera, correspondences, outlier, options, s, &stats);
+  // The legend first, so that markers and ids stay on top of it; then the markers, and the ids
+  // placed around them.
   std::vector<Eigen::Vector2d> anchors(n);
-  std::vector<std::string> kinds(n);
-  std::vector<cv::Scalar> colours(n);
-  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& observed = correspondences.pixels[i];
-    anchors[i] = observed;
-    if (!predicted[i]) {
-      kinds[i] = "behind";
-      colours[i] = kBehindColour;
-      ++stats.behind;
-    } else if (outlier[i]) {
-      kinds[i] = "outlier";
-      colours[i] = kOutlierColour;
-      ++stats.outliers;
-    } else {
-      kinds[i] = "point";
-      colours[i] = Viridis(residual[i] / colour_top);
-      ++stats.drawn;
-    }
-    if (!inside(observed)) {
-      kinds[i] = "outside";
-      ++stats.outside;
-      arrows[i] = BorderArrow(observed, w, h, s);
-      anchors[i] = arrows[i].first;
-    }
-  }
+  for (size_t i = 0; i < n; ++i) anchors[i] = points[i].anchor;
   const Box legend_box = DrawLegend(image, stats, anchors, s);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& observed = correspondences.pixels[i];
-    if (kinds[i] == "outside") {
-      DrawArrow(image, arrows[i], s, colours[i]);
-    } else if (kinds[i] == "point") {
-      HaloLine(image, observed, observed + stats.magnify * (*predicted[i] - observed), s,
-               colours[i]);
-      Cross(image, *predicted[i], 0.8 * s.ring, s, kWhite, false);
-      Ring(image, observed, s, colours[i]);
-    } else if (kinds[i] == "outlier") {
-      Ring(image, observed, s, colours[i]);
-      Cross(image, observed, 0.7 * s.ring, s, colours[i], true);
-    } else {
-      Ring(image, observed, s, colours[i]);
-    }
-  }
-  std::vector<std::string> texts(n);
-  std::vector<cv::Size> sizes(n);
-  for (size_t i = 0; i < n; ++i) {
-    texts[i] = correspondences.ids[i];
-    if (texts[i].size() > 24) texts[i] = texts[i].substr(0, 23) + "~";
-    for (char& c : texts[i]) {
-      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
-    }
-    if (kinds[i] == "outlier") texts[i] += " (" + FormatPx(residual[i]) + " px off)";
-    if (kinds[i] == "behind") texts[i] += " (behind)";
-    if (kinds[i] == "outside") {
-      char at[64];
-      std::snprintf(at, sizeof at, " (at %.0f, %.0f)", correspondences.pixels[i].x(),
-                    correspondences.pixels[i].y());
-      texts[i] += at;
-    }
-    int baseline = 0;
-    const cv::Size size =
-        cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
-    sizes[i] = cv::Size(size.width + 2 * s.line, size.height + baseline + 2 * s.line);
-  }
-  std::vector<size_t> order(n);
-  for (size_t i = 0; i < n; ++i) order[i] = i;
-  const auto rank = [&](size_t i) {
-    return kinds[i] == "outlier" ? 2e300 : kinds[i] == "outside" ? 1e300 : residual[i];
-  };
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(a) > rank(b); });
-  const std::vector<Box> boxes = PlaceLabels(anchors, sizes, order, w, h, s, {legend_box});
-  for (size_t i = 0; i < n; ++i) {
-    const Box& b = boxes[i];
-    int baseline = 0;
-    cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
-    HaloText(image, texts[i],
-             cv::Point(static_cast<int>(std::lround(b.x0 + s.line)),
-                       static_cast<int>(std::lround(b.y1 - baseline - s.line))),
-             s, kinds[i] == "point" ? kWhite : colours[i]);
-    OverlayLabel label;
-    label.id = correspondences.ids[i];
-    label.kind = kinds[i];
-    label.anchor = kinds[i] == "outside" ? correspondences.pixels[i] : anchors[i];
-    label.box = Eigen::Vector4d(b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
-    label.residual_px = residual[i];
-    stats.labels.push_back(label);
-  }
+  DrawMarkers(image, points, correspondences, stats.magnify, s);
+  DrawLabels(image, points, correspondences, legend_box, s, &stats);
 
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
