@@ -78,12 +78,86 @@ double Median(std::vector<double> values) {
 
 // The page's data: everything the script draws, computed here so that the script holds no
 // geometry beyond three.js's rendering (and the pixel-origin shift).
-json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
-               const Correspondences* correspondences, ViewStats& stats) {
-  const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
+// One point as the page draws it: where it is, where it was seen, the observed pixel's ray,
+// and where the camera puts it (with and without the lens; none behind the camera).
+// `ray_depth_behind` is the depth its ray is drawn to when the point is behind the camera;
+// `max_distortion_px` gets the largest lens displacement seen.
+json PointJson(const Camera& camera, const Correspondences& correspondences, size_t i,
+               bool outlier, double ray_depth_behind, double* max_distortion_px,
+               ViewStats& stats) {
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
+  const Eigen::Vector3d& x = correspondences.points_in_world[i];
+  const Eigen::Vector2d& observed = correspondences.pixels[i];
+  const double depth = (camera.cam_from_world * x).z();
+  const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, x);
+  json point = {{"id", correspondences.ids[i]},
+                {"point_in_world", Vec(x)},
+                {"observed_px", Vec(observed)},
+                {"outlier", outlier}};
+  ++stats.points;
+  // The observed pixel's ray, drawn from the eye to the point's depth (the median depth for a
+  // point behind the camera); beyond the distortion's fold there is no ray.
+  try {
+    const double ray_depth = depth > 0.0 ? depth : ray_depth_behind;
+    point["ray_end_in_world"] =
+        Vec(Inverse(camera.cam_from_world) *
+            PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
+  } catch (const std::domain_error&) {
+    point["ray_end_in_world"] = nullptr;
+  }
+  if (!predicted) {
+    point["predicted_px"] = nullptr;
+    point["residual_px"] = nullptr;
+    ++stats.behind;
+    return point;
+  }
+  // The pinhole's pixel is finite where the lens's is (a lens that overflows has none).
+  const Eigen::Vector2d linear =
+      PixelFromWorld(Camera{camera.image_size, camera.intrinsics.Pinhole(), camera.cam_from_world,
+                            camera.z_near, camera.z_far, camera.projection},
+                     x)
+          .value_or(*predicted);
+  *max_distortion_px = std::max(*max_distortion_px, (linear - *predicted).norm());
+  point["predicted_px"] = Vec(*predicted);
+  point["predicted_linear_px"] = Vec(linear);
+  point["residual_px"] = (*predicted - observed).norm();
+  const bool inside = predicted->x() >= -0.5 && predicted->x() <= w - 0.5 &&
+                      predicted->y() >= -0.5 && predicted->y() <= h - 0.5;
+  point["inside_image"] = inside;
+  if (!inside) ++stats.outside_image;
+  return point;
+}
+
+// The frustum drawn: near plane, the image plane at the points' median depth, a far plane just
+// beyond the farthest point (the camera's own far plane is often far beyond the scene).
+json FrustumJson(const Camera& camera, double median_depth, double max_depth) {
+  const int w = camera.image_size.width;
+  const int h = camera.image_size.height;
+  const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
   const Intrinsics pinhole = camera.intrinsics.Pinhole();
+  const double far_drawn = std::min(camera.z_far, std::max(1.25 * max_depth, 2.0 * camera.z_near));
+  const double image_depth = std::clamp(median_depth, camera.z_near, far_drawn);
+  const auto corners_at = [&](double depth) {
+    json corners = json::array();
+    const Eigen::Vector2d image_corners[4] = {
+        {-0.5, -0.5}, {w - 0.5, -0.5}, {w - 0.5, h - 0.5}, {-0.5, h - 0.5}};
+    for (const Eigen::Vector2d& c : image_corners) {
+      corners.push_back(Vec(world_from_cam * PointInCamAtDepth(camera, pinhole, c, depth)));
+    }
+    return corners;
+  };
+  return {{"near", camera.z_near},
+          {"far", std::isfinite(camera.z_far) ? json(camera.z_far) : json("inf")},
+          {"far_drawn", far_drawn},
+          {"image_depth", image_depth},
+          {"near_corners_in_world", corners_at(camera.z_near)},
+          {"image_corners_in_world", corners_at(image_depth)},
+          {"far_corners_in_world", corners_at(far_drawn)}};
+}
+
+json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
+               const Correspondences* correspondences, ViewStats& stats) {
   std::vector<bool> outlier(correspondences ? correspondences->pixels.size() : 0, false);
   json notes = json::array();
   for (const int i : outlier_indices) {
@@ -97,8 +171,6 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
   }
   // Depths of the points in front, for the image plane and the far plane drawn.
   std::vector<double> depths;
-  json points = json::array();
-  double max_distortion_px = 0.0;
   if (correspondences) {
     for (const Eigen::Vector3d& x : correspondences->points_in_world) {
       const double z = (camera.cam_from_world * x).z();
@@ -109,48 +181,11 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
                                              : Median(depths);
   const double max_depth = depths.empty() ? median_depth
                                           : *std::max_element(depths.begin(), depths.end());
-  if (correspondences) {
-    for (size_t i = 0; i < correspondences->pixels.size(); ++i) {
-      const Eigen::Vector3d& x = correspondences->points_in_world[i];
-      const Eigen::Vector2d& observed = correspondences->pixels[i];
-      const double depth = (camera.cam_from_world * x).z();
-      const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, x);
-      json point = {{"id", correspondences->ids[i]},
-                    {"point_in_world", Vec(x)},
-                    {"observed_px", Vec(observed)},
-                    {"outlier", outlier[i]}};
-      ++stats.points;
-      // The observed pixel's ray, drawn from the eye to the point's depth (the median depth for a
-      // point behind the camera); beyond the distortion's fold there is no ray.
-      try {
-        const double ray_depth = depth > 0.0 ? depth : median_depth;
-        point["ray_end_in_world"] =
-            Vec(world_from_cam * PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
-      } catch (const std::domain_error&) {
-        point["ray_end_in_world"] = nullptr;
-      }
-      if (predicted) {
-        // The pinhole's pixel is finite where the lens's is (a lens that overflows has none).
-        const Eigen::Vector2d linear =
-            PixelFromWorld(Camera{camera.image_size, pinhole, camera.cam_from_world, camera.z_near,
-                                  camera.z_far, camera.projection},
-                           x)
-                .value_or(*predicted);
-        max_distortion_px = std::max(max_distortion_px, (linear - *predicted).norm());
-        point["predicted_px"] = Vec(*predicted);
-        point["predicted_linear_px"] = Vec(linear);
-        point["residual_px"] = (*predicted - observed).norm();
-        const bool inside = predicted->x() >= -0.5 && predicted->x() <= w - 0.5 &&
-                            predicted->y() >= -0.5 && predicted->y() <= h - 0.5;
-        point["inside_image"] = inside;
-        if (!inside) ++stats.outside_image;
-      } else {
-        point["predicted_px"] = nullptr;
-        point["residual_px"] = nullptr;
-        ++stats.behind;
-      }
-      points.push_back(point);
-    }
+  json points = json::array();
+  double max_distortion_px = 0.0;
+  for (size_t i = 0; correspondences && i < correspondences->pixels.size(); ++i) {
+    points.push_back(PointJson(camera, *correspondences, i, outlier[i], median_depth,
+                               &max_distortion_px, stats));
   }
   if (max_distortion_px > 0.0) {
     notes.push_back(Concat(
@@ -158,31 +193,11 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
         "moves the points there by up to ",
         std::round(max_distortion_px * 100) / 100, " px against camproj project"));
   }
-  // The frustum drawn: near plane, the image plane at the points' median depth, a far plane just
-  // beyond the farthest point (the camera's own far plane is often far beyond the scene).
-  const double far_drawn = std::min(camera.z_far, std::max(1.25 * max_depth, 2.0 * camera.z_near));
-  const double image_depth = std::clamp(median_depth, camera.z_near, far_drawn);
-  const auto corners_at = [&](double depth) {
-    json corners = json::array();
-    const Eigen::Vector2d image_corners[4] = {
-        {-0.5, -0.5}, {w - 0.5, -0.5}, {w - 0.5, h - 0.5}, {-0.5, h - 0.5}};
-    for (const Eigen::Vector2d& c : image_corners) {
-      corners.push_back(Vec(world_from_cam * PointInCamAtDepth(camera, pinhole, c, depth)));
-    }
-    return corners;
-  };
-  json frustum = {{"near", camera.z_near},
-                  {"far", std::isfinite(camera.z_far) ? json(camera.z_far) : json("inf")},
-                  {"far_drawn", far_drawn},
-                  {"image_depth", image_depth},
-                  {"near_corners_in_world", corners_at(camera.z_near)},
-                  {"image_corners_in_world", corners_at(image_depth)},
-                  {"far_corners_in_world", corners_at(far_drawn)}};
-  json scene = {{"image_size", {w, h}},
+  json scene = {{"image_size", {camera.image_size.width, camera.image_size.height}},
                 {"projection", camera.projection == Projection::kOrthographic ? "orthographic"
                                                                                : "perspective"},
-                {"eye_in_world", Vec(world_from_cam.translation)},
-                {"frustum", frustum},
+                {"eye_in_world", Vec(Inverse(camera.cam_from_world).translation)},
+                {"frustum", FrustumJson(camera, median_depth, max_depth)},
                 {"points", points},
                 {"notes", notes}};
   ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
