@@ -84,6 +84,8 @@ class Intrinsics:
         """[[fx, skew, cx], [0, fy, cy], [0, 0, 1]] (3x3, a new array)."""
     @staticmethod
     def from_K(K: ArrayLike) -> "Intrinsics": ...
+    def __eq__(self, other: object) -> bool:
+        """Field by field (Intrinsics, Frustum and Perspective alike); all three pickle."""
 
 class Frustum:
     """glFrustum's near-plane window (left, right, bottom, top) at distance ``near`` in gl_eye
@@ -96,6 +98,7 @@ class Frustum:
     top: float
     near: float
     far: float
+    def __eq__(self, other: object) -> bool: ...
 
 class Perspective:
     """gluPerspective: full vertical field of view in degrees, width/height aspect, near, far."""
@@ -104,6 +107,7 @@ class Perspective:
     aspect: float
     near: float
     far: float
+    def __eq__(self, other: object) -> bool: ...
 
 class LeftOutPoint:
     index: int          # 0-based, into the fitted points

@@ -2,6 +2,7 @@
 // (lib/include/camproj/). No geometry here: every number comes from a library call; this file
 // converts numpy arrays, strings and exceptions. Conventions: docs/conventions.md; the Python
 // API, with units, is in camproj.pyi.
+#include <array>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -155,6 +156,17 @@ Rigid3 PoseOf(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
 }
 
 CameraViews ViewsOf(const PyCamera& c) { return ViewsOfCamera(c.camera, c.target_distance); }
+
+// The value types' fields in constructor order: what __eq__ compares and pickle stores.
+std::array<double, 10> FieldsOf(const Intrinsics& k) {
+  return {k.fx, k.fy, k.cx, k.cy, k.skew, k.k1, k.k2, k.p1, k.p2, k.k3};
+}
+std::array<double, 6> FieldsOf(const Frustum& f) {
+  return {f.left, f.right, f.bottom, f.top, f.z_near, f.z_far};
+}
+std::array<double, 4> FieldsOf(const Perspective& p) {
+  return {p.fovy_deg, p.aspect, p.z_near, p.z_far};
+}
 
 // fit()'s option values, each checked as the command line checks its option: TypeError naming
 // the option for a value of the wrong type, ValueError for a wrong value.
@@ -481,6 +493,15 @@ PYBIND11_MODULE(camproj, m) {
       .def_readonly("k3", &Intrinsics::k3)
       .def_property_readonly("K", &Intrinsics::K)
       .def_static("from_K", &IntrinsicsFromK, py::arg("K"))
+      // Values compare equal field by field (bit for bit but -0 == 0); pickled as those fields.
+      .def("__eq__", [](const Intrinsics& a, const Intrinsics& b) { return FieldsOf(a) == FieldsOf(b); },
+           py::is_operator())
+      .def(py::pickle([](const Intrinsics& k) { return FieldsOf(k); },
+                      [](const std::array<double, 10>& f) {
+                        Intrinsics k{f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]};
+                        k.Check();
+                        return k;
+                      }))
       .def("__repr__", [](const Intrinsics& k) {
         if (!k.HasBeyondTwoRadial()) {
           return py::str("Intrinsics(fx={}, fy={}, cx={}, cy={}, skew={}, k1={}, k2={})")
@@ -505,6 +526,14 @@ PYBIND11_MODULE(camproj, m) {
       .def_readonly("top", &Frustum::top)
       .def_readonly("near", &Frustum::z_near)
       .def_readonly("far", &Frustum::z_far)
+      .def("__eq__", [](const Frustum& a, const Frustum& b) { return FieldsOf(a) == FieldsOf(b); },
+           py::is_operator())
+      .def(py::pickle([](const Frustum& f) { return FieldsOf(f); },
+                      [](const std::array<double, 6>& t) {
+                        Frustum f{t[0], t[1], t[2], t[3], t[4], t[5]};
+                        f.Check();
+                        return f;
+                      }))
       .def("__repr__", [](const Frustum& f) {
         return py::str("Frustum(left={}, right={}, bottom={}, top={}, near={}, far={})")
             .format(f.left, f.right, f.bottom, f.top, f.z_near, f.z_far);
@@ -521,6 +550,15 @@ PYBIND11_MODULE(camproj, m) {
       .def_readonly("aspect", &Perspective::aspect)
       .def_readonly("near", &Perspective::z_near)
       .def_readonly("far", &Perspective::z_far)
+      .def("__eq__",
+           [](const Perspective& a, const Perspective& b) { return FieldsOf(a) == FieldsOf(b); },
+           py::is_operator())
+      .def(py::pickle([](const Perspective& p) { return FieldsOf(p); },
+                      [](const std::array<double, 4>& t) {
+                        Perspective p{t[0], t[1], t[2], t[3]};
+                        p.Check();
+                        return p;
+                      }))
       .def("__repr__", [](const Perspective& p) {
         return py::str("Perspective(fovy_deg={}, aspect={}, near={}, far={})")
             .format(p.fovy_deg, p.aspect, p.z_near, p.z_far);

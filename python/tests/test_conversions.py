@@ -225,3 +225,19 @@ def test_the_stub_declares_every_public_name_of_the_module():
         members |= {n.target.id for n in node.body if isinstance(n, ast.AnnAssign)}
         missing = {m for m in dir(cls) if not m.startswith("_")} - members
         assert missing == set(), f"{cls.__name__}: {missing} not in camproj.pyi"
+
+
+# The value types compare field by field and pickle (to ship them to Dask workers); a pickle is
+# checked on the way back in as the constructor checks its arguments.
+def test_value_types_compare_and_pickle():
+    import pickle
+    k = camproj.Intrinsics(2300.0, 2310.0, 951.25, 1079.5, 3.5, k1=-0.12, k2=0.03, p1=1e-4, p2=-2e-4, k3=0.001)
+    f = camproj.Frustum(-0.4, 0.35, -0.2, 0.25, 0.5, math.inf)
+    p = camproj.Perspective(45.0, 16 / 9, 0.1, 100.0)
+    for value in [k, f, p]:
+        back = pickle.loads(pickle.dumps(value))
+        assert back == value and repr(back) == repr(value)
+        assert value != 3 and not (value == None)  # noqa: E711
+    assert k != camproj.Intrinsics(2300.0, 2310.0, 951.25, 1079.5, 3.5)
+    with pytest.raises(ValueError):
+        camproj.Perspective.__new__(camproj.Perspective).__setstate__([45.0, 16 / 9, 1.0, 0.5])
