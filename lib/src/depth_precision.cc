@@ -210,54 +210,59 @@ std::string Remedy(const GlDepth& depth, DepthAdviceTarget target) {
   return Concat("use ", kFloatZoReversedAdvice);
 }
 
-}  // namespace
+constexpr GlDepth kStandardNo{ClipDepth::kNegativeOneToOne, false};
+constexpr GlDepth kReversedZo{ClipDepth::kZeroToOne, true};
 
-DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
-                        DepthAdviceTarget target) {
-  CheckRange(z_near, z_far);
+// DepthAdvice::warnings (depth_precision.h).
+std::vector<std::string> DepthRangeWarnings(double z_near, double z_far, const GlDepth& depth,
+                                            DepthAdviceTarget target) {
+  std::vector<std::string> warnings;
   const bool infinite = std::isinf(z_far);
-  const GlDepth standard_no{ClipDepth::kNegativeOneToOne, false};
-  const GlDepth reversed_zo{ClipDepth::kZeroToOne, true};
-
-  DepthAdvice advice;
   if (!infinite && z_far / z_near > kDepthRatioWarning) {
-    advice.warnings.push_back(Concat(
+    warnings.push_back(Concat(
         "far/near = ", Ratio(z_far / z_near), " (near ", Distance(z_near), ", far ",
         Distance(z_far), ") is above ", Ratio(kDepthRatioWarning),
-        ": a 24-bit depth buffer ", ResolvesText(z_far, z_near, z_far, standard_no),
+        ": a 24-bit depth buffer ", ResolvesText(z_far, z_near, z_far, kStandardNo),
         " at the far plane; ", Remedy(depth, target), ", or raise near"));
   }
   if (infinite && !IsZoReversed(depth)) {
     const double z = 1000.0 * z_near;
-    advice.warnings.push_back(Concat(
+    warnings.push_back(Concat(
         "infinite far plane without ZO reversed-Z: the depth step grows as z^2/near (",
         TwoDigits(DepthStepAt(z, z_near, z_far, depth, DepthBuffer::kFloat32)),
         " world units at 1000 near = ", Distance(z), " even with a float32 buffer); ", Remedy(depth, target)));
   }
+  return warnings;
+}
 
+// The table's rows: near, their geometric mean, half far and far (distinct, in order); for an
+// infinite far, near times 1, 10, 100 and 1000.
+std::vector<double> TableDistances(double z_near, double z_far) {
+  if (std::isinf(z_far)) return {z_near, 10.0 * z_near, 100.0 * z_near, 1000.0 * z_near};
   std::vector<double> distances;
-  if (infinite) {
-    distances = {z_near, 10.0 * z_near, 100.0 * z_near, 1000.0 * z_near};
-  } else {
-    for (double z : {z_near, std::sqrt(z_near * z_far), 0.5 * z_far, z_far}) {
-      if (z >= z_near && z <= z_far &&
-          std::find(distances.begin(), distances.end(), z) == distances.end()) {
-        distances.push_back(z);
-      }
+  for (double z : {z_near, std::sqrt(z_near * z_far), 0.5 * z_far, z_far}) {
+    if (z >= z_near && z <= z_far &&
+        std::find(distances.begin(), distances.end(), z) == distances.end()) {
+      distances.push_back(z);
     }
-    std::sort(distances.begin(), distances.end());
   }
+  std::sort(distances.begin(), distances.end());
+  return distances;
+}
 
+// DepthAdvice::table: the depth step at TableDistances for the standard conventions and
+// `depth`'s, in aligned columns.
+std::string DepthStepTable(double z_near, double z_far, const GlDepth& depth) {
   struct Column {
     std::string name;
     GlDepth depth;
     DepthBuffer buffer;
   };
-  std::vector<Column> columns = {{"24-bit NO", standard_no, DepthBuffer::kFixed24},
-                                 {"float32 NO", standard_no, DepthBuffer::kFloat32},
-                                 {"float32 ZO reversed-Z", reversed_zo, DepthBuffer::kFloat32}};
-  const bool yours_shown = (depth.clip_depth == standard_no.clip_depth &&
-                            depth.reversed_z == standard_no.reversed_z) ||
+  std::vector<Column> columns = {{"24-bit NO", kStandardNo, DepthBuffer::kFixed24},
+                                 {"float32 NO", kStandardNo, DepthBuffer::kFloat32},
+                                 {"float32 ZO reversed-Z", kReversedZo, DepthBuffer::kFloat32}};
+  const bool yours_shown = (depth.clip_depth == kStandardNo.clip_depth &&
+                            depth.reversed_z == kStandardNo.reversed_z) ||
                            IsZoReversed(depth);
   if (!yours_shown) {
     columns.push_back({"float32 " + DepthName(depth) + " (yours)", depth, DepthBuffer::kFloat32});
@@ -267,7 +272,7 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
   cells.push_back({"distance"});
   for (const Column& column : columns) cells[0].push_back(column.name);
   bool any_marked = false;
-  for (double z : distances) {
+  for (double z : TableDistances(z_near, z_far)) {
     std::string label = Distance(z);
     if (z == z_near) label += " (near)";
     if (z == z_far) label += " (far)";
@@ -290,7 +295,8 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
   std::ostringstream table;
   table << "depth step in world units (how far a point must move along the view axis to change "
            "the stored depth; near "
-        << Distance(z_near) << ", far " << (infinite ? "inf" : Distance(z_far)) << "):\n";
+        << Distance(z_near) << ", far " << (std::isinf(z_far) ? "inf" : Distance(z_far))
+        << "):\n";
   for (const auto& row : cells) {
     std::string line;
     for (size_t i = 0; i < row.size(); ++i) {
@@ -303,24 +309,37 @@ DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
     table << "* finer than float32 spacing of the distance itself: there the vertex arithmetic, "
              "not the depth buffer, limits precision\n";
   }
-  advice.table = table.str();
+  return table.str();
+}
 
+// DepthAdvice::advice.
+std::string AdviceLine(const GlDepth& depth, DepthAdviceTarget target) {
   if (target == DepthAdviceTarget::kThreeJs) {
-    advice.advice = IsZoReversed(depth)
-                        ? Concat("ZO reversed-Z in three.js: ", Remedy(depth, target),
-                                 "; it rebuilds projectionMatrix from fov, aspect and view on "
-                                 "the first render")
-                        : Concat("where depth precision matters in three.js: ",
-                                 Remedy(depth, target).substr(4));
-    return advice;
+    return IsZoReversed(depth)
+               ? Concat("ZO reversed-Z in three.js: ", Remedy(depth, target),
+                        "; it rebuilds projectionMatrix from fov, aspect and view on the first "
+                        "render")
+               : Concat("where depth precision matters in three.js: ",
+                        Remedy(depth, target).substr(4));
   }
-  advice.advice = IsZoReversed(depth)
-                      ? "ZO reversed-Z: use it with a float depth buffer (GL_DEPTH_COMPONENT32F), "
-                        "glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), glDepthFunc(GL_GREATER) "
-                        "and glClearDepth(0)"
-                      : "where depth precision matters, use reversed-Z with ZO and a float depth "
-                        "buffer: glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), "
-                        "glDepthFunc(GL_GREATER), glClearDepth(0), GL_DEPTH_COMPONENT32F";
+  return IsZoReversed(depth)
+             ? "ZO reversed-Z: use it with a float depth buffer (GL_DEPTH_COMPONENT32F), "
+               "glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), glDepthFunc(GL_GREATER) "
+               "and glClearDepth(0)"
+             : "where depth precision matters, use reversed-Z with ZO and a float depth "
+               "buffer: glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), "
+               "glDepthFunc(GL_GREATER), glClearDepth(0), GL_DEPTH_COMPONENT32F";
+}
+
+}  // namespace
+
+DepthAdvice AdviseDepth(double z_near, double z_far, const GlDepth& depth,
+                        DepthAdviceTarget target) {
+  CheckRange(z_near, z_far);
+  DepthAdvice advice;
+  advice.warnings = DepthRangeWarnings(z_near, z_far, depth, target);
+  advice.table = DepthStepTable(z_near, z_far, depth);
+  advice.advice = AdviceLine(depth, target);
   return advice;
 }
 
