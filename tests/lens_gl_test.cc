@@ -12,6 +12,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <array>
 #include <string>
 
 #include "camproj/export.h"
@@ -67,6 +68,32 @@ TEST(RadialFoldRadiusTest, HandComputed) {
   // k1 = -0.35, k2 = 0.04: 0.2 s^2 - 1.05 s + 1, smaller root (1.05 - 0.55) / 0.4 = 1.25.
   EXPECT_NEAR(RadialFoldRadius(-0.35, 0.04), std::sqrt(1.25), 1e-15);
   EXPECT_THROW(RadialFoldRadius(std::nan(""), 0.0), std::invalid_argument);
+}
+
+// Extreme coefficients: computed in units scaled by a power of two, so the discriminant does not
+// overflow (k2 = 1e160, k3 = -1 searched for ever) and 3 k1 does not (k1 = -1e308 answered 0).
+// Where the fold is k1's alone (k2, k3 negligible against it) it is 1 / sqrt(-3 k1) to a few
+// ulps; where a double cannot place it, a refusal, not a hang or "no fold".
+TEST(RadialFoldRadiusTest, ExtremeCoefficientsNeitherHangNorLoseTheFold) {
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_DOUBLE_EQ(RadialFoldRadius(-1e308, 0.0, 0.0), 1.0 / (std::sqrt(3.0) * 1e154));
+  EXPECT_DOUBLE_EQ(RadialFoldRadius(-1e308, 1e308, 1e308), 1.0 / (std::sqrt(3.0) * 1e154));
+  EXPECT_DOUBLE_EQ(RadialFoldRadius(-1e160, 0.0, 1e160), 1.0 / std::sqrt(3e160));
+  EXPECT_DOUBLE_EQ(RadialFoldRadius(-1e-300, 0.0, 0.0), 1.0 / std::sqrt(3e-300));
+  // Scaling by powers of two is exact: a lens and the same lens in units 2^40 apart.
+  EXPECT_EQ(RadialFoldRadius(-0.3 * 0x1p40, 0.04 * 0x1p80, -0.002 * 0x1p120),
+            RadialFoldRadius(-0.3, 0.04, -0.002) * 0x1p-20);
+  // A fold beyond r = 2^100 (k3 = -1e-320 against k1, k2 ~ 0.1): none that an image reaches.
+  EXPECT_EQ(RadialFoldRadius(0.1, 0.01, -1e-320), inf);
+  for (const auto& k : {std::array<double, 3>{0.0, 1e160, -1.0}, {1e160, 0.0, -1e160},
+                        {0.0, 1e155, -1.0}}) {
+    try {
+      RadialFoldRadius(k[0], k[1], k[2]);
+      ADD_FAILURE() << k[0] << " " << k[1] << " " << k[2] << " answered";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("too far apart in scale"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(LensGlTest, RefusesALensThatFoldsInsideTheImageAndOrthographicCameras) {

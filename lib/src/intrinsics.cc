@@ -108,9 +108,26 @@ Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d
 
 namespace {
 
-// The smallest root s > 0 of h(s) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 (h(0) = 1), k3 != 0: h is
-// monotone between its critical points (the roots of h'(s) = 3 k1 + 10 k2 s + 21 k3 s^2), so the
-// first interval whose end has h <= 0 holds the root, found by bisection to the last bit.
+// Where the scaled fold search below stops looking: h's terms at s <= 2^339 stay within a
+// double's range (|7 k3 s^3| < 2^1023 with the scaled |k3| < 8).
+constexpr double kMaxScaledFoldRoot = 0x1p339;
+
+// Bisection of h on [lo, hi] (h(lo) > 0 >= h(hi)) to adjacent doubles. Midpoint halvings reach
+// adjacency within ~2100 steps from any bracket of finite doubles; the bound is a guard.
+template <class H>
+double BisectFold(const H& h, double lo, double hi) {
+  for (int step = 0; step < 2200 && std::nextafter(lo, hi) < hi; ++step) {
+    const double mid = 0.5 * (lo + hi);
+    (h(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// The smallest root s > 0 of h(s) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 (h(0) = 1), k3 != 0, for
+// coefficients scaled to |k1| < 2, |k2| < 4, |k3| < 8 (RadialFoldRadius): h is monotone between its
+// critical points (the roots of h'(s) = 3 k1 + 10 k2 s + 21 k3 s^2), so the first interval whose
+// end has h <= 0 holds the root, found by bisection to the last bit. +infinity beyond
+// kMaxScaledFoldRoot.
 double SmallestCubicFoldRoot(double k1, double k2, double k3) {
   auto h = [&](double s) { return 1.0 + s * (3.0 * k1 + s * (5.0 * k2 + s * 7.0 * k3)); };
   std::vector<double> ends;
@@ -118,30 +135,22 @@ double SmallestCubicFoldRoot(double k1, double k2, double k3) {
   if (disc >= 0.0) {
     const double sq = std::sqrt(disc);
     for (const double s : {(-10.0 * k2 - sq) / (42.0 * k3), (-10.0 * k2 + sq) / (42.0 * k3)}) {
-      if (s > 0.0) ends.push_back(s);
+      if (s > 0.0) ends.push_back(std::min(s, kMaxScaledFoldRoot));
     }
     std::sort(ends.begin(), ends.end());
   }
   double lo = 0.0;
   for (const double end : ends) {
-    if (h(end) <= 0.0) {
-      double hi = end;
-      while (hi - lo > 0.0 && std::nextafter(lo, hi) < hi) {
-        const double mid = 0.5 * (lo + hi);
-        (h(mid) > 0.0 ? lo : hi) = mid;
-      }
-      return hi;
-    }
+    if (h(end) <= 0.0) return BisectFold(h, lo, end);
     lo = end;
   }
   if (k3 > 0.0) return kInfinity;  // h > 0 beyond the last critical point
   double hi = std::max(1.0, 2.0 * lo);
-  while (h(hi) > 0.0) hi *= 2.0;
-  while (hi - lo > 0.0 && std::nextafter(lo, hi) < hi) {
-    const double mid = 0.5 * (lo + hi);
-    (h(mid) > 0.0 ? lo : hi) = mid;
+  while (h(hi) > 0.0) {
+    if (hi >= kMaxScaledFoldRoot) return kInfinity;
+    hi *= 2.0;
   }
-  return hi;
+  return BisectFold(h, lo, hi);
 }
 
 }  // namespace
@@ -150,21 +159,45 @@ double RadialFoldRadius(double k1, double k2, double k3) {
   RequireFinite(k1, "k1");
   RequireFinite(k2, "k2");
   RequireFinite(k3, "k3");
-  if (k3 != 0.0) return std::sqrt(SmallestCubicFoldRoot(k1, k2, k3));
-  // Smallest positive root s = r^2 of 5 k2 s^2 + 3 k1 s + 1.
-  double s_fold = kInfinity;
-  if (k2 == 0.0) {
-    if (k1 < 0.0) s_fold = -1.0 / (3.0 * k1);
-  } else {
-    const double disc = 9.0 * k1 * k1 - 20.0 * k2;
-    if (disc >= 0.0) {
-      const double sq = std::sqrt(disc);
-      for (const double s : {(-3.0 * k1 - sq) / (10.0 * k2), (-3.0 * k1 + sq) / (10.0 * k2)}) {
-        if (s > 0.0) s_fold = std::min(s_fold, s);
-      }
+  // In units of s = r^2 scaled by a power of two c ~ max(|k1|, |k2|^1/2, |k3|^1/3), the scaled
+  // coefficients k1 / c, k2 / c^2, k3 / c^3 are at most ~1: no square or product below
+  // overflows (k1 = 1e160 made the discriminant infinite and the search never ended) or loses
+  // the fold (k1 = -1e308 overflowed 3 k1 and answered 0). Powers of two scale exactly: for
+  // moderate coefficients the roots are those of the unscaled formulas, bit for bit.
+  const double scale = std::max({std::abs(k1), std::sqrt(std::abs(k2)), std::cbrt(std::abs(k3))});
+  if (scale == 0.0) return kInfinity;  // no distortion
+  const int e = std::ilogb(scale);
+  const double given[3] = {k1, k2, k3};  // for the message (the scaled k3 may be subnormal)
+  k1 = std::ldexp(k1, -e);
+  k2 = std::ldexp(k2, -2 * e);
+  k3 = std::ldexp(k3, -3 * e);
+  // The fold in scaled units t = s 2^e; s = t 2^-e (kInfinity stays so).
+  const auto unscaled_radius = [&](double t) { return std::sqrt(std::ldexp(t, -e)); };
+  if (k3 != 0.0) {
+    const double t_fold = SmallestCubicFoldRoot(k1, k2, k3);
+    // Not found below kMaxScaledFoldRoot: beyond r = 2^100 (s = 2^200) no image reaches (a
+    // 179.99 degree field of view ends at r = 1.1e4), so there it is "no fold"; nearer, the
+    // coefficients are too far apart in scale for a double to place it.
+    if (std::isinf(t_fold) && k3 < 0.0 && std::ldexp(kMaxScaledFoldRoot, -e) < 0x1p200) {
+      throw std::invalid_argument(internal::Concat(
+          "radial distortion k1 = ", given[0], ", k2 = ", given[1], ", k3 = ", given[2],
+          ": the coefficients are too far apart in scale to place the lens's fold in double "
+          "precision"));
+    }
+    return unscaled_radius(t_fold);
+  }
+  // Smallest positive root t of 5 k2 t^2 + 3 k1 t + 1, as q / (5 k2) and 1 / q with
+  // q = -(3 k1 + sign(k1) sqrt(disc)) / 2: the textbook formula's -3 k1 - sqrt(disc) cancels
+  // where k2 is small against k1^2 (k1 = -1e308, k2 = 1e308 lost the fold at 5.8e-155).
+  double t_fold = kInfinity;
+  const double disc = 9.0 * k1 * k1 - 20.0 * k2;
+  if (disc >= 0.0) {
+    const double q = -0.5 * (3.0 * k1 + std::copysign(std::sqrt(disc), k1));
+    for (const double t : {k2 != 0.0 ? q / (5.0 * k2) : kInfinity, q != 0.0 ? 1.0 / q : kInfinity}) {
+      if (t > 0.0) t_fold = std::min(t_fold, t);
     }
   }
-  return std::sqrt(s_fold);
+  return unscaled_radius(t_fold);
 }
 
 Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vector2d& pixel) {

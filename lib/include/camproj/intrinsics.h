@@ -82,7 +82,11 @@ Eigen::Vector2d PixelFromCam(const Intrinsics& intrinsics, const Eigen::Vector3d
 // i.e. the smallest positive root s = r^2 of 7 k3 s^3 + 5 k2 s^2 + 3 k1 s + 1; +infinity when there
 // is none (g increases for ever, e.g. k1, k2, k3 >= 0). g is increasing on [0, r_fold): the model
 // is a valid lens there only. Example: k2 = k3 = 0, k1 < 0 gives r_fold = 1 / sqrt(-3 k1).
-// Throws unless k1, k2, k3 are finite.
+// Computed in units scaled by a power of two to the coefficients' size, so extreme coefficients
+// (1e+-300) neither overflow nor lose the fold. Also +infinity for a fold beyond r = 2^100, which
+// no image reaches. Throws std::invalid_argument unless k1, k2, k3 are finite, and for k3 < 0 so
+// much smaller in scale than k1 or k2 (k1 = 1e160, k3 = -1e160) that a double cannot place the
+// fold.
 double RadialFoldRadius(double k1, double k2, double k3 = 0.0);
 
 // The ray through `pixel`, as (x, y, 1) in the cam frame: the inverse of PixelFromCam up to depth.
