@@ -36,6 +36,13 @@ TEST(CameraTest, PixelsBeyondADoubleAreNone) {
   camera.projection = Projection::kOrthographic;
   camera.intrinsics.k1 = 0.0;
   EXPECT_FALSE(PixelFromWorld(camera, {1e306, 0.0, 1.0}).has_value());  // fx x = inf
+  // Cam coordinates that overflow from finite ones: no pixel, for both projections (the
+  // perspective one threw "point_in_cam must be finite").
+  camera.cam_from_world.translation = {1e308, 0.0, 0.0};
+  for (const Projection projection : {Projection::kOrthographic, Projection::kPerspective}) {
+    camera.projection = projection;
+    EXPECT_FALSE(PixelFromWorld(camera, {1e308, 0.0, 1.0}).has_value());
+  }
 }
 
 TEST(CameraTest, DepthRangeCoveringBoxByHand) {

@@ -374,6 +374,9 @@ TEST(PointsFileTest, StreamedFileWithAnOverlongLineFailsCleanly) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), over + ": line 3 is longer than 9 bytes");
   }
+  // No bound at all: max_line_bytes + 1 wrapped to 0 and refused every line.
+  limits.max_line_bytes = std::numeric_limits<size_t>::max();
+  EXPECT_EQ(ReadCorrespondencesFile(over, limits).pixels.size(), 2u);
 }
 
 TEST(PointsFileTest, UnreadablePathsNameThePath) {

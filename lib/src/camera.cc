@@ -82,6 +82,8 @@ std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
                                               const Eigen::Vector3d& point_in_world) {
   const Eigen::Vector3d point_in_cam = camera.cam_from_world * point_in_world;
   if (!(point_in_cam.z() > 0.0)) return std::nullopt;
+  // A finite point whose cam coordinates overflow (t = 1e308, X = 1e308) has no pixel either.
+  if (!point_in_cam.allFinite()) return std::nullopt;
   if (camera.projection == Projection::kOrthographic) {
     const Intrinsics& k = camera.intrinsics;
     const Eigen::Vector2d pixel(k.fx * point_in_cam.x() + k.skew * point_in_cam.y() + k.cx,

@@ -377,7 +377,10 @@ void ParseFile(const std::string& path, const CorrespondencesLimits& limits, Csv
       const size_t newline = chunk.find('\n', begin);
       const size_t end = newline == std::string_view::npos ? chunk.size() : newline;
       const std::string_view piece = chunk.substr(begin, end - begin);
-      if (pending.size() + piece.size() > limits.max_line_bytes + 1) {
+      // A line of max_line_bytes and its CR (the parser strips it); written as a subtraction,
+      // since max_line_bytes + 1 wraps at SIZE_MAX (which then refused every line).
+      if (pending.size() + piece.size() > limits.max_line_bytes &&
+          pending.size() + piece.size() - limits.max_line_bytes > 1) {
         const size_t cr = piece.find('\r');
         if (cr != std::string_view::npos && cr + 1 < piece.size()) {
           parser.FailCarriageReturn(parser.next_line());

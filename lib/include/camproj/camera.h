@@ -66,9 +66,9 @@ CameraViews ViewsOfCamera(const Camera& camera, double target_distance = 1.0,
 void RequireFiniteViews(const Camera& camera, const GlDepth& depth = {});
 
 // The pixel (kCenter) of a world point, distortion included; std::nullopt if the point is not in
-// front of the camera (z_cam <= 0), or if its pixel is beyond a double (a ray ~1e300 times
-// farther off the axis than along it, or a lens polynomial that overflows), for either
-// projection.
+// front of the camera (z_cam <= 0), or if its cam coordinates or its pixel are beyond a double
+// (t = 1e308 and X = 1e308, a ray ~1e300 times farther off the axis than along it, or a lens
+// polynomial that overflows), for either projection.
 std::optional<Eigen::Vector2d> PixelFromWorld(const Camera& camera,
                                               const Eigen::Vector3d& point_in_world);
 
