@@ -72,7 +72,8 @@ struct ReportResiduals {
   std::vector<bool> outlier;
   std::vector<double> length;  // px; inf for a point behind the camera
   double largest = 0.0;        // px, over the kept points with a finite residual
-  double colour_top = 1e-12;   // what the colour scale's top stands for (> 0)
+  // What the colour scale's top stands for (> 0).
+  double ColourTop() const { return std::max(largest, 1e-12); }
 };
 
 ReportResiduals ResidualsOf(const FitResult& fit) {
@@ -87,7 +88,6 @@ ReportResiduals ResidualsOf(const FitResult& fit) {
     r.length[i] = fit.residuals_px[i].norm();
     if (!r.outlier[i] && std::isfinite(r.length[i])) r.largest = std::max(r.largest, r.length[i]);
   }
-  r.colour_top = std::max(r.largest, 1e-12);
   return r;
 }
 
@@ -101,7 +101,7 @@ double DrawResidualBars(const FitResult& fit, const ReportResiduals& residuals,
   const size_t n = fit.residuals_px.size();
   const std::vector<bool>& outlier = residuals.outlier;
   const std::vector<double>& length = residuals.length;
-  const double largest = residuals.largest, colour_top = residuals.colour_top;
+  const double largest = residuals.largest, colour_top = residuals.ColourTop();
   const double top = 34, h = 200;
   const double axis_max = std::max(largest * 1.15, 1e-3);
   const double step = NiceStep(axis_max, 5);
@@ -152,7 +152,7 @@ double DrawResidualsOverImage(const FitResult& fit, const ReportResiduals& resid
   const size_t n = fit.residuals_px.size();
   const std::vector<bool>& outlier = residuals.outlier;
   const std::vector<double>& length = residuals.length;
-  const double largest = residuals.largest, colour_top = residuals.colour_top;
+  const double largest = residuals.largest, colour_top = residuals.ColourTop();
   const double w_img = fit.camera.image_size.width, h_img = fit.camera.image_size.height;
   const double scale = std::min(kPlotWidth / w_img, 420.0 / h_img);
   const double x0 = kMargin, y0 = y + 30;

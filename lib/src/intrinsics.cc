@@ -159,41 +159,40 @@ double RadialFoldRadius(double k1, double k2, double k3) {
   RequireFinite(k1, "k1");
   RequireFinite(k2, "k2");
   RequireFinite(k3, "k3");
-  // In units of s = r^2 scaled by a power of two c ~ max(|k1|, |k2|^1/2, |k3|^1/3), the scaled
-  // coefficients k1 / c, k2 / c^2, k3 / c^3 are at most ~1: no square or product below
-  // overflows (k1 = 1e160 made the discriminant infinite and the search never ended) or loses
-  // the fold (k1 = -1e308 overflowed 3 k1 and answered 0). Powers of two scale exactly: for
-  // moderate coefficients the roots are those of the unscaled formulas, bit for bit.
+  // In units of s = r^2 scaled by a power of two c ~ max(|k1|, |k2|^1/2, |k3|^1/3), the
+  // scaled coefficients a1 = k1 / c, a2 = k2 / c^2, a3 = k3 / c^3 are at most ~1: no square or
+  // product below overflows (k1 = 1e160 made the discriminant infinite and the search never
+  // ended) or loses the fold (k1 = -1e308 overflowed 3 k1 and answered 0). Powers of two scale
+  // exactly: for moderate coefficients the roots are those of the unscaled formulas, bit for bit.
   const double scale = std::max({std::abs(k1), std::sqrt(std::abs(k2)), std::cbrt(std::abs(k3))});
   if (scale == 0.0) return kInfinity;  // no distortion
   const int e = std::ilogb(scale);
-  const double given[3] = {k1, k2, k3};  // for the message (the scaled k3 may be subnormal)
-  k1 = std::ldexp(k1, -e);
-  k2 = std::ldexp(k2, -2 * e);
-  k3 = std::ldexp(k3, -3 * e);
+  const double a1 = std::ldexp(k1, -e);
+  const double a2 = std::ldexp(k2, -2 * e);
+  const double a3 = std::ldexp(k3, -3 * e);
   // The fold in scaled units t = s 2^e; s = t 2^-e (kInfinity stays so).
   const auto unscaled_radius = [&](double t) { return std::sqrt(std::ldexp(t, -e)); };
-  if (k3 != 0.0) {
-    const double t_fold = SmallestCubicFoldRoot(k1, k2, k3);
+  if (a3 != 0.0) {
+    const double t_fold = SmallestCubicFoldRoot(a1, a2, a3);
     // Not found below kMaxScaledFoldRoot: beyond r = 2^100 (s = 2^200) no image reaches (a
     // 179.99 degree field of view ends at r = 1.1e4), so there it is "no fold"; nearer, the
     // coefficients are too far apart in scale for a double to place it.
-    if (std::isinf(t_fold) && k3 < 0.0 && std::ldexp(kMaxScaledFoldRoot, -e) < 0x1p200) {
+    if (std::isinf(t_fold) && a3 < 0.0 && std::ldexp(kMaxScaledFoldRoot, -e) < 0x1p200) {
       throw std::invalid_argument(internal::Concat(
-          "radial distortion k1 = ", given[0], ", k2 = ", given[1], ", k3 = ", given[2],
+          "radial distortion k1 = ", k1, ", k2 = ", k2, ", k3 = ", k3,
           ": the coefficients are too far apart in scale to place the lens's fold in double "
           "precision"));
     }
     return unscaled_radius(t_fold);
   }
-  // Smallest positive root t of 5 k2 t^2 + 3 k1 t + 1, as q / (5 k2) and 1 / q with
-  // q = -(3 k1 + sign(k1) sqrt(disc)) / 2: the textbook formula's -3 k1 - sqrt(disc) cancels
-  // where k2 is small against k1^2 (k1 = -1e308, k2 = 1e308 lost the fold at 5.8e-155).
+  // Smallest positive root t of 5 a2 t^2 + 3 a1 t + 1, as q / (5 a2) and 1 / q with
+  // q = -(3 a1 + sign(a1) sqrt(disc)) / 2: the textbook formula's -3 a1 - sqrt(disc) cancels
+  // where a2 is small against a1^2 (k1 = -1e308, k2 = 1e308 lost the fold at 5.8e-155).
   double t_fold = kInfinity;
-  const double disc = 9.0 * k1 * k1 - 20.0 * k2;
+  const double disc = 9.0 * a1 * a1 - 20.0 * a2;
   if (disc >= 0.0) {
-    const double q = -0.5 * (3.0 * k1 + std::copysign(std::sqrt(disc), k1));
-    for (const double t : {k2 != 0.0 ? q / (5.0 * k2) : kInfinity, q != 0.0 ? 1.0 / q : kInfinity}) {
+    const double q = -0.5 * (3.0 * a1 + std::copysign(std::sqrt(disc), a1));
+    for (const double t : {a2 != 0.0 ? q / (5.0 * a2) : kInfinity, q != 0.0 ? 1.0 / q : kInfinity}) {
       if (t > 0.0) t_fold = std::min(t_fold, t);
     }
   }

@@ -445,9 +445,11 @@ std::string LabelText(const OverlayPoint& point, const std::string& id,
   return text;
 }
 
-// The labels, placed around their anchors clear of each other and of the legend (the outliers
-// first, then the points outside, then by residual), drawn, and listed in stats.labels.
+// The labels, placed around `anchors` (the points' OverlayPoint::anchor) clear of each other
+// and of the legend (the outliers first, then the points outside, then by residual), drawn, and
+// listed in stats.labels.
 void DrawLabels(cv::Mat& image, const std::vector<OverlayPoint>& points,
+                const std::vector<Eigen::Vector2d>& anchors,
                 const Correspondences& correspondences, const Box& legend_box, const Style& s,
                 OverlayStats* stats) {
   const int w = image.cols;
@@ -455,14 +457,12 @@ void DrawLabels(cv::Mat& image, const std::vector<OverlayPoint>& points,
   const size_t n = points.size();
   std::vector<std::string> texts(n);
   std::vector<cv::Size> sizes(n);
-  std::vector<Eigen::Vector2d> anchors(n);
   for (size_t i = 0; i < n; ++i) {
     texts[i] = LabelText(points[i], correspondences.ids[i], correspondences.pixels[i]);
     int baseline = 0;
     const cv::Size size =
         cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
     sizes[i] = cv::Size(size.width + 2 * s.line, size.height + baseline + 2 * s.line);
-    anchors[i] = points[i].anchor;
   }
   std::vector<size_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = i;
@@ -527,7 +527,7 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
   for (size_t i = 0; i < n; ++i) anchors[i] = points[i].anchor;
   const Box legend_box = DrawLegend(image, stats, anchors, s);
   DrawMarkers(image, points, correspondences, stats.magnify, s);
-  DrawLabels(image, points, correspondences, legend_box, s, &stats);
+  DrawLabels(image, points, anchors, correspondences, legend_box, s, &stats);
 
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
