@@ -167,6 +167,26 @@ TEST(CameraFileTest, MalformedFilesNameTheKeyOrLine) {
             "frustum": {"near": 1, "far": 2}})").find("left-handed"), std::string::npos);
 }
 
+// Values that pass their own checks but whose derived views overflow a double are refused under
+// the key they come from: the pose (its look-at eye is -R^T t) or the intrinsics with near and far
+// (whose frustum and projection matrix).
+TEST(CameraFileTest, ViewsBeyondADoubleNameWhereTheyComeFrom) {
+  const std::string intrinsics = R"({"image_size": [640, 480],
+      "intrinsics": {"fx": 500, "fy": 500, "cx": 319.5, "cy": 239.5},)";
+  const std::string rotated = R"("R": [[0.6,0,0.8],[0,1,0],[-0.8,0,0.6]])";
+  const std::string overflowing_pose =
+      ExpectInputError(intrinsics + R"("cam_from_world": {)" + rotated +
+                       R"(, "t": [1.5e308, 0, 1.5e308]}, "frustum": {"near": 1, "far": 2}})");
+  EXPECT_NE(overflowing_pose.find("cam.json: cam_from_world: the look-at eye"), std::string::npos)
+      << overflowing_pose;
+  const std::string overflowing_frustum = ExpectInputError(intrinsics + R"("cam_from_world": {)" +
+                                                           rotated + R"(, "t": [0, 0, 0]},
+      "frustum": {"near": 1e308, "far": "inf"}})");
+  EXPECT_NE(overflowing_frustum.find("cam.json: intrinsics with frustum.near, frustum.far: "),
+            std::string::npos)
+      << overflowing_frustum;
+}
+
 // The message of the InputError that selecting `view` in `text` as "calib.json" throws.
 std::string ExpectViewError(const std::string& text, const std::string& view) {
   try {

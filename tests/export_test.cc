@@ -1,5 +1,6 @@
 #include "camproj/export.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -736,6 +737,30 @@ TEST(ExportCameraTest, InvalidCameraIsRefusedByEveryFormat) {
         ExportFormat::kThree, ExportFormat::kJson}) {
     EXPECT_THROW(ExportCamera(camera, format), std::invalid_argument) << ToString(format);
   }
+}
+
+// A valid camera far from the origin with a near plane of 1e-300: the automatic origin is the
+// camera centre (the step 1e-300 cannot round 1e10), not "-inf"; a float32 error beyond a
+// double is said in words.
+TEST(ExportCameraTest, ExtremeNearPlanesAndErrorsBeyondADoubleAreWrittenInWords) {
+  Camera camera;
+  camera.image_size = {640, 480};
+  camera.intrinsics.fx = camera.intrinsics.fy = 500.0;
+  camera.intrinsics.cx = 319.5;
+  camera.intrinsics.cy = 239.5;
+  camera.cam_from_world.translation = Eigen::Vector3d(1e10, 0.0, 0.0);
+  camera.z_near = 1e-300;
+  camera.z_far = 10.0;
+  for (const ExportFormat format : {ExportFormat::kGl, ExportFormat::kGlm, ExportFormat::kThree}) {
+    const std::string text = ExportCamera(camera, format);
+    EXPECT_THAT(text, ::testing::HasSubstr("px with camproj export --origin auto"))
+        << ToString(format);
+    EXPECT_THAT(text, ::testing::Not(::testing::HasSubstr("inf px"))) << ToString(format);
+  }
+  camera.intrinsics.fx = camera.intrinsics.fy = 1e300;
+  camera.z_near = 1e-10;
+  EXPECT_THAT(ExportCamera(camera, ExportFormat::kGl),
+              ::testing::HasSubstr("float32 error at the near plane more than 1.8e+308 px"));
 }
 
 }  // namespace

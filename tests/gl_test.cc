@@ -1,6 +1,7 @@
 #include "camproj/gl.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -348,6 +349,66 @@ TEST(GlTest, MalformedMatricesAreRefusedWithTheEntryNamed) {
   EXPECT_THROW(FrustumFromClipFromGlEye(ClipFromGlEye(k, size, 1, 10)), std::invalid_argument);
   EXPECT_THROW(ClipFromGlEye(k, size, 0.0, 10), std::invalid_argument);
   EXPECT_THROW(ClipFromGlEye(k, size, 1, 0.5), std::invalid_argument);
+}
+
+// Every argument below passes its own check, yet the result is beyond a double (an entry
+// overflows, or a scale underflows to 0): each conversion throws std::invalid_argument saying so,
+// never returns inf, NaN or a matrix that maps every point to one pixel.
+void ExpectBeyondADouble(const std::function<void()>& convert, const char* what) {
+  try {
+    convert();
+    ADD_FAILURE() << what << ": no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be represented"), std::string::npos)
+        << what << ": " << e.what();
+  }
+}
+
+TEST(GlTest, ResultsBeyondADoubleAreRefused) {
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  ExpectBeyondADouble([] { ClipFromGlEye(Frustum{-1, 1, -1, 1, 1e308, kInfinity}); },
+                      "frustum near 1e308, infinite far (B = -2 near)");
+  ExpectBeyondADouble([] { ClipFromGlEye(Frustum{-1e-310, 1e-310, -1, 1, 1, 10}); },
+                      "frustum width 2e-310");
+  ExpectBeyondADouble([=] { ClipFromGlEye(Frustum{-1e300, 1e300, -1, 1, tiny, 1}); },
+                      "frustum x scale underflows to 0");
+  ExpectBeyondADouble([] { ClipFromGlEye(Perspective{1e-320, 1.0, 1.0, 10.0}); },
+                      "perspective fovy 1e-320 deg");
+  ExpectBeyondADouble([] { FrustumFromPerspective(Perspective{90.0, 1.7e308, 1.0, 10.0}); },
+                      "perspective aspect 1.7e308 (right - left overflows)");
+  Intrinsics k;
+  k.fx = k.fy = 1e308;
+  ExpectBeyondADouble([&] { ClipFromGlEye(k, ImageSize{1, 1}, 1.0, 10.0); },
+                      "fx 1e308 on a 1x1 image");
+  k.fx = k.fy = 1e-320;
+  ExpectBeyondADouble([&] { ClipFromGlEye(k, ImageSize{1000000, 1000000}, 1.0, 10.0); },
+                      "fx 1e-320 on 1e6 px (scale underflows)");
+  k.fx = k.fy = 500.0;
+  ExpectBeyondADouble([&] { ClipFromGlEyeOrthographic(k, ImageSize{640, 480}, 0.0, 1e-310); },
+                      "orthographic near 0, far 1e-310");
+  EXPECT_THROW(ClipFromGlEyeOrthographic(k, ImageSize{640, 480}, -1e308, 1e308),
+               std::invalid_argument);  // far - near overflows
+  k.fx = k.fy = 1e308;
+  k.cx = 1e308;
+  ExpectBeyondADouble([&] { OrthoFromOrthographic(k, ImageSize{2, 2}, 0.0, 1.0); },
+                      "glOrtho box of fx 1e308, cx 1e308 (left == right)");
+  Eigen::Matrix4d m = ClipFromGlEye(Frustum{});
+  m(0, 0) = 1e308;
+  ExpectBeyondADouble([&] { IntrinsicsFromClipFromGlEye(m, ImageSize{640, 480}); },
+                      "intrinsics of m00 = 1e308");
+  m(0, 0) = tiny;
+  ExpectBeyondADouble([&] { FrustumFromClipFromGlEye(m); }, "frustum of m00 = 5e-324");
+  ExpectBeyondADouble([=] { IntrinsicsFromFrustum(Frustum{-1e10, 1e10, -1, 1, 1e-320, 1},
+                                                  ImageSize{640, 480}); },
+                      "intrinsics of a frustum whose fx underflows to 0");
+  Eigen::Matrix4d bad = ClipFromGlEye(Frustum{});
+  bad(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(GlPixelFromWorld(bad, Eigen::Matrix4d::Identity(), Eigen::Vector3d(0, 0, -2),
+                                ImageSize{640, 480}),
+               std::invalid_argument);
+  // The valid extremes nearest to these still convert, exactly as before.
+  EXPECT_NO_THROW(ClipFromGlEye(Frustum{-1, 1, -1, 1, 1e307, kInfinity}));
+  EXPECT_NO_THROW(ClipFromGlEye(Perspective{1e-3, 1.0, 1.0, 10.0}));
 }
 
 }  // namespace

@@ -186,5 +186,21 @@ TEST(IntrinsicsTest, BadValuesAreNamed) {
                std::invalid_argument);
 }
 
+TEST(IntrinsicsTest, ARayBeyondADoubleIsRefusedNotInfinite) {
+  // Both finite, the pixel's offset from the principal point is not: the ray would be inf.
+  Intrinsics k;
+  k.fx = k.fy = 1.0;
+  k.cx = -1e308;
+  try {
+    CamRayFromPixel(k, Eigen::Vector2d(1e308, 0.0));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be represented"), std::string::npos) << e.what();
+  }
+  k.k1 = 0.1;  // the distorted path too
+  EXPECT_THROW(CamRayFromPixel(k, Eigen::Vector2d(1e308, 0.0)), std::invalid_argument);
+  EXPECT_EQ(CamRayFromPixel(k, Eigen::Vector2d(-1e308, 0.0)), Eigen::Vector3d(0, 0, 1));
+}
+
 }  // namespace
 }  // namespace camproj

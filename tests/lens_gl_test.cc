@@ -410,5 +410,26 @@ TEST(LensGlTest, StMapFilesAreFloatRgbaInNukeChannelOrder) {
   }
 }
 
+// Lenses whose numbers pass the camera's checks but that float32 GLSL or the lens polynomial
+// cannot hold are refused, naming why, never written as inf, 0 px edges or null UVs.
+TEST(LensGlTest, LensesBeyondFloatOrDoubleAreRefusedNotWrittenAsInfOrNull) {
+  // k1 = 1e300 passes the camera's checks; a GLSL float literal above 3.4e38 is infinite.
+  EXPECT_THAT([] { LensGlslText(TestCamera(1e300, 0.0)); },
+              ::testing::ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("k1 = 1.0000000000000001e+300 is beyond float32's range")));
+  EXPECT_NO_THROW(LensGlslText(TestCamera(1e38, 0.0)));
+  Camera pinhole = TestCamera(0.0, 0.0);
+  pinhole.intrinsics.fx = pinhole.intrinsics.fy = 1e300;  // 2 fx / W = 1.9e298
+  EXPECT_THAT([&] { LensGlslText(pinhole); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("beyond float32's range")));
+  // fx = 1e-300 px: the corners' normalized radius overflows the polynomial (null UVs before).
+  for (const double k1 : {0.0, 0.1}) {
+    Camera wide = TestCamera(k1, 0.0);
+    wide.intrinsics.fx = wide.intrinsics.fy = 1e-300;
+    EXPECT_THAT([&] { LensDistortionMeshJson(wide, 8); },
+                ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("180 degrees")));
+  }
+}
+
 }  // namespace
 }  // namespace camproj

@@ -109,5 +109,18 @@ TEST(LookAtTest, ExtremeScalesGiveTheSamePose) {
   }
 }
 
+TEST(LookAtTest, ALookAtBeyondADoubleIsRefusedNotInfinite) {
+  // A finite pose whose target, eye + distance * gaze, overflows.
+  Rigid3 cam_from_world;
+  cam_from_world.translation = Eigen::Vector3d(0, 0, -1.5e308);  // eye (0, 0, 1.5e308)
+  try {
+    LookAtFromCamFromWorld(cam_from_world, 1e308);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("look-at target"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(LookAtFromCamFromWorld(cam_from_world, 1.0));
+}
+
 }  // namespace
 }  // namespace camproj

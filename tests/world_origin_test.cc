@@ -48,6 +48,22 @@ TEST(WorldOriginTest, RoundOriginRoundsToAPowerOfTenOfTheExtent) {
   EXPECT_THROW(RoundOrigin(Eigen::Vector3d(NAN, 0.0, 0.0), 1.0), std::invalid_argument);
 }
 
+// Steps a double cannot scale by (10^300 overflows) or round to (2^53 steps from 0) leave the
+// coordinate as it is; the origin is always finite. A valid camera at 1e10 with near 1e-300
+// exported with --origin auto threw "world origin must be finite, got -inf".
+TEST(WorldOriginTest, ExtremeStepsKeepTheCoordinateAndStayFinite) {
+  const Eigen::Vector3d far_away(1e10, -1e10, 3.0);
+  EXPECT_EQ(RoundOrigin(far_away, 1e-300), far_away);
+  EXPECT_EQ(RoundOrigin(far_away, 1e-320), far_away);
+  EXPECT_EQ(RoundOrigin(Eigen::Vector3d(1.7e308, 0.0, 0.0), 1e308),
+            Eigen::Vector3d(1.7e308, 0.0, 0.0));
+  EXPECT_EQ(RoundOrigin(Eigen::Vector3d(1e20, 0.5, 0.0), 1.0), Eigen::Vector3d(1e20, 1.0, 0.0));
+  Camera camera = CameraAt(Eigen::Vector3d(1e10, 0.0, 0.0));
+  camera.z_near = 1e-300;
+  EXPECT_TRUE(AutoOriginOfCamera(camera).allFinite());
+  EXPECT_EQ(AutoOriginOfCamera(camera), CameraCenterInWorld(camera.cam_from_world));
+}
+
 // The origin is within step * sqrt(3) / 2 of the centre (each axis within step / 2), for any
 // centre and extent.
 TEST(WorldOriginTest, RoundedOriginLiesWithinHalfAStepPerAxis) {

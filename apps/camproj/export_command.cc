@@ -152,9 +152,9 @@ void PrintFloat32Precision(const Camera& camera, bool quiet) {
   char line[512];
   std::snprintf(line, sizeof line,
                 "float32 vertices and view matrix: expected error at the near plane "
-                "(depth %.6g) %.2g px without a world origin, %.2g px with %s "
+                "(depth %.6g) %s px without a world origin, %s px with %s "
                 "%.17g,%.17g,%.17g",
-                camera.z_near, without, with,
+                camera.z_near, GeneralBound(without, 2).c_str(), GeneralBound(with, 2).c_str(),
                 camera.world_origin ? "the world origin" : "--origin auto =",
                 origin->x(), origin->y(), origin->z());
   if (!camera.world_origin && without > kFloat32ErrorWarningPx) {

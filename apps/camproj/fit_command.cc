@@ -28,6 +28,7 @@
 #include "camproj/fit_report.h"
 #include "camproj/fit_request.h"
 #include "camproj/model_select.h"
+#include "camproj/number_text.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
 #include "camproj/world_origin.h"
@@ -426,8 +427,8 @@ void PrintNotes(const FitRequest& request, const FitResult& fit) {
   } else if (const double error = Float32PixelError(fit.camera, std::nullopt, fit.camera.z_near);
              error > kFloat32ErrorWarningPx) {
     std::printf("note: the world coordinates are too large for float32: GL exports would draw "
-                "points ~%.2g px off at the near plane; fit with --origin auto (docs/exports.md)\n",
-                error);
+                "points ~%s px off at the near plane; fit with --origin auto (docs/exports.md)\n",
+                GeneralBound(error, 2).c_str());
   }
 }
 

@@ -43,7 +43,9 @@ CameraViews ViewsOfCamera(const Camera& camera, double target_distance, const Gl
   if (pinhole.skew == 0.0) {
     views.frustum =
         FrustumFromIntrinsics(pinhole, camera.image_size, camera.z_near, camera.z_far);
-    if (IsSymmetric(*views.frustum)) views.perspective = PerspectiveFromFrustum(*views.frustum);
+    if (HasPerspectiveForm(*views.frustum)) {
+      views.perspective = PerspectiveFromFrustum(*views.frustum);
+    }
   }
   views.clip_from_gl_eye =
       ClipFromGlEye(pinhole, camera.image_size, camera.z_near, camera.z_far, depth);

@@ -278,10 +278,18 @@ Camera CameraFromDocument(const json& document, const Reader& reader) {
                                   "too large for a double");
     }
   }
+  // The derived views, checked by what they come from: the look-at (eye = -R^T t) from the pose
+  // alone, the rest from the intrinsics with near and far.
+  const std::string pose_key = document.contains("cam_from_world") ? "cam_from_world" : "look_at";
+  try {
+    LookAtFromCamFromWorld(camera.cam_from_world);
+  } catch (const std::invalid_argument& e) {
+    reader.Fail(pose_key, e.what());
+  }
   try {
     RequireFiniteViews(camera);
   } catch (const std::invalid_argument& e) {
-    reader.Fail("intrinsics", e.what());
+    reader.Fail("intrinsics with frustum.near, frustum.far", e.what());
   }
   return camera;
 }

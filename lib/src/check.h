@@ -46,6 +46,32 @@ void RequireFiniteAll(const Derived& m, const char* name) {
   }
 }
 
+// Throws unless every entry of a computed result is finite: arguments that pass their own checks
+// can still give a result beyond a double (a frustum with near 1e308 and a width of 1e-300). The
+// message is `what`, then the first entry that is not finite.
+template <typename Derived, typename... Args>
+void RequireFiniteResult(const Derived& m, const Args&... what) {
+  for (int i = 0; i < m.size(); ++i) {
+    if (!std::isfinite(m.data()[i])) {
+      ThrowInvalidArgument(what..., " cannot be represented in a double (", m.data()[i],
+                           " at index ", i, ")");
+    }
+  }
+}
+
+// `result` after its own Check(), whose message is prefixed by `what`: a conversion whose
+// arguments are valid can still produce a value its type refuses (an intrinsics' fx that
+// underflows to 0, a frustum plane that overflows).
+template <typename Result, typename... Args>
+const Result& CheckedResult(const Result& result, const Args&... what) {
+  try {
+    result.Check();
+  } catch (const std::invalid_argument& error) {
+    ThrowInvalidArgument(what..., " cannot be represented (", error.what(), ")");
+  }
+  return result;
+}
+
 }  // namespace internal
 }  // namespace camproj
 

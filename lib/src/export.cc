@@ -11,6 +11,7 @@
 
 #include "camproj/camera_file.h"
 #include "camproj/lens_gl.h"
+#include "camproj/number_text.h"
 #include "camproj/world_origin.h"
 #include "check.h"
 
@@ -99,13 +100,13 @@ std::string OriginNote(const Camera& camera) {
         << o.x() << ", " << o.y() << ", " << o.z()
         << "), subtracted in double before the cast to float; expected float32 error at the near "
            "plane "
-        << std::setprecision(2) << Float32PixelError(camera, camera.world_origin, camera.z_near)
-        << " px (" << error_without << " px without the origin)";
+        << GeneralBound(Float32PixelError(camera, camera.world_origin, camera.z_near), 2) << " px ("
+        << GeneralBound(error_without, 2) << " px without the origin)";
   } else {
     out << "world origin: none: the view matrix takes world coordinates as they are; expected "
            "float32 error at the near plane "
-        << std::setprecision(2) << error_without << " px ("
-        << Float32PixelError(camera, auto_origin, camera.z_near)
+        << GeneralBound(error_without, 2) << " px ("
+        << GeneralBound(Float32PixelError(camera, auto_origin, camera.z_near), 2)
         << " px with camproj export --origin auto)";
   }
   return out.str();

@@ -6,6 +6,7 @@
 
 namespace camproj {
 
+using internal::CheckedResult;
 using internal::Require;
 using internal::ThrowInvalidArgument;
 using internal::RequireFinite;
@@ -83,6 +84,18 @@ bool IsSymmetric(const Frustum& frustum) {
              kSymmetryTolerance * (frustum.top - frustum.bottom);
 }
 
+namespace {
+
+double FovyDegOfFrustum(const Frustum& frustum) {
+  return 2.0 * std::atan2(0.5 * (frustum.top - frustum.bottom), frustum.z_near) * 180.0 / kPi;
+}
+
+}  // namespace
+
+bool HasPerspectiveForm(const Frustum& frustum) {
+  return IsSymmetric(frustum) && FovyDegOfFrustum(frustum) < 180.0;
+}
+
 Frustum FrustumFromPerspective(const Perspective& perspective) {
   perspective.Check();
   Frustum frustum;
@@ -92,7 +105,8 @@ Frustum FrustumFromPerspective(const Perspective& perspective) {
   frustum.left = -frustum.right;
   frustum.z_near = perspective.z_near;
   frustum.z_far = perspective.z_far;
-  return frustum;
+  return CheckedResult(frustum, "the frustum of fovy_deg ", perspective.fovy_deg, ", aspect ",
+                       perspective.aspect, ", near ", perspective.z_near);
 }
 
 Perspective PerspectiveFromFrustum(const Frustum& frustum) {
@@ -106,11 +120,14 @@ Perspective PerspectiveFromFrustum(const Frustum& frustum) {
           ", vertical (top + bottom) / (top - bottom) = ", (frustum.top + frustum.bottom) / height,
           " (allowed ", kSymmetryTolerance, "); use the frustum or the projection matrix");
   Perspective perspective;
-  perspective.fovy_deg = 2.0 * std::atan2(0.5 * height, frustum.z_near) * 180.0 / kPi;
+  perspective.fovy_deg = FovyDegOfFrustum(frustum);
+  Require(perspective.fovy_deg < 180.0, "the frustum's vertical field of view rounds to 180 "
+          "degrees in a double (height ", height, " at near ", frustum.z_near,
+          ") and has no gluPerspective form; use the frustum or the projection matrix");
   perspective.aspect = width / height;
   perspective.z_near = frustum.z_near;
   perspective.z_far = frustum.z_far;
-  return perspective;
+  return CheckedResult(perspective, "the perspective of the frustum");
 }
 
 Frustum FrustumFromIntrinsics(const Intrinsics& intrinsics, const ImageSize& size, double z_near,
@@ -147,7 +164,9 @@ Intrinsics IntrinsicsFromFrustum(const Frustum& frustum, const ImageSize& size,
               std::isfinite(corner.cy),
           "the frustum's intrinsics are not finite (fx = ", corner.fx, ", fy = ", corner.fy,
           "): its extents are too small against near for a double");
-  return ConvertPixelOrigin(corner, PixelOrigin::kCorner, origin);
+  return CheckedResult(ConvertPixelOrigin(corner, PixelOrigin::kCorner, origin),
+                       "the intrinsics of the frustum on a ", size.width, "x", size.height,
+                       " image");
 }
 
 Perspective PerspectiveFromIntrinsics(const Intrinsics& intrinsics, const ImageSize& size,

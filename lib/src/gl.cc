@@ -11,16 +11,18 @@ namespace camproj {
 
 using internal::Require;
 using internal::ThrowInvalidArgument;
+using internal::CheckedResult;
 using internal::RequireFiniteAll;
+using internal::RequireFiniteResult;
 
 namespace {
 
 // f n / (f - n) and (f + n) / (f - n) without the overflow of f n or f + n when the depths are
-// huge (a world in units of 2^-600): the plain forms wherever they are finite, so that ordinary
-// depths keep their rounding (and glm's); a factor 2 is exact, so 2 f n / (f - n) is 2 times it.
+// huge, or the underflow of f n when they are tiny (a world in units of 2^-600 or 2^-1000): the
+// plain forms wherever f n is a normal double, so that ordinary depths keep their rounding (and
+// glm's); a factor 2 is exact, so 2 f n / (f - n) is 2 times it.
 double ProductOverRange(double n, double f) {
-  const double plain = f * n / (f - n);
-  return std::isfinite(plain) ? plain : n * (f / (f - n));
+  return std::isnormal(f * n) ? f * n / (f - n) : n * (f / (f - n));
 }
 double SumOverRange(double n, double f) {
   const double plain = (f + n) / (f - n);
@@ -56,6 +58,20 @@ Eigen::Matrix4d PerspectiveMatrix(double x_scale, double x_skew, double x_offset
   return m;
 }
 
+// Valid arguments can still give a matrix beyond a double: entries that overflow (near 1e308 over
+// a width of 1e-300) or scales that underflow to 0 (every point mapped to the image centre, or
+// every depth to one value). The depth scale is (2,3) in a perspective matrix (ndc z = -A - B /
+// z_eye), (2,2) in an orthographic one.
+template <typename... Args>
+const Eigen::Matrix4d& CheckedProjection(const Eigen::Matrix4d& m, int depth_scale_col,
+                                         const Args&... what) {
+  RequireFiniteResult(m, what...);
+  Require(m(0, 0) != 0.0 && m(1, 1) != 0.0 && m(2, depth_scale_col) != 0.0, what...,
+          " cannot be represented in a double (a scale underflows to 0: (0,0) = ", m(0, 0),
+          ", (1,1) = ", m(1, 1), ", (2,", depth_scale_col, ") = ", m(2, depth_scale_col), ")");
+  return m;
+}
+
 // The matrix divided by its positive scale -m(3,2), after checking the perspective structure.
 Eigen::Matrix4d NormalizedPerspective(const Eigen::Matrix4d& clip_from_gl_eye) {
   RequireFiniteAll(clip_from_gl_eye, "projection matrix");
@@ -76,9 +92,12 @@ Eigen::Matrix4d ClipFromGlEye(const Frustum& frustum, const GlDepth& depth) {
   frustum.Check();
   const double width = frustum.right - frustum.left;
   const double height = frustum.top - frustum.bottom;
-  return PerspectiveMatrix(2.0 * frustum.z_near / width, 0.0, (frustum.right + frustum.left) / width,
-                           2.0 * frustum.z_near / height, (frustum.top + frustum.bottom) / height,
-                           DepthRow(frustum.z_near, frustum.z_far, depth));
+  return CheckedProjection(
+      PerspectiveMatrix(2.0 * frustum.z_near / width, 0.0, (frustum.right + frustum.left) / width,
+                        2.0 * frustum.z_near / height, (frustum.top + frustum.bottom) / height,
+                        DepthRow(frustum.z_near, frustum.z_far, depth)),
+      3, "the projection matrix of the frustum with near ", frustum.z_near, ", width ", width,
+      ", height ", height);
 }
 
 Eigen::Matrix4d ClipFromGlEye(const Perspective& perspective, const GlDepth& depth) {
@@ -102,8 +121,11 @@ Eigen::Matrix4d ClipFromGlEye(const Intrinsics& intrinsics, const ImageSize& siz
   const double w = size.width;
   const double h = size.height;
   // "+ 0.0" turns the -0 of a zero skew into +0, so printed matrices read as glFrustum's.
-  return PerspectiveMatrix(2.0 * k.fx / w, -2.0 * k.skew / w + 0.0, 1.0 - 2.0 * k.cx / w,
-                           2.0 * k.fy / h, 2.0 * k.cy / h - 1.0, DepthRow(z_near, z_far, depth));
+  return CheckedProjection(
+      PerspectiveMatrix(2.0 * k.fx / w, -2.0 * k.skew / w + 0.0, 1.0 - 2.0 * k.cx / w,
+                        2.0 * k.fy / h, 2.0 * k.cy / h - 1.0, DepthRow(z_near, z_far, depth)),
+      3, "the projection matrix of fx = ", k.fx, ", fy = ", k.fy, " on a ", size.width, "x",
+      size.height, " image with near ", z_near, ", far ", z_far);
 }
 
 Eigen::Matrix4d ClipFromGlEyeOrtho(const Ortho& ortho, ClipDepth clip_depth) {
@@ -137,6 +159,8 @@ Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const Im
   }
   Require(std::isfinite(z_near) && std::isfinite(z_far) && z_far > z_near,
           "an orthographic projection needs finite near < far, got near ", z_near, ", far ", z_far);
+  Require(std::isfinite(z_far - z_near), "an orthographic projection's depth range far - near "
+          "must be finite, got near ", z_near, ", far ", z_far);
   // Corner convention, x_eye = x_cam, y_eye = -y_cam, z_eye = -z_cam:
   //   u = fx x_cam + skew y_cam + cx,  x_ndc = 2 u / W - 1;
   //   v = fy y_cam + cy,               y_ndc = 1 - 2 v / H.
@@ -157,7 +181,9 @@ Eigen::Matrix4d ClipFromGlEyeOrthographic(const Intrinsics& intrinsics, const Im
   const double a = (ndc_near - ndc_far) / (z_far - z_near);
   m(2, 2) = a;
   m(2, 3) = ndc_near + a * z_near;
-  return m;
+  return CheckedProjection(m, 2, "the orthographic projection matrix of fx = ", k.fx, ", fy = ",
+                           k.fy, " px per unit on a ", size.width, "x", size.height,
+                           " image with near ", z_near, ", far ", z_far);
 }
 
 Ortho OrthoFromOrthographic(const Intrinsics& intrinsics, const ImageSize& size, double z_near,
@@ -172,7 +198,8 @@ Ortho OrthoFromOrthographic(const Intrinsics& intrinsics, const ImageSize& size,
   ortho.top = (1.0 - m(1, 3)) / m(1, 1);
   ortho.z_near = z_near;
   ortho.z_far = z_far;
-  return ortho;
+  return CheckedResult(ortho, "the glOrtho box of fx = ", intrinsics.fx, ", fy = ", intrinsics.fy,
+                       " px per unit on a ", size.width, "x", size.height, " image");
 }
 
 Intrinsics IntrinsicsFromClipFromGlEye(const Eigen::Matrix4d& clip_from_gl_eye,
@@ -190,7 +217,9 @@ Intrinsics IntrinsicsFromClipFromGlEye(const Eigen::Matrix4d& clip_from_gl_eye,
   Require(corner.fx > 0.0 && corner.fy > 0.0,
           "projection matrix gives non-positive focal lengths fx = ", corner.fx, ", fy = ",
           corner.fy);
-  return ConvertPixelOrigin(corner, PixelOrigin::kCorner, origin);
+  return CheckedResult(ConvertPixelOrigin(corner, PixelOrigin::kCorner, origin),
+                       "the intrinsics of the projection matrix on a ", size.width, "x",
+                       size.height, " image");
 }
 
 DepthRange DepthRangeFromClipFromGlEye(const Eigen::Matrix4d& clip_from_gl_eye,
@@ -232,7 +261,7 @@ Frustum FrustumFromClipFromGlEye(const Eigen::Matrix4d& clip_from_gl_eye, const 
   frustum.top = 0.5 * height * (m(1, 2) + 1.0);
   frustum.z_near = range.z_near;
   frustum.z_far = range.z_far;
-  return frustum;
+  return CheckedResult(frustum, "the frustum of the projection matrix");
 }
 
 Eigen::Matrix4d GlEyeFromWorld(const Rigid3& cam_from_world) {
@@ -255,6 +284,9 @@ GlPixel GlPixelFromWorld(const Eigen::Matrix4d& clip_from_gl_eye,
                          const Eigen::Vector3d& point_in_world, const ImageSize& size,
                          ClipDepth clip_depth, PixelOrigin origin) {
   size.Check();
+  RequireFiniteAll(clip_from_gl_eye, "projection matrix");
+  RequireFiniteAll(gl_eye_from_world, "view matrix");
+  RequireFiniteAll(point_in_world, "point_in_world");
   const Eigen::Vector4d clip =
       clip_from_gl_eye * (gl_eye_from_world * point_in_world.homogeneous());
   Require(clip.w() > 0.0, "point is not in front of the camera: clip.w = ", clip.w());

@@ -205,6 +205,13 @@ Eigen::Vector3d CamRayFromPixel(const Intrinsics& intrinsics, const Eigen::Vecto
   // Undo K first: (xd, yd) are the distorted normalized coordinates.
   const double yd = (pixel.y() - intrinsics.cy) / intrinsics.fy;
   const double xd = (pixel.x() - intrinsics.cx - intrinsics.skew * yd) / intrinsics.fx;
+  // A finite pixel far from a finite principal point (cx = -1e308) is beyond a double.
+  if (!std::isfinite(xd) || !std::isfinite(yd)) {
+    internal::ThrowInvalidArgument("the ray of pixel (", pixel.x(), ", ", pixel.y(),
+                                   ") cannot be represented in a double (normalized ", xd, ", ", yd,
+                                   ") for fx = ", intrinsics.fx, ", fy = ", intrinsics.fy,
+                                   ", cx = ", intrinsics.cx, ", cy = ", intrinsics.cy);
+  }
   if (!intrinsics.HasDistortion()) return {xd, yd, 1.0};
 
   // Radial distortion scales the radius: rd = g(r) = r d(r), d = 1 + k1 r^2 + k2 r^4 + k3 r^6.

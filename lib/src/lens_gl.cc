@@ -72,8 +72,11 @@ std::ostringstream ExactStream() {
   return out;
 }
 
-// A GLSL float literal that reads back to the same float as the double rounds to.
-std::string GlslFloat(double value) {
+// A GLSL float literal that reads back to the same float as the double rounds to. Throws for a
+// value beyond float32's range (a literal above 3.4e38 is infinite in GLSL), naming it.
+std::string GlslFloat(double value, const char* name) {
+  Require(std::abs(value) <= std::numeric_limits<float>::max(), "GLSL constant ", name,
+          " = ", value, " is beyond float32's range (", std::numeric_limits<float>::max(), ")");
   auto out = ExactStream();
   out << value;
   std::string text = out.str();
@@ -81,9 +84,11 @@ std::string GlslFloat(double value) {
   return text;
 }
 
-std::string GlslMat4(const Eigen::Matrix4d& m) {
+std::string GlslMat4(const Eigen::Matrix4d& m, const char* name) {
   std::string text = "mat4(";
-  for (int i = 0; i < 16; ++i) text += (i ? ", " : "") + GlslFloat(m.data()[i]);  // column-major
+  for (int i = 0; i < 16; ++i) {
+    text += (i ? ", " : "") + GlslFloat(m.data()[i], name);  // column-major
+  }
   return text + ")";
 }
 
@@ -110,6 +115,13 @@ void RequireLensCoversImage(const Camera& camera) {
           "p1 = ", k.p1, ", p2 = ", k.p2, ", k3 = ", k.k3, " (calibrate without --tangential and "
           "--k3 for a lens GL can render, or warp with OpenCV's cv::remap from the opencv-yaml "
           "export)");
+  for (const Eigen::Vector2d& corner : OuterCorners(camera.image_size)) {
+    const double rd = DistortedNormalized(k, corner).stableNorm();
+    Require(rd < kLensMaxNormalizedRadius, "the image corner (", corner.x(), ", ", corner.y(),
+            ") is at normalized radius ", rd, " (fx = ", k.fx, ", fy = ", k.fy,
+            "): the image spans 180 degrees to within a double, which no lens rendering or "
+            "render target can hold");
+  }
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
   if (!std::isfinite(r_fold)) return;
   const double rd_fold = DistortedRadius(r_fold, k.k1, k.k2);
@@ -272,7 +284,18 @@ double LensMaxEdgePx(const Camera& camera, double error_px) {
 
 std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
   const double r_limit = LensRadiusLimit(camera);
+  // The coefficients first: a lens float32 cannot hold is refused as that, whatever follows.
+  const std::string k1_text = GlslFloat(camera.intrinsics.k1, "k1");
+  const std::string k2_text = GlslFloat(camera.intrinsics.k2, "k2");
   const double m = LensSecondDerivativePx(camera);
+  Require(std::isfinite(m), "the lens map's second derivative over the image is beyond a double "
+          "(k1 = ", camera.intrinsics.k1, ", k2 = ", camera.intrinsics.k2,
+          "): no tessellation bounds the per-vertex error");
+  // With a lens, r_limit^2 below float32's smallest normal would flush to 0 and leave every
+  // vertex undistorted (without one camproj_lens is the identity whatever the limit).
+  Require(m == 0.0 || r_limit * r_limit >= std::numeric_limits<float>::min(),
+          "the lens's radius limit squared ", r_limit * r_limit,
+          " is below float32's smallest normal number");
   const auto max_edge = [m](double error_px) {
     return m == 0.0 ? std::numeric_limits<double>::infinity() : std::sqrt(6.0 * error_px / m);
   };
@@ -314,11 +337,13 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
          "at or\n"
       << "// behind the eye plane (z_eye >= 0; eye.w > 0 assumed) are left alone: the near plane "
          "clips them.\n";
-  out << "const float camproj_k1 = " << GlslFloat(k.k1) << ";\n"
-      << "const float camproj_k2 = " << GlslFloat(k.k2) << ";\n"
-      << "const float camproj_r2_limit = " << GlslFloat(r_limit * r_limit) << ";\n"
-      << "const mat4 camproj_projection = " << GlslMat4(views.clip_from_gl_eye) << ";\n"
-      << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_world) << ";\n"
+  out << "const float camproj_k1 = " << k1_text << ";\n"
+      << "const float camproj_k2 = " << k2_text << ";\n"
+      << "const float camproj_r2_limit = " << GlslFloat(r_limit * r_limit, "r_limit^2") << ";\n"
+      << "const mat4 camproj_projection = "
+      << GlslMat4(views.clip_from_gl_eye, "a projection matrix entry") << ";\n"
+      << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_world, "a view matrix entry")
+      << ";\n"
       << "// gl_eye (x right, y up, looking down -z) is cam (x right, y down, z forward) with y "
          "and\n"
       << "// z negated: x = X/Z = x_eye / -z_eye, y = Y/Z = y_eye / z_eye. Only r^2 = x^2 + y^2 "

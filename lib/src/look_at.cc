@@ -45,6 +45,10 @@ LookAt LookAtFromCamFromWorld(const Rigid3& cam_from_world, double target_distan
   const Eigen::Vector3d gaze = cam_from_world.rotation.row(2).transpose();
   look_at.target = look_at.eye + target_distance * gaze;
   look_at.up = -cam_from_world.rotation.row(1).transpose();
+  // A finite translation of 1e308 can put the eye, or the target beyond it, past a double.
+  internal::RequireFiniteResult(look_at.eye, "the look-at eye of the pose");
+  internal::RequireFiniteResult(look_at.target, "the look-at target at distance ",
+                                target_distance);
   return look_at;
 }
 

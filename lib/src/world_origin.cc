@@ -26,17 +26,30 @@ Eigen::Vector3d RoundOrigin(const Eigen::Vector3d& center, double extent) {
   internal::RequireFiniteAll(center, "origin centre");
   internal::Require(std::isfinite(extent) && extent >= 0.0,
                     "origin extent must be finite and >= 0, got ", extent);
+  // Below 1e-290 the power of ten's reciprocal would not be finite (10^-k for k < -308): no
+  // rounding, the centre itself (a step this small shortens no decimal anyway).
+  if (extent > 0.0 && extent < 1e-290) return center + Eigen::Vector3d::Zero();  // + 0: no "-0"
   // step = 10^k, the largest power of ten <= extent; log10 may be off by one ulp at a power of
   // ten, so k is corrected against the exact powers (10^k is exact in a double for |k| <= 22).
   int k = extent > 0.0 ? static_cast<int>(std::floor(std::log10(extent))) : 0;
   while (k < 308 && std::pow(10.0, k + 1) <= extent) ++k;
-  while (k > -308 && std::pow(10.0, k) > extent && extent > 0.0) --k;
+  while (k > -290 && std::pow(10.0, k) > extent && extent > 0.0) --k;
+  const double step = std::pow(10.0, k);
   Eigen::Vector3d origin;
   for (int axis = 0; axis < 3; ++axis) {
+    // A coordinate 2^53 steps from 0 is already a multiple of the step to within its ulp, and
+    // scaling it by 10^-k could overflow (a camera at 1e10 with near 1e-300): kept as it is.
     // Dividing by 10^-k for k < 0 gives the double nearest to the decimal (0.03, not
     // 3 * 0.01 = 0.030000000000000002), which prints as users would type it.
-    origin[axis] = k >= 0 ? std::round(center[axis] / std::pow(10.0, k)) * std::pow(10.0, k)
-                          : std::round(center[axis] * std::pow(10.0, -k)) / std::pow(10.0, -k);
+    const double c = center[axis];
+    if (std::abs(c) >= 0x1p53 * step) {
+      origin[axis] = c;
+    } else {
+      origin[axis] = k >= 0 ? std::round(c / step) * step
+                            : std::round(c * std::pow(10.0, -k)) / std::pow(10.0, -k);
+      // Rounding up near the largest double (1.7e308 to a step of 1e308) can overflow.
+      if (!std::isfinite(origin[axis])) origin[axis] = c;
+    }
     origin[axis] += 0.0;  // no "-0"
   }
   return origin;

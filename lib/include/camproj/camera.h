@@ -45,7 +45,7 @@ struct Camera {
 struct CameraViews {
   LookAt look_at;                          // target at target_distance along the gaze
   std::optional<Frustum> frustum;          // absent when skew != 0 (no glFrustum form)
-  std::optional<Perspective> perspective;  // only when the frustum is symmetric
+  std::optional<Perspective> perspective;  // only where HasPerspectiveForm(*frustum)
   std::optional<Ortho> ortho;              // orthographic camera without skew: the glOrtho box
   Eigen::Matrix4d clip_from_gl_eye;        // projection matrix (pinhole part, skew included)
   Eigen::Matrix4d gl_eye_from_world;       // view matrix

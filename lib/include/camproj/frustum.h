@@ -67,10 +67,17 @@ inline constexpr double kSymmetryTolerance = 1e-9;
 // Throws on an invalid frustum (Frustum::Check).
 bool IsSymmetric(const Frustum& frustum);
 
+// Throws if the frustum cannot be represented in doubles (right - left overflows).
 Frustum FrustumFromPerspective(const Perspective& perspective);
 
+// Whether PerspectiveFromFrustum succeeds: the frustum is symmetric and its vertical field of view
+// is below 180 degrees in a double (one about 2e16 times taller than near rounds to 180). Throws
+// on an invalid frustum.
+bool HasPerspectiveForm(const Frustum& frustum);
+
 // Throws std::invalid_argument saying which side is off-centre (and by how much) unless
-// IsSymmetric(frustum): an off-axis frustum has no gluPerspective form.
+// IsSymmetric(frustum): an off-axis frustum has no gluPerspective form; nor has one whose field
+// of view rounds to 180 degrees.
 Perspective PerspectiveFromFrustum(const Frustum& frustum);
 
 // The frustum whose near-plane window maps exactly onto the image (see the file comment).

@@ -28,7 +28,10 @@ namespace camproj {
 // Throws std::invalid_argument unless `camera` is valid, perspective and its lens covers the
 // image: the largest distorted normalized radius of the 4 outer image corners (kCenter (-0.5,
 // -0.5) ... (W - 0.5, H - 0.5)) is below g(r_fold) = the distorted radius of RadialFoldRadius.
-// The message names k1, k2, the fold and the corner. A camera without distortion passes.
+// The message names k1, k2, the fold and the corner. A camera without distortion passes, unless
+// a corner's normalized radius is kLensMaxNormalizedRadius or more (fx = 1e-300 px: the image
+// spans 180 degrees to within a double, and the lens polynomial's r^4 overflows).
+inline constexpr double kLensMaxNormalizedRadius = 1e50;
 void RequireLensCoversImage(const Camera& camera);
 
 // The largest undistorted normalized radius r = |(X/Z, Y/Z)| the image sees (at an outer corner).

@@ -3,6 +3,7 @@
 #define CAMPROJ_NUMBER_TEXT_H_
 
 #include <charconv>
+#include <limits>
 #include <string>
 
 namespace camproj {
@@ -27,6 +28,15 @@ inline std::string GeneralDouble(double value, int significant_digits) {
                                           std::chars_format::general, significant_digits);
   (void)error;  // 64 bytes hold 17 digits, the sign, the point and the exponent
   return std::string(buffer, end);
+}
+
+// GeneralDouble of a non-negative bound, or "more than 1.8e+308" for +infinity: a bound beyond a
+// double (the float32 error of a camera float32 cannot hold at all) said in words, not "inf".
+inline std::string GeneralBound(double value, int significant_digits) {
+  if (value == std::numeric_limits<double>::infinity()) {
+    return "more than " + GeneralDouble(std::numeric_limits<double>::max(), 2);
+  }
+  return GeneralDouble(value, significant_digits);
 }
 
 }  // namespace camproj

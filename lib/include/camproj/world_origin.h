@@ -30,8 +30,9 @@ Eigen::Matrix4d GlEyeFromOriginWorld(const Rigid3& cam_from_world,
 // step = 10^floor(log10(extent)), the largest power of ten not above `extent` (step 1 when extent
 // is 0), so that the origin is a number users can type and lies within step * sqrt(3) / 2 of
 // `center`. Example: center (412345.67, 5612345.67, 123.4), extent 87 -> step 10 ->
-// (412350, 5612350, 120). Throws std::invalid_argument for a non-finite center or a negative or
-// non-finite extent.
+// (412350, 5612350, 120). A coordinate of 2^53 steps or more, or an extent below 1e-290, is kept
+// as it is (rounding would not shorten it, and 10^-k would overflow). Throws
+// std::invalid_argument for a non-finite center or a negative or non-finite extent.
 Eigen::Vector3d RoundOrigin(const Eigen::Vector3d& center, double extent);
 
 // `camproj fit --origin auto`: the points' centroid rounded by RoundOrigin with extent = the
