@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 namespace camproj {
@@ -87,6 +88,24 @@ TEST(CameraTest, DepthRangeRefusesABoxBehindTheCameraAndBadBoxes) {
   EXPECT_THROW(DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, 1, NAN}}), std::invalid_argument);
   EXPECT_THROW(DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, 1, 3}}, -0.1),
                std::invalid_argument);
+  // A NaN pose was "entirely behind the camera (depth nan)"; now the pose's own message.
+  Rigid3 nan_pose;
+  nan_pose.rotation(0, 0) = NAN;
+  EXPECT_THAT([&] { DepthRangeCoveringBox(nan_pose, BoxInWorld{{0, 0, 2}, {1, 1, 3}}); },
+              ::testing::ThrowsMessage<std::invalid_argument>(
+                  ::testing::HasSubstr("rotation must be finite")));
+  // Ranges beyond a double: far = inf for a margin of 1e308, near underflowing to 0, a corner
+  // whose depth overflows. Each was returned as it came out.
+  const auto beyond = ::testing::ThrowsMessage<std::invalid_argument>(
+      ::testing::HasSubstr("cannot be represented in a double"));
+  EXPECT_THAT([] { DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 2}, {1, 1, 3}}, 1e308); },
+              beyond);
+  EXPECT_THAT([] { DepthRangeCoveringBox(Rigid3{}, BoxInWorld{{0, 0, 1e-320}, {1, 1, 3}}, 1e10); },
+              beyond);
+  Rigid3 far_pose;
+  far_pose.translation = {0.0, 0.0, 1e308};
+  EXPECT_THAT([&] { DepthRangeCoveringBox(far_pose, BoxInWorld{{0, 0, 0}, {1, 1, 1e308}}); },
+              beyond);
 }
 
 }  // namespace

@@ -116,12 +116,16 @@ Eigen::Vector3d BoxInWorld::Corner(int index) const {
 
 DepthRangeOfBox DepthRangeCoveringBox(const Rigid3& cam_from_world, const BoxInWorld& box,
                                       double depth_margin) {
+  cam_from_world.Check();
   box.Check();
   internal::Require(std::isfinite(depth_margin) && depth_margin >= 0.0,
                     "depth margin must be >= 0, got ", depth_margin);
   DepthRangeOfBox range;
   for (int i = 0; i < 8; ++i) {
     const double depth = (cam_from_world * box.Corner(i)).z();
+    internal::Require(std::isfinite(depth), "the depth of the box's corner (",
+                      box.Corner(i).transpose(), ") cannot be represented in a double (", depth,
+                      ")");
     if (i == 0 || depth < range.min_depth) {
       range.min_depth = depth;
       range.nearest_corner = i;
@@ -134,6 +138,11 @@ DepthRangeOfBox DepthRangeCoveringBox(const Rigid3& cam_from_world, const BoxInW
                     range.max_depth, ")");
   if (range.min_depth > 0.0) range.z_near = range.min_depth / (1.0 + depth_margin);
   range.z_far = range.max_depth * (1.0 + depth_margin);
+  // A margin of 1e308 overflows far and can underflow near to 0: no plane pair to give.
+  internal::Require(std::isfinite(range.z_far) && (!range.z_near || *range.z_near > 0.0),
+                    "the depth range covering the box cannot be represented in a double (depths ",
+                    range.min_depth, " to ", range.max_depth, ", margin ", depth_margin,
+                    ": near ", range.z_near.value_or(0.0), ", far ", range.z_far, ")");
   return range;
 }
 

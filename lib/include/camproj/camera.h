@@ -99,8 +99,8 @@ struct DepthRangeOfBox {
 };
 
 // The range for `box` seen by a camera at `cam_from_world`. Throws std::invalid_argument when the
-// whole box is behind the camera (max depth <= 0), naming the depth, or for an invalid box or
-// depth_margin < 0.
+// whole box is behind the camera (max depth <= 0), naming the depth, for an invalid pose, box or
+// depth_margin < 0, or when a depth or the range is beyond a double (a margin of 1e308).
 DepthRangeOfBox DepthRangeCoveringBox(const Rigid3& cam_from_world, const BoxInWorld& box,
                                       double depth_margin = 0.1);
 
