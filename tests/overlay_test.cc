@@ -165,6 +165,30 @@ TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
   EXPECT_NEAR(picture.stats.labels[0].residual_px, 268435956.0 - 300.0, 1.0);
 }
 
+// A point in front of the camera whose pixel is beyond a double (x / z = 1e308 / 1e-10) has no
+// reprojection like a point behind, but is counted and labelled as what it is (it was counted
+// "behind the camera" before).
+TEST(OverlayTest, APointInFrontWithAPixelBeyondADoubleIsNotCalledBehind) {
+  Camera camera;
+  camera.image_size = {1000, 800};
+  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
+  camera.intrinsics.cx = 499.5;
+  camera.intrinsics.cy = 399.5;
+  camera.z_near = 1e-12;
+  camera.z_far = 10.0;
+  Correspondences points;
+  points.points_in_world = {{1e308, 0.0, 1e-10}, {0.0, 0.0, -1.0}, {0.1, 0.1, 2.0}};
+  points.pixels = {{300.0, 399.5}, {400.0, 399.5}, {550.0, 450.0}};
+  points.ids = {"beyond", "behind", "a"};
+  const OverlayPicture picture = DrawOverlayImage(camera, points, {}, ImageFormat::kPng);
+  EXPECT_EQ(picture.stats.no_pixel, 1);
+  EXPECT_EQ(picture.stats.behind, 1);
+  EXPECT_EQ(picture.stats.drawn, 1);
+  EXPECT_EQ(picture.stats.labels[0].kind, "no-pixel");
+  EXPECT_EQ(picture.stats.labels[0].residual_px, -1.0);
+  EXPECT_EQ(picture.stats.labels[1].kind, "behind");
+}
+
 // A JPEG background cut short is refused (libjpeg decoded it with a warning and garbage below
 // the cut, exit 0, before session 37); baseline, progressive and restart-interval JPEGs, and one
 // with data after its end (a phone's motion photo), are drawn on.

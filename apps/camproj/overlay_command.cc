@@ -89,6 +89,9 @@ Command AddOverlayCommand(CLI::App& root) {
             std::cout << "wrote " << args->output_path << " (" << stats.drawn << " points";
             if (stats.outliers > 0) std::cout << ", " << stats.outliers << " outliers";
             if (stats.behind > 0) std::cout << ", " << stats.behind << " behind the camera";
+            if (stats.no_pixel > 0) {
+              std::cout << ", " << stats.no_pixel << " in front with a pixel beyond a double";
+            }
             if (stats.outside > 0) std::cout << ", " << stats.outside << " outside the image";
             std::cout << "; residuals x " << stats.magnify << ")\n";
             return kExitOk;

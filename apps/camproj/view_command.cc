@@ -76,6 +76,9 @@ Command AddViewCommand(CLI::App& root) {
             std::cout << "wrote " << args->output_path << " (" << stats.points << " points";
             if (stats.outliers > 0) std::cout << ", " << stats.outliers << " outliers";
             if (stats.behind > 0) std::cout << ", " << stats.behind << " behind the camera";
+            if (stats.no_pixel > 0) {
+              std::cout << ", " << stats.no_pixel << " in front with a pixel beyond a double";
+            }
             if (stats.outside_image > 0) {
               std::cout << ", " << stats.outside_image << " outside the image";
             }

@@ -276,6 +276,10 @@ Box DrawLegend(cv::Mat& image, const OverlayStats& stats, const std::vector<Eige
   if (stats.behind > 0) {
     lines.push_back(std::to_string(stats.behind) + " behind the camera (no reprojection)");
   }
+  if (stats.no_pixel > 0) {
+    lines.push_back(std::to_string(stats.no_pixel) +
+                    " in front, pixel beyond a double (no reprojection)");
+  }
   int baseline = 0;
   const int line_height =
       cv::getTextSize("Ag", cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline)
@@ -380,9 +384,12 @@ std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Corresponden
     const Eigen::Vector2d& observed = correspondences.pixels[i];
     point.anchor = observed;
     if (!point.predicted) {
-      point.kind = "behind";
+      // PixelFromWorld has no pixel behind the camera, nor for a point in front whose pixel
+      // would be beyond a double: told apart by the depth.
+      const bool in_front = (camera.cam_from_world * correspondences.points_in_world[i]).z() > 0.0;
+      point.kind = in_front ? "no-pixel" : "behind";
       point.colour = kBehindColour;
-      ++stats.behind;
+      ++(in_front ? stats.no_pixel : stats.behind);
     } else if (outlier[i]) {
       point.kind = "outlier";
       point.colour = kOutlierColour;
@@ -437,6 +444,7 @@ std::string LabelText(const OverlayPoint& point, const std::string& id,
   }
   if (point.kind == "outlier") text += " (" + FormatPx(point.residual_px) + " px off)";
   if (point.kind == "behind") text += " (behind)";
+  if (point.kind == "no-pixel") text += " (no pixel)";
   if (point.kind == "outside") {
     char at[64];
     std::snprintf(at, sizeof at, " (at %.0f, %.0f)", observed.x(), observed.y());

@@ -109,7 +109,7 @@ json PointJson(const Camera& camera, const Correspondences& correspondences, siz
   if (!predicted) {
     point["predicted_px"] = nullptr;
     point["residual_px"] = nullptr;
-    ++stats.behind;
+    ++(depth > 0.0 ? stats.no_pixel : stats.behind);  // in front: its pixel is beyond a double
     return point;
   }
   // The pinhole's pixel is finite where the lens's is (a lens that overflows has none).

@@ -36,15 +36,18 @@ struct OverlayOptions {
 // Where an id was written, for a reader of the picture (`camproj overlay --labels`) and tests.
 struct OverlayLabel {
   std::string id;
-  std::string kind;          // "point" | "outlier" | "outside" (arrow at the border) | "behind"
+  // "point" | "outlier" | "outside" (arrow at the border) | "behind" | "no-pixel" (in front, but
+  // its pixel is beyond a double: PixelFromWorld gives none)
+  std::string kind;
   Eigen::Vector2d anchor;    // the marker the label belongs to, kCenter px
   Eigen::Vector4d box;       // the text's box: left, top, width, height in image px
-  double residual_px = -1;   // |reprojected - observed|; -1 behind the camera
+  double residual_px = -1;   // |reprojected - observed|; -1 behind the camera or no pixel
 };
 
 struct OverlayStats {
   int drawn = 0;     // points the fit kept that are in front of the camera (outside ones included)
   int behind = 0;    // points behind the camera (ring and id, no reprojection)
+  int no_pixel = 0;  // points in front whose pixel is beyond a double (ring and id, likewise)
   int outliers = 0;  // points drawn as outliers
   int outside = 0;   // observed pixels outside the image (arrows at the border)
   double magnify = 0.0;             // the magnification used

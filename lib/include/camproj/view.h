@@ -38,6 +38,7 @@ struct ViewOptions {
 struct ViewStats {
   int points = 0;          // points drawn
   int behind = 0;          // points not in front of the camera (drawn, without a residual)
+  int no_pixel = 0;        // points in front whose pixel is beyond a double (likewise)
   int outliers = 0;        // points the fit left out (the camera file's fit.outliers)
   int outside_image = 0;   // points whose projection falls outside the image
   int mesh_triangles = 0;
