@@ -89,6 +89,17 @@ def test_frustum_perspective_round_trip():
         camproj.perspective_from_frustum(frustum)  # off-axis: no gluPerspective form
 
 
+def test_conversions_beyond_a_double_raise_instead_of_returning_inf():
+    # Each argument passes its own check; the result does not fit in a double.
+    with pytest.raises(ValueError, match="cannot be represented in a double"):
+        camproj.gl_projection_from_frustum(camproj.Frustum(-1, 1, -1, 1, 1e308, math.inf))
+    with pytest.raises(ValueError, match="cannot be represented in a double"):
+        camproj.gl_projection_from_perspective(camproj.Perspective(fovy_deg=1e-320, aspect=1.0,
+                                                                   near=1.0, far=10.0))
+    with pytest.raises(ValueError, match="look-at target"):
+        camproj.look_at_from_cam_from_world(np.eye(3), [0.0, 0.0, -1.5e308], 1e308)
+
+
 def test_project_matches_cv2_project_points():
     R, t = pose()
     k1, k2 = -0.12, 0.031
