@@ -323,6 +323,16 @@ PY
     expect_exit 1 "$bin" fit "$local_points" --image-size 640x480 --intrinsics "$truth"
     expect_in err "usage: --intrinsics .*truth.json is for a 1920x1080 image, but --image-size is 640x480"
     expect_exit 0 "$bin" fit "$local_points" --image-size 1920x1080 --intrinsics "$truth" --model pose
+    # An intrinsic both freed and fixed was fixed silently, the later option winning (session 40).
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --free aspect --aspect 1.01 -o "$work/c.json"
+    expect_in err "usage: aspect is both freed (--free aspect) and fixed (--aspect 1.01): give one"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --model focal+k1 --fix k1 -o "$work/c.json"
+    expect_in err "usage: k1 is both freed (--model focal+k1) and fixed (--fix k1): give one"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --model focal+aspect --fovy 40 -o "$work/c.json"
+    expect_in err "usage: focal is both freed (--model focal+aspect) and fixed (--fovy 40): give one"
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --free aspect --fovy 40 -o "$work/c.json"
+    expect_in err "usage: aspect is both freed (--free aspect) and fixed (--fovy 40): give one"
+    [[ ! -e "$work/c.json" ]] || fail "a refused option left a file"
     expect_exit 1 "$bin" convert --frustum -0.05,0.05,-0.05,0.05,0.1,1 --image-size 100x100 --to gl --near 5
     expect_in err "usage: --skew, --near and --far go with --intrinsics"
     expect_exit 1 "$bin" fit "$local_points" --image-size 2000000x1000
@@ -1298,9 +1308,9 @@ PY
     expect_in out "^calibrated 13 views, 702 points: rms 0.4"
     expect_not_in out "^model"
     expect_not_in out "^left out point"
-    expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model k2 -o "$work/bad.json"
+    expect_exit 1 "$bin" calibrate "$work/right" --image-size 640x480 --model k2 -o "$work/bad.json"
     expect_in err "--model k2: k2 needs k1 too"
-    expect_exit 2 "$bin" calibrate "$work/right" --image-size 640x480 --model opencv --fix k3 -o "$work/bad.json"
+    expect_exit 1 "$bin" calibrate "$work/right" --image-size 640x480 --model opencv --fix k3 -o "$work/bad.json"
     expect_in err "--model opencv --fix k3: k3 is both freed and fixed"
     # A view named by a file name with a comma and a quote: its poses row is quoted (RFC 4180),
     # 22 fields like every other (23 before session 37).

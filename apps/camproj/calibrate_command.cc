@@ -32,14 +32,15 @@ struct CalibrateArgs {
   std::string pixel_origin = "center";
 };
 
-// The model --model and --fix ask for (CalibrateOptionsForModel); a bad one names both flags.
+// The model --model and --fix ask for (CalibrateOptionsForModel); a bad one is a usage error
+// (exit 1, as for `fit --model`) naming both flags.
 CalibrateOptions ModelOptions(const std::string& model, const std::vector<std::string>& fix) {
   try {
     return CalibrateOptionsForModel(model, fix);
   } catch (const std::invalid_argument& e) {
     std::string flags = "--model " + model;
     for (size_t i = 0; i < fix.size(); ++i) flags += (i == 0 ? " --fix " : ",") + fix[i];
-    throw std::invalid_argument(flags + ": " + e.what());
+    throw UsageError(flags + ": " + e.what());
   }
 }
 

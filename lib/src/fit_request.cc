@@ -129,6 +129,41 @@ void SetModel(const FitArguments& args, const ImageSize& size, FitOptions* optio
   }
 }
 
+// A name both freed (--free, or listed in --model) and fixed (--fix, or a value such as
+// --aspect 1.01) would be fixed silently, the later option winning: refuse it instead.
+void RefuseFreedAndFixed(const FitArguments& args) {
+  std::vector<std::pair<std::string, std::string>> freed;  // (name, the option that frees it)
+  for (const std::string& name : args.free) freed.emplace_back(name, "--free " + name);
+  if (args.model != "auto" && args.model.rfind("orthographic", 0) != 0) {
+    for (const std::string& name : ModelNames(args.model)) freed.emplace_back(name, "--model " + args.model);
+  }
+  const auto number = [](double value) {
+    char text[32];
+    return std::string(text, std::to_chars(text, text + sizeof(text), value).ptr);
+  };
+  std::vector<std::pair<std::string, std::string>> fixed;  // (name, the option that fixes it)
+  for (const std::string& name : args.fix) fixed.emplace_back(name, "--fix " + name);
+  if (args.focal > 0.0) fixed.emplace_back("focal", "--focal " + number(args.focal));
+  if (args.fovy_deg > 0.0) {
+    fixed.emplace_back("focal", "--fovy " + number(args.fovy_deg));
+    // fovy fixes fx = fy / aspect at aspect 1 (or --aspect): a free aspect would be dropped.
+    fixed.emplace_back("aspect", "--fovy " + number(args.fovy_deg));
+  }
+  if (args.aspect > 0.0) fixed.emplace_back("aspect", "--aspect " + number(args.aspect));
+  if (args.principal_point) fixed.emplace_back("principal-point", "--principal-point");
+  if (!std::isnan(args.skew)) fixed.emplace_back("skew", "--skew " + number(args.skew));
+  if (!std::isnan(args.k1)) fixed.emplace_back("k1", "--k1 " + number(args.k1));
+  if (!std::isnan(args.k2)) fixed.emplace_back("k2", "--k2 " + number(args.k2));
+  for (const auto& [name, freed_by] : freed) {
+    for (const auto& [fixed_name, fixed_by] : fixed) {
+      if (name == fixed_name) {
+        throw std::invalid_argument(name + " is both freed (" + freed_by + ") and fixed (" + fixed_by +
+                                    "): give one");
+      }
+    }
+  }
+}
+
 // --free, --fix and the intrinsics' values (--focal, --fovy, --aspect, --principal-point, --skew,
 // --k1, --k2, --intrinsics) over the model's modes. `automatic`: the default path (a --fix then
 // fixes at the default value, as the ladder would).
@@ -167,6 +202,7 @@ void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool au
           "size in a file of its own)");
     }
   }
+  RefuseFreedAndFixed(args);
   for (const std::string& name : args.free) *ModeOf(options, name) = ParameterMode::Free();
   for (const std::string& name : args.fix) {
     if (name == "focal") {

@@ -50,6 +50,9 @@ def clicks(data_dir):
     ({"keep_all": "no"}, TypeError, "keep_all: expected True or False, got 'no' (str)"),
     ({"model": 3}, TypeError, "model: expected a string, got 3 (int)"),
     ({"origin": "centre"}, ValueError, "origin: expected \"auto\" or 3 numbers X, Y, Z, got 'centre' (str)"),
+    # An intrinsic both freed and fixed is refused (the later option won before session 40).
+    ({"free": ["aspect"], "aspect": 1.01}, ValueError, "aspect is both freed (--free aspect) and fixed (--aspect 1.01): give one"),
+    ({"model": "focal+k1", "fix": "k1"}, ValueError, "k1 is both freed (--model focal+k1) and fixed (--fix k1): give one"),
     # A misspelled option is refused even with the value None.
     ({"modle": None}, ValueError, 'fit: unknown option "modle"'),
 ])
