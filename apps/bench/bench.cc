@@ -83,7 +83,7 @@ const char* kUsage =
     "Usage: bench [--quick] [--out DIR] [--scenes-scale X] [--mapamok-literal-focal]\n"
     "\n"
     "Fits the same seeded synthetic scenes (camproj::SynthesizeScene: 1920x1080, fovy 45 deg;\n"
-    "N in {6,10,30,100,1000,10000} points, noise 0, 0.5, 2 px; a point cloud and a plane; a\n"
+    "N in {6,10,20,30,100,1000,10000} points, noise 0, 0.5, 2 px; a point cloud and a plane; a\n"
     "centred camera and a projector with its principal point at the bottom edge) with every\n"
     "method, and writes per method and cell the median and 90th-percentile wall time per fit,\n"
     "median RMS, focal, rotation and camera-centre errors, failure rate and the ratio of the\n"

@@ -245,7 +245,7 @@ Command AddExportCommand(CLI::App& root) {
       "  opencv-yaml  cv::FileStorage YAML: camera_matrix, distortion_coefficients, rvec, tvec\n"
       "  colmap       cameras.txt and images.txt lines (COLMAP's corner pixel convention)\n"
       "  three        JSON for a three.js PerspectiveCamera (projectionMatrix, matrixWorld)\n"
-      "  json         the camera file itself\n"
+      "  json         the camera file rewritten, without its fit record\n"
       "  glsl         GLSL rendering the lens (k1, k2) per vertex: camproj_lens(), matrices\n"
       "  distortion-mesh  JSON (or -o MESH.obj: OBJ) mesh warping a pinhole render target onto\n"
       "               the image (--mesh-step)\n"

@@ -112,9 +112,9 @@ void RequireLensCoversImage(const Camera& camera) {
           "an orthographic camera has no lens distortion to render");
   const Intrinsics& k = camera.intrinsics;
   Require(!k.HasBeyondTwoRadial(), "the GL lens renders radial k1, k2 only; this camera also has "
-          "p1 = ", k.p1, ", p2 = ", k.p2, ", k3 = ", k.k3, " (calibrate without --tangential and "
-          "--k3 for a lens GL can render, or warp with OpenCV's cv::remap from the opencv-yaml "
-          "export)");
+          "p1 = ", k.p1, ", p2 = ", k.p2, ", k3 = ", k.k3, " (calibrate with --fix tangential,k3 "
+          "or a --model without tangential and k3 for a lens GL can render, or warp with "
+          "OpenCV's cv::remap from the opencv-yaml export)");
   for (const Eigen::Vector2d& corner : OuterCorners(camera.image_size)) {
     const double rd = DistortedNormalized(k, corner).stableNorm();
     Require(rd < kLensMaxNormalizedRadius, "the image corner (", corner.x(), ", ", corner.y(),

@@ -9,11 +9,11 @@
 //                same numbers (glm's 16-scalar constructor takes column 0 first), with the upload
 //                call and the depth state (glClipControl, glDepthFunc) in comments.
 //   opencv-yaml  a cv::FileStorage YAML file: image_width, image_height, camera_matrix (3x3),
-//                distortion_coefficients (1x5: k1 k2 0 0 0), rvec and tvec (3x1: cam_from_world
+//                distortion_coefficients (1x5: k1 k2 p1 p2 k3), rvec and tvec (3x1: cam_from_world
 //                as cv::solvePnP returns it, rvec = Rodrigues vector of R) and R (3x3). cx, cy in
 //                OpenCV's kCenter origin.
-//   colmap       the lines of a COLMAP text model: cameras.txt (PINHOLE, or OPENCV when k1 or k2
-//                is set; cx, cy in COLMAP's kCorner origin), images.txt (QW QX QY QZ TX TY TZ of
+//   colmap       the lines of a COLMAP text model: cameras.txt (PINHOLE; OPENCV when k1, k2, p1 or p2
+//                is set; FULL_OPENCV when k3 is; cx, cy in COLMAP's kCorner origin), images.txt (QW QX QY QZ TX TY TZ of
 //                cam_from_world, then the empty POINTS2D line) and an empty points3D.txt, each
 //                section opened by a "# ==> FILE <==" line.
 //   three        a JSON object for a three.js PerspectiveCamera: projectionMatrix and matrixWorld

@@ -12,8 +12,9 @@
 // Criterion (geometric AIC, Kanatani; the 3D points are exact, so it is J / sigma^2 + 2 p):
 //   AIC = J / sigma^2 + 2 p,   BIC = J / sigma^2 + p ln(2 N),
 // J the sum of squared reprojection errors (px^2), p the number of parameters (pose 6 + free
-// intrinsics), sigma the pixel noise: given, or estimated as sqrt(J / (2N - p)) from the richest
-// model the scene supports, floored at kMinNoisePx. Details: docs/model-selection.md.
+// intrinsics), sigma the pixel noise: given, or the prior combined with the residuals of the
+// richest model the scene supports, sqrt((prior_weight prior_sigma_px^2 + J) / (prior_weight +
+// 2N - p)), floored at kMinNoisePx (AutoFitOptions). Details: docs/model-selection.md.
 #ifndef CAMPROJ_MODEL_SELECT_H_
 #define CAMPROJ_MODEL_SELECT_H_
 
