@@ -506,7 +506,7 @@ PY
     px=$(cat "$work/lens.json.px")
     for to in gl glm three; do
       expect_exit 0 "$bin" export "$work/lens.json" --to "$to" --quiet
-      expect_in out "k1 = -0.14999999999999999, k2 = 0.02 are not in the projection matrix .*up to $px px (worst image corner)"
+      expect_in out "k1 = -0.15, k2 = 0.02 are not in the projection matrix .*up to $px px (worst image corner)"
       expect_in err "^camproj: warning: k1 = -0.15, k2 = 0.02: the $to export's projection matrix is the pinhole part only and puts points up to $px px (worst image corner)"
     done
     expect_exit 0 "$bin" export "$work/lens.json" --to opencv-yaml

@@ -416,7 +416,7 @@ TEST(LensGlTest, LensesBeyondFloatOrDoubleAreRefusedNotWrittenAsInfOrNull) {
   // k1 = 1e300 passes the camera's checks; a GLSL float literal above 3.4e38 is infinite.
   EXPECT_THAT([] { LensGlslText(TestCamera(1e300, 0.0)); },
               ::testing::ThrowsMessage<std::invalid_argument>(
-                  HasSubstr("k1 = 1.0000000000000001e+300 is beyond float32's range")));
+                  HasSubstr("k1 = 1e+300 is beyond float32's range")));
   EXPECT_NO_THROW(LensGlslText(TestCamera(1e38, 0.0)));
   Camera pinhole = TestCamera(0.0, 0.0);
   pinhole.intrinsics.fx = pinhole.intrinsics.fy = 1e300;  // 2 fx / W = 1.9e298

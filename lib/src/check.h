@@ -2,6 +2,7 @@
 #ifndef CAMPROJ_SRC_CHECK_H_
 #define CAMPROJ_SRC_CHECK_H_
 
+#include <charconv>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -12,11 +13,26 @@
 namespace camproj {
 namespace internal {
 
+// A value as a message shows it; a double in its shortest form that reads back to the same
+// double (-0.15, not max_digits10's -0.14999999999999999).
+template <typename T>
+void AppendToMessage(std::ostringstream& out, const T& value) {
+  out << value;
+}
+inline void AppendToMessage(std::ostringstream& out, double value) {
+  char text[32];
+  out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
+}
+inline void AppendToMessage(std::ostringstream& out, float value) {
+  char text[32];
+  out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
+}
+
 template <typename... Args>
 std::string Concat(const Args&... args) {
   std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);
-  (out << ... << args);
+  out << std::setprecision(std::numeric_limits<double>::max_digits10);  // Eigen's matrices
+  (AppendToMessage(out, args), ...);
   return out.str();
 }
 
