@@ -4,21 +4,18 @@
 
 #include <charconv>
 #include <cmath>
-#include <iomanip>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+
+#include <Eigen/Core>
 
 namespace camproj {
 namespace internal {
 
 // A value as a message shows it; a double in its shortest form that reads back to the same
 // double (-0.15, not max_digits10's -0.14999999999999999).
-template <typename T>
-void AppendToMessage(std::ostringstream& out, const T& value) {
-  out << value;
-}
 inline void AppendToMessage(std::ostringstream& out, double value) {
   char text[32];
   out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
@@ -27,11 +24,26 @@ inline void AppendToMessage(std::ostringstream& out, float value) {
   char text[32];
   out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
 }
+// An Eigen vector or matrix: its entries so, one space apart, rows separated by "; " (Eigen's
+// own << pads every entry to the widest, "(1e-07                      0                      1)").
+template <typename T>
+void AppendToMessage(std::ostringstream& out, const T& value) {
+  if constexpr (std::is_base_of_v<Eigen::MatrixBase<T>, T>) {
+    for (Eigen::Index i = 0; i < value.rows(); ++i) {
+      if (i > 0) out << "; ";
+      for (Eigen::Index j = 0; j < value.cols(); ++j) {
+        if (j > 0) out << ' ';
+        AppendToMessage(out, static_cast<double>(value(i, j)));
+      }
+    }
+  } else {
+    out << value;
+  }
+}
 
 template <typename... Args>
 std::string Concat(const Args&... args) {
   std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);  // Eigen's matrices
   (AppendToMessage(out, args), ...);
   return out.str();
 }
