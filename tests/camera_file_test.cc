@@ -276,7 +276,14 @@ TEST(CameraFileTest, MalformedWorldOriginNamesTheKey) {
             std::string::npos);
   EXPECT_NE(ExpectInputError(prefix + "\"auto\"}").find("world_origin: expected an array"),
             std::string::npos);
-  EXPECT_NE(ExpectInputError(prefix + "[1, 2, 1e400]}").find("cam.json"), std::string::npos);
+  EXPECT_NE(ExpectInputError(prefix + "[1, 2, 1e400]}").find("cam.json: line 3: the number 1e400 is out of the range of a double"),
+            std::string::npos);
+  // One too small for a double read as 0 (fx 1e-400 was refused as "fx must be positive, got 0",
+  // a world origin 1e-400 taken as 0); a subnormal one is a double and reads as itself.
+  EXPECT_NE(ExpectInputError(prefix + "[1, 2,\n -1E-400]}")
+                .find("cam.json: line 4: the number -1E-400 is out of the range of a double (too small: it would read as 0)"),
+            std::string::npos);
+  EXPECT_EQ(CameraFromJsonText(prefix + "[1e-310, 0e-500, -0.0]}", "cam.json").world_origin->x(), 1e-310);
   // Finite, but C - origin overflows a double: refused when read, naming the key (every number
   // the file derives must be finite).
   EXPECT_NE(ExpectInputError(R"({"image_size": [640, 480], "intrinsics": {"fx": 500, "fy": 500, "cx": 1, "cy": 2},

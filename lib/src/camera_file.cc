@@ -1,9 +1,12 @@
 #include "camproj/camera_file.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -145,7 +148,8 @@ Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
   return ConvertPixelOrigin(intrinsics, origin, PixelOrigin::kCenter);
 }
 
-// Throws InputError if arrays and objects nest deeper than kMaxJsonDepth anywhere in `text`.
+// Throws InputError if arrays and objects nest deeper than kMaxJsonDepth anywhere in `text`, or
+// a number is beyond a double's range (naming its line, which the parser's message does not).
 // Runs before the parser, so nothing recursive ever sees a deeper document: a linear scan that
 // skips strings (a bracket inside a string does not nest).
 void RequireShallowJson(const std::string& text, const std::string& source) {
@@ -170,6 +174,19 @@ void RequireShallowJson(const std::string& text, const std::string& source) {
       }
     } else if (c == ']' || c == '}') {
       --depth;
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+      // A number the parser would read as 0 (1e-400) or refuse without a line (1e400).
+      size_t end = i;
+      while (end < text.size() && std::strchr("0123456789+-.eE", text[end]) != nullptr) ++end;
+      double value = 0.0;
+      if (std::from_chars(text.data() + i, text.data() + end, value).ec == std::errc::result_out_of_range) {
+        const std::string number = text.substr(i, end - i);
+        const size_t exponent = number.find_first_of("eE");
+        const bool tiny = exponent != std::string::npos && number[exponent + 1] == '-';
+        throw InputError(source + ": line " + std::to_string(line) + ": the number " + number +
+                         " is out of the range of a double" + (tiny ? " (too small: it would read as 0)" : ""));
+      }
+      i = end - 1;
     }
   }
 }
