@@ -11,29 +11,28 @@
 
 #include <Eigen/Core>
 
+#include "camproj/number_text.h"
+
 namespace camproj {
 namespace internal {
 
-// A value as a message shows it; a double in its shortest form that reads back to the same
-// double (-0.15, not max_digits10's -0.14999999999999999).
-inline void AppendToMessage(std::ostringstream& out, double value) {
-  char text[32];
-  out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
-}
-inline void AppendToMessage(std::ostringstream& out, float value) {
-  char text[32];
-  out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
-}
-// An Eigen vector or matrix: its entries so, one space apart, rows separated by "; " (Eigen's
-// own << pads every entry to the widest, "(1e-07                      0                      1)").
+// A value as a message shows it: a double (or float) in its shortest form that reads back to
+// the same value (-0.15, not max_digits10's -0.14999999999999999); an Eigen vector or matrix
+// entry by entry, one space apart, rows separated by "; " (Eigen's own << pads every entry to
+// the widest, "(1e-07                      0                      1)").
 template <typename T>
 void AppendToMessage(std::ostringstream& out, const T& value) {
-  if constexpr (std::is_base_of_v<Eigen::MatrixBase<T>, T>) {
+  if constexpr (std::is_same_v<T, double>) {
+    out << ShortestDouble(value);
+  } else if constexpr (std::is_same_v<T, float>) {
+    char text[16];  // any float's shortest form
+    out.write(text, std::to_chars(text, text + sizeof(text), value).ptr - text);
+  } else if constexpr (std::is_base_of_v<Eigen::MatrixBase<T>, T>) {
     for (Eigen::Index i = 0; i < value.rows(); ++i) {
       if (i > 0) out << "; ";
       for (Eigen::Index j = 0; j < value.cols(); ++j) {
         if (j > 0) out << ' ';
-        AppendToMessage(out, static_cast<double>(value(i, j)));
+        out << ShortestDouble(static_cast<double>(value(i, j)));
       }
     }
   } else {

@@ -12,6 +12,7 @@
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/fit_report.h"
+#include "camproj/number_text.h"
 #include "camproj/world_origin.h"
 #include "check.h"
 #include "view/obj_mesh.h"
@@ -129,6 +130,29 @@ void SetModel(const FitArguments& args, const ImageSize& size, FitOptions* optio
   }
 }
 
+// An intrinsic given a value by an option: --focal PX, --fovy DEG (which fixes the focal length
+// and the aspect: fx = fy / aspect at aspect 1 or --aspect), --aspect, --principal-point,
+// --skew, --k1, --k2.
+struct GivenValue {
+  std::string name;    // the intrinsic, as --free and --fix name it
+  std::string option;  // "--focal"
+  std::string value;   // "1500"; empty for --principal-point
+};
+std::vector<GivenValue> GivenValues(const FitArguments& args) {
+  std::vector<GivenValue> given;
+  if (args.focal > 0.0) given.push_back({"focal", "--focal", ShortestDouble(args.focal)});
+  if (args.fovy_deg > 0.0) {
+    given.push_back({"focal", "--fovy", ShortestDouble(args.fovy_deg)});
+    given.push_back({"aspect", "--fovy", ShortestDouble(args.fovy_deg)});
+  }
+  if (args.aspect > 0.0) given.push_back({"aspect", "--aspect", ShortestDouble(args.aspect)});
+  if (args.principal_point) given.push_back({"principal-point", "--principal-point", ""});
+  if (!std::isnan(args.skew)) given.push_back({"skew", "--skew", ShortestDouble(args.skew)});
+  if (!std::isnan(args.k1)) given.push_back({"k1", "--k1", ShortestDouble(args.k1)});
+  if (!std::isnan(args.k2)) given.push_back({"k2", "--k2", ShortestDouble(args.k2)});
+  return given;
+}
+
 // A name both freed (--free, or listed in --model) and fixed (--fix, or a value such as
 // --aspect 1.01) would be fixed silently, the later option winning: refuse it instead.
 void RefuseFreedAndFixed(const FitArguments& args) {
@@ -137,23 +161,11 @@ void RefuseFreedAndFixed(const FitArguments& args) {
   if (args.model != "auto" && args.model.rfind("orthographic", 0) != 0) {
     for (const std::string& name : ModelNames(args.model)) freed.emplace_back(name, "--model " + args.model);
   }
-  const auto number = [](double value) {
-    char text[32];
-    return std::string(text, std::to_chars(text, text + sizeof(text), value).ptr);
-  };
   std::vector<std::pair<std::string, std::string>> fixed;  // (name, the option that fixes it)
   for (const std::string& name : args.fix) fixed.emplace_back(name, "--fix " + name);
-  if (args.focal > 0.0) fixed.emplace_back("focal", "--focal " + number(args.focal));
-  if (args.fovy_deg > 0.0) {
-    fixed.emplace_back("focal", "--fovy " + number(args.fovy_deg));
-    // fovy fixes fx = fy / aspect at aspect 1 (or --aspect): a free aspect would be dropped.
-    fixed.emplace_back("aspect", "--fovy " + number(args.fovy_deg));
+  for (const GivenValue& given : GivenValues(args)) {
+    fixed.emplace_back(given.name, given.value.empty() ? given.option : given.option + " " + given.value);
   }
-  if (args.aspect > 0.0) fixed.emplace_back("aspect", "--aspect " + number(args.aspect));
-  if (args.principal_point) fixed.emplace_back("principal-point", "--principal-point");
-  if (!std::isnan(args.skew)) fixed.emplace_back("skew", "--skew " + number(args.skew));
-  if (!std::isnan(args.k1)) fixed.emplace_back("k1", "--k1 " + number(args.k1));
-  if (!std::isnan(args.k2)) fixed.emplace_back("k2", "--k2 " + number(args.k2));
   for (const auto& [name, freed_by] : freed) {
     for (const auto& [fixed_name, fixed_by] : fixed) {
       if (name == fixed_name) {
@@ -174,13 +186,9 @@ void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool au
     // --intrinsics gives every intrinsic: a value or mode beside it would be dropped.
     std::vector<std::string> given;
     if (args.model != "auto" && args.model != "pose") given.push_back("--model " + args.model);
-    if (args.focal > 0.0) given.push_back("--focal");
-    if (args.fovy_deg > 0.0) given.push_back("--fovy");
-    if (args.aspect > 0.0) given.push_back("--aspect");
-    if (args.principal_point) given.push_back("--principal-point");
-    if (!std::isnan(args.skew)) given.push_back("--skew");
-    if (!std::isnan(args.k1)) given.push_back("--k1");
-    if (!std::isnan(args.k2)) given.push_back("--k2");
+    for (const GivenValue& value : GivenValues(args)) {
+      if (given.empty() || given.back() != value.option) given.push_back(value.option);  // --fovy once
+    }
     if (!args.free.empty()) given.push_back("--free");
     if (!args.fix.empty()) given.push_back("--fix");
     if (!given.empty()) {
