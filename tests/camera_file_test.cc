@@ -243,6 +243,27 @@ TEST(CameraFileTest, CalibrationViewsAreSelectedByName) {
             "calib.json, view a: camera: missing");
 }
 
+// Every reader of the JSON files goes through one parser, so a number beyond a double's range
+// names its line in a calibration file's view and in an intrinsics file as in a camera file
+// (fx 1e-400 read as 0 would be "fx must be positive, got 0", with no line).
+TEST(CameraFileTest, CalibrationAndIntrinsicsReadersNameAnOutOfRangeNumbersLine) {
+  const std::string calibration =
+      "{\"views\": [{\"name\": \"a\", \"camera\": {\"image_size\": [640, 480],\n"
+      "  \"intrinsics\": {\"fx\": 1e-400, \"fy\": 500, \"cx\": 1, \"cy\": 2}}}]}";
+  EXPECT_EQ(ExpectViewError(calibration, "a"),
+            "calib.json: line 2: the number 1e-400 is out of the range of a double (too small: "
+            "it would read as 0)");
+  const std::string intrinsics = "{\"image_size\": [640, 480],\n\"intrinsics\": {\"fx\": 500,\n"
+                                 "\"fy\": 500, \"cx\": 1e400, \"cy\": 2}}";
+  try {
+    IntrinsicsFromJsonText(intrinsics, "k.json", nullptr);
+    ADD_FAILURE() << "no InputError for " << intrinsics;
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "k.json: line 3: the number 1e400 is out of the range of a double");
+  }
+}
+
 // world_origin (docs/camera-file.md) is optional: absent stays absent, present round-trips bit
 // for bit (shortest round-trip printing), and gl.view_relative_to_origin is written with it.
 TEST(CameraFileTest, WorldOriginRoundTripsAndIsOptional) {
