@@ -1511,9 +1511,11 @@ PY
     expect_not_in err "report"
     ;;
   calibrate_many_views)
-    # A 504-view calibration (the 12 left views that fit, 42 times under other names, from one
-    # view-column file) writes a 1.4 MB file: the moving-camera recipe's second step (fit
-    # --intrinsics) and --view read it; only a file over 16 MiB is refused.
+    # A 504-view calibration (the 12 left views that fit, 42 times under other names, each copy's
+    # board frame moved along X by a whole number of squares, so no copy repeats a view exactly:
+    # that is refused; from one view-column file) writes a 1.4 MB file: the moving-camera
+    # recipe's second step (fit --intrinsics) and --view read it; only a file over 16 MiB is
+    # refused.
     boards="$data/real/opencv_chessboard"
     py - "$work/many.csv" "$boards"/left0[13-9].csv "$boards"/left1*.csv <<'PY'
 import os, sys
@@ -1524,7 +1526,8 @@ with open(sys.argv[1], "w") as out:
             name = os.path.splitext(os.path.basename(path))[0]
             for line in open(path).read().split("\n")[1:]:
                 if line.strip():
-                    out.write("%s_%d,%s\n" % (name, copy, line))
+                    x, rest = line.split(",", 1)
+                    out.write("%s_%d,%r,%s\n" % (name, copy, float(x) + 16 * copy, rest))
 PY
     expect_exit 0 "$bin" calibrate "$work/many.csv" --image-size 640x480 -o "$work/calib.json"
     expect_in out "^calibrated 504 views, 27048 points: rms 0.189592 px"
