@@ -264,6 +264,30 @@ TEST(CameraFileTest, CalibrationAndIntrinsicsReadersNameAnOutOfRangeNumbersLine)
   }
 }
 
+// An orthographic camera's fx, fy are px per world unit: not intrinsics a pose fit can take
+// (`camproj fit --intrinsics ortho.json` fitted a pinhole from them and refused the points as
+// mismatched).
+TEST(CameraFileTest, AnOrthographicCamerasIntrinsicsAreRefusedAsAPinholes) {
+  const std::string intrinsics =
+      R"({"image_size": [640, 480], "intrinsics": {"fx": 40, "fy": 40, "cx": 319.5, "cy": 239.5},
+          "projection": )";
+  for (const auto& [projection, message] :
+       {std::pair<std::string, std::string>{
+            "\"orthographic\"",
+            "k.json: projection: an orthographic camera's intrinsics (px per world unit) are not "
+            "a pinhole's: give a perspective camera or a calibration"},
+        {"\"fisheye\"", "k.json: projection: expected \"perspective\" or \"orthographic\""},
+        {"3", "k.json: projection: expected \"perspective\" or \"orthographic\""}}) {
+    try {
+      IntrinsicsFromJsonText(intrinsics + projection + "}", "k.json", nullptr);
+      ADD_FAILURE() << "no InputError for projection " << projection;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), message);
+    }
+  }
+  EXPECT_EQ(IntrinsicsFromJsonText(intrinsics + "\"perspective\"}", "k.json", nullptr).fx, 40.0);
+}
+
 // world_origin (docs/camera-file.md) is optional: absent stays absent, present round-trips bit
 // for bit (shortest round-trip printing), and gl.view_relative_to_origin is written with it.
 TEST(CameraFileTest, WorldOriginRoundTripsAndIsOptional) {

@@ -385,6 +385,15 @@ Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& so
   const json document = ParseJson(text, source);
   const Reader reader(source);
   const Intrinsics intrinsics = ReadIntrinsics(document, reader);
+  // An orthographic camera's fx, fy are px per world unit, not a focal length: taken for a
+  // pinhole's, a pose fit from them was refused as mismatched points.
+  if (document.is_object() && document.contains("projection") &&
+      document.at("projection") != "perspective") {
+    reader.Fail("projection", document.at("projection") == "orthographic"
+                                  ? "an orthographic camera's intrinsics (px per world unit) are "
+                                    "not a pinhole's: give a perspective camera or a calibration"
+                                  : "expected \"perspective\" or \"orthographic\"");
+  }
   if (image_size != nullptr) {
     *image_size = std::nullopt;
     if (document.is_object() && document.contains("image_size")) {

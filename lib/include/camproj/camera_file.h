@@ -90,7 +90,8 @@ Camera ReadCalibrationView(const std::string& path, const std::string& view);
 // The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
 // skew, k1, k2]} and optionally "pixel_origin" (a calibration file too): returned in kCenter.
 // `image_size`, if given, gets the object's "image_size" (the image the intrinsics are for),
-// or nullopt where it has none. Throws InputError. ReadIntrinsicsFile and ReadCalibrationView
+// or nullopt where it has none. Throws InputError, also for an orthographic camera's file (its
+// fx, fy are px per world unit, not a pinhole's). ReadIntrinsicsFile and ReadCalibrationView
 // refuse a file over 16 MiB (a calibration of ~5800 views), ReadCameraFile one over 1 MiB.
 Intrinsics IntrinsicsFromJsonText(const std::string& text, const std::string& source,
                                   std::optional<ImageSize>* image_size = nullptr);
