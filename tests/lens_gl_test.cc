@@ -17,6 +17,7 @@
 
 #include "camproj/export.h"
 #include "camproj/look_at.h"
+#include "camproj/world_origin.h"
 #include "seeds.h"
 
 namespace camproj {
@@ -298,6 +299,23 @@ TEST(LensGlTest, GlslHoldsTheGlExportsMatricesBitForBit) {
       EXPECT_EQ(ExportCamera(camera, ExportFormat::kGlsl, options), text);
     }
   }
+  // With a world origin the view matrix is the gl export's too, gl_eye_from_origin_world, and the
+  // header says what to subtract (it held gl_eye_from_world and drew a UTM-scale point 14 px off
+  // in float32, while the export's note gave the error with the origin).
+  Camera survey = TestCamera(-0.1, 0.0);
+  const Eigen::Vector3d center(412345.0, 5612345.0, 120.0);
+  survey.cam_from_world = CamFromWorldFromLookAt(
+      {center, center + Eigen::Vector3d(0.0, 5.0, -20.0), Eigen::Vector3d::UnitZ()});
+  survey.world_origin = Eigen::Vector3d(412340.0, 5612340.0, 100.0);
+  const std::string text = LensGlslText(survey);
+  EXPECT_EQ(GlslMatrix(text, "camproj_view"),
+            GlEyeFromOriginWorld(survey.cam_from_world, *survey.world_origin));
+  EXPECT_THAT(text, HasSubstr("\n// world origin (412340, 5612340, 100): the view matrix is "
+                              "gl_eye_from_origin_world: give vertices as point_in_world - "
+                              "(412340, 5612340, 100), subtracted in double"));
+  EXPECT_THAT(ExportCamera(survey, ExportFormat::kGl),
+              HasSubstr("# world origin (412340, 5612340, 100): the view matrix is "
+                        "gl_eye_from_origin_world"));
   // The pinhole-only exports name the ones that render the lens.
   const std::string gl = ExportCamera(TestCamera(-0.3, 0.0), ExportFormat::kGl);
   EXPECT_THAT(gl, HasSubstr("to render the lens: export glsl (per vertex), distortion-mesh or "

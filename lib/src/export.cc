@@ -87,31 +87,6 @@ std::string GlPixelNote(const Camera& camera) {
                           "section 2)");
 }
 
-// The world origin of the view matrix, what users subtract, and the float32 error with and without
-// it at the near plane (Float32PixelError), one sentence.
-std::string OriginNote(const Camera& camera) {
-  auto out = ExactStream();
-  const Eigen::Vector3d auto_origin = AutoOriginOfCamera(camera);
-  const double error_without = Float32PixelError(camera, std::nullopt, camera.z_near);
-  if (camera.world_origin) {
-    const Eigen::Vector3d& o = *camera.world_origin;
-    out << "world origin (" << o.x() << ", " << o.y() << ", " << o.z()
-        << "): the view matrix is gl_eye_from_origin_world: give vertices as point_in_world - ("
-        << o.x() << ", " << o.y() << ", " << o.z()
-        << "), subtracted in double before the cast to float; expected float32 error at the near "
-           "plane "
-        << GeneralBound(Float32PixelError(camera, camera.world_origin, camera.z_near), 2) << " px ("
-        << GeneralBound(error_without, 2) << " px without the origin)";
-  } else {
-    out << "world origin: none: the view matrix takes world coordinates as they are; expected "
-           "float32 error at the near plane "
-        << GeneralBound(error_without, 2) << " px ("
-        << GeneralBound(Float32PixelError(camera, auto_origin, camera.z_near), 2)
-        << " px with camproj export --origin auto)";
-  }
-  return out.str();
-}
-
 void PrintMatrix(std::ostream& out, const char* name, const Eigen::Matrix4d& m, bool row_major) {
   out << name;
   for (int i = 0; i < 16; ++i) {
@@ -144,7 +119,7 @@ std::string ExportGlText(const Camera& camera, const ExportOptions& options) {
   } else {
     out << "# distortion: none (k1, k2, p1, p2, k3 are 0): the matrices are the whole camera\n";
   }
-  out << "# " << OriginNote(camera) << '\n';
+  out << "# " << WorldOriginNote(camera) << '\n';
   PrintMatrix(out, "projection", views.clip_from_gl_eye, options.row_major);
   PrintMatrix(out, "view", views.gl_eye_from_origin_world, options.row_major);
   return out.str();
@@ -197,7 +172,7 @@ std::string ExportGlmText(const Camera& camera, const ExportOptions& options) {
   } else {
     out << "// Distortion: none (k1, k2, p1, p2, k3 are 0): the matrices are the whole camera.\n";
   }
-  out << "// " << OriginNote(camera) << ".\n";
+  out << "// " << WorldOriginNote(camera) << ".\n";
   if (camera.world_origin) {
     const Eigen::Vector3d& o = *camera.world_origin;
     out << "// Vertices: glm::vec3(glm::dvec3(point_in_world) - world_origin).\n"
@@ -415,7 +390,7 @@ std::string ThreeNote(const Camera& camera, const GlDepth& depth, ThreeRebuild r
           " (three's camera looks down -z with y up); for a camera "
           "without a parent set camera.position.fromArray(position) and "
           "camera.quaternion.fromArray(quaternion), which the renderer turns into this matrixWorld.";
-  note += " " + OriginNote(camera) +
+  note += " " + WorldOriginNote(camera) +
           (camera.world_origin
                ? ": positions in this three world are point_in_world - world_origin (objects' "
                  "positions and geometry vertices alike; three multiplies the object and camera "

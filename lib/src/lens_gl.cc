@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
+#include "camproj/world_origin.h"
 #include "check.h"
 #include "image_codecs.h"
 
@@ -315,7 +316,8 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << " - (v + 0.5) for the camproj kCenter pixel (u, v).\n"
       << "// Depth " << ToString(depth.clip_depth) << (depth.reversed_z ? ", reversed-Z" : "")
       << "; near " << camera.z_near << ", far " << camera.z_far
-      << ": camproj_lens leaves z and w alone, so depth is as in the gl export.\n";
+      << ": camproj_lens leaves z and w alone, so depth is as in the gl export.\n"
+      << "// " << WorldOriginNote(camera) << ".\n";
   if (m == 0.0) {
     out << "// k1 = k2 = 0: camproj_lens is the identity (the matrices are the whole camera).\n";
   } else {
@@ -342,7 +344,7 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << "const float camproj_r2_limit = " << GlslFloat(r_limit * r_limit, "r_limit^2") << ";\n"
       << "const mat4 camproj_projection = "
       << GlslMat4(views.clip_from_gl_eye, "a projection matrix entry") << ";\n"
-      << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_world, "a view matrix entry")
+      << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_origin_world, "a view matrix entry")
       << ";\n"
       << "// gl_eye (x right, y up, looking down -z) is cam (x right, y down, z forward) with y "
          "and\n"

@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <string>
 
 #include "camproj/conventions.h"
 #include "camproj/gl.h"
+#include "camproj/number_text.h"
 #include "check.h"
 
 namespace camproj {
@@ -100,6 +105,30 @@ double Float32PixelError(const Camera& camera, const std::optional<Eigen::Vector
   const double f = std::max(k.fx, k.fy) + std::abs(k.skew);
   const double eye_error = 3.0 * kFloat32Roundoff * (d + depth);
   return camera.projection == Projection::kOrthographic ? f * eye_error : f * eye_error / depth;
+}
+
+std::string WorldOriginNote(const Camera& camera) {
+  std::ostringstream out;  // doubles that read back bit for bit
+  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  const Eigen::Vector3d auto_origin = AutoOriginOfCamera(camera);
+  const double error_without = Float32PixelError(camera, std::nullopt, camera.z_near);
+  if (camera.world_origin) {
+    const Eigen::Vector3d& o = *camera.world_origin;
+    out << "world origin (" << o.x() << ", " << o.y() << ", " << o.z()
+        << "): the view matrix is gl_eye_from_origin_world: give vertices as point_in_world - ("
+        << o.x() << ", " << o.y() << ", " << o.z()
+        << "), subtracted in double before the cast to float; expected float32 error at the near "
+           "plane "
+        << GeneralBound(Float32PixelError(camera, camera.world_origin, camera.z_near), 2) << " px ("
+        << GeneralBound(error_without, 2) << " px without the origin)";
+  } else {
+    out << "world origin: none: the view matrix takes world coordinates as they are; expected "
+           "float32 error at the near plane "
+        << GeneralBound(error_without, 2) << " px ("
+        << GeneralBound(Float32PixelError(camera, auto_origin, camera.z_near), 2)
+        << " px with camproj export --origin auto)";
+  }
+  return out.str();
 }
 
 }  // namespace camproj

@@ -6,6 +6,7 @@
 #define CAMPROJ_WORLD_ORIGIN_H_
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -56,6 +57,13 @@ Eigen::Vector3d AutoOriginOfCamera(const Camera& camera);
 // std::invalid_argument for an invalid camera, a non-positive depth or a non-finite origin.
 double Float32PixelError(const Camera& camera, const std::optional<Eigen::Vector3d>& world_origin,
                          double depth);
+
+// The GL-facing exports' sentence on the world origin (gl, glm, glsl, three): with one, that
+// their view matrix is gl_eye_from_origin_world and what to subtract from vertices, with the
+// float32 error at the near plane with and without it; without, that the view matrix takes world
+// coordinates as they are, with the error with and without `--origin auto`. No trailing period.
+// Throws as Float32PixelError.
+std::string WorldOriginNote(const Camera& camera);
 
 // Above this expected error (px) at the near plane `camproj export` warns that the camera needs a
 // world origin (docs/exports.md).
