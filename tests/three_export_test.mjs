@@ -163,5 +163,44 @@ run('fit', path.join(dataDir, 'synthetic/points.csv'), '--image-size', '1280x800
     'principal-point', '--sigma', '3', '-o', centred);
 await testCamera('centred', centred, path.join(dataDir, 'synthetic/points.csv'), false);
 
+// zo reversed-Z, where a renderer made with reversedDepthBuffer: true runs, on its first render,
+// what three r187's WebGLRenderer does for a camera whose reversedDepth is not yet true:
+// `camera._reversedDepth = true; camera.updateProjectionMatrix()`. The snippet sets the field, so
+// the exact matrix stays -- also for a skewed camera, which three cannot rebuild (that rebuild put
+// points 20-29 px off) -- and a later rebuild of a camera three can rebuild is reversed too.
+async function testReversedZ(label, cameraPath, pointsPath) {
+  const threePath = path.join(work, `${label}.zo-reversed.three.json`);
+  writeFileSync(threePath, run('export', cameraPath, '--to', 'three', '--depth', 'zo', '--reversed-z', '--quiet'));
+  const points = camprojPixels(cameraPath, pointsPath);
+  const { camera, c } = await loadWithDoc(threePath);
+  const [W, H] = c.image_size;
+  check(c.type === 'PerspectiveCamera', `${label}: type ${c.type}`);
+  const reversedDepthBuffer = true;
+  if (reversedDepthBuffer && camera.reversedDepth !== true) {
+    camera._reversedDepth = true;
+    camera.updateProjectionMatrix();
+  }
+  let worst = worstPx(camera, points, W, H, (p) => p.corner);
+  check(worst <= kTolerancePx, `${label}: zo reversed-Z after the renderer's first-render check, worst ${worst.toExponential(2)} px`);
+  const exact = camera.projectionMatrix.elements.slice();
+  check(exact.every((v, i) => v === c.projectionMatrix[i]), `${label}: zo reversed-Z projectionMatrix kept exactly`);
+  if (c.fov !== undefined) {
+    camera.updateProjectionMatrix();
+    worst = worstPx(camera, points, W, H, (p) => p.corner);
+    check(worst <= kTolerancePx, `${label}: zo reversed-Z rebuilt by updateProjectionMatrix, worst ${worst.toExponential(2)} px`);
+  }
+}
+await testReversedZ('projector', projector, path.join(dataDir, 'projector/points.csv'));
+// The projector with skew (no fov, aspect or view form): a minimal camera file.
+const fitted = JSON.parse(readFileSync(projector, 'utf8'));
+const skewed = path.join(work, 'skewed.json');
+writeFileSync(skewed, JSON.stringify({
+  image_size: fitted.image_size,
+  intrinsics: { ...fitted.intrinsics, skew: 35 },
+  cam_from_world: fitted.cam_from_world,
+  frustum: { near: fitted.frustum.near, far: fitted.frustum.far },
+}));
+await testReversedZ('skewed', skewed, path.join(dataDir, 'projector/points.csv'));
+
 console.log(failures === 0 ? 'three_export_test: all passed' : `three_export_test: ${failures} failed`);
 process.exit(failures === 0 ? 0 : 1);

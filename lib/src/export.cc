@@ -320,11 +320,11 @@ ThreeRebuild SetThreeProjectionFields(const Camera& camera, const CameraViews& v
     }
     return rebuild;
   }
+  (*document)["type"] = "PerspectiveCamera";
   if (!views.frustum) {
     rebuild.no_rebuild += " skew != 0 (no fov, aspect or view form);";
     return rebuild;
   }
-  (*document)["type"] = "PerspectiveCamera";
   // Enlarge the frustum to one centred on the gaze and show the image as a window of it, in
   // units of s = W / (r - l) per near-plane unit on both axes, so that fullWidth / fullHeight
   // is the full view's aspect (setViewOffset sets aspect to it). Exactly centred: no window.
@@ -374,7 +374,9 @@ std::string ThreeNote(const Camera& camera, const GlDepth& depth, ThreeRebuild r
   note += rebuild.off_axis;
   note += depth.reversed_z
               ? (depth.clip_depth == ClipDepth::kZeroToOne
-                     ? " Depth zo reversed-Z: a renderer made with reversedDepthBuffer: true."
+                     ? " Depth zo reversed-Z: a renderer made with reversedDepthBuffer: true; "
+                       "set camera._reversedDepth = true (three r187) after loading "
+                       "projectionMatrix, or that renderer rebuilds it on its first render."
                      : "")
               : (depth.clip_depth == ClipDepth::kZeroToOne ? " Depth zo: WebGPURenderer."
                                                            : " Depth no: WebGLRenderer.");
