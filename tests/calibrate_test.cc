@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "camproj/fit.h"
+#include "camproj/number_text.h"
 #include "camproj/points_file.h"
 #include "camproj/synth.h"
 #include "seeds.h"
@@ -411,6 +412,35 @@ TEST(CalibrateTest, AViewGivenTwiceIsRefusedByName) {
   }
   // Another board frame is another view (the copy's pose absorbs it).
   for (Eigen::Vector3d& x : views.back().points_in_world) x.x() += 1.0;
+  EXPECT_NO_THROW(Calibrate(views, Options()));
+}
+
+// Pixels no camera of the image size could have seen: one beyond kMaxImageSide px outside the
+// image is named (at 1e155 the closed form overflowed: "the views do not determine the
+// intrinsics"), and most of them outside is a wrong image size (64 x 48 for these 640 x 480
+// views was calibrated, cx 342, exit 0).
+TEST(CalibrateTest, PixelsNoCameraOfTheImageSawAreRefused) {
+  std::vector<CalibrationView> views = ChessboardViews("left");
+  CalibrateOptions small = Options();
+  small.image_size = {64, 48};
+  try {
+    Calibrate(views, small);
+    FAIL() << "calibrated at 64 x 48";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "702 of the 702 pixels lie outside the 64 x 48 image (they span u 151.5 to 603.8, "
+              "v 49.72 to 431.7): check the image size");
+  }
+  views[5].pixels[1].x() = 1e155;
+  try {
+    Calibrate(views, Options());
+    FAIL() << "calibrated with a pixel at 1e155";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "left06: point 2: pixel (1e+155, " + ShortestDouble(views[5].pixels[1].y()) +
+                  ") lies more than 1000000 px outside the 640 x 480 image");
+  }
+  views[5].pixels[1].x() = 639.5 + 1e6;  // on the bound: a pixel, if an odd one
   EXPECT_NO_THROW(Calibrate(views, Options()));
 }
 

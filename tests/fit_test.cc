@@ -7,6 +7,7 @@
 #include <numeric>
 #include <optional>
 #include <random>
+#include <regex>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -639,6 +640,15 @@ TEST_F(RefusalTest, OffsetsBeyondDoublePrecisionAreRefused) {
     EXPECT_EQ(RefusalOf(points, scene_.observed_pixels, camera_.size, options, &message_),
               SceneError::Reason::kNonFiniteInput);
     EXPECT_NE(message_.find("Subtract a common offset"), std::string::npos) << message_;
+    // Its numbers to two digits, at most 7 characters ("0.00011", "9.8e+11"): they are
+    // estimates (a shortest round-trip form printed 17 digits).
+    const std::string number = "[0-9.e+-]{1,7}";
+    EXPECT_TRUE(std::regex_search(
+        message_, std::regex("^the 3D points are " + number + " times as far from the origin as "
+                             "from each other: double precision rounds their positions relative "
+                             "to each other by " + number + " of their spread, which moves their "
+                             "pixels by about " + number + " px,")))
+        << message_;
   }
 }
 

@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "camproj/model_select.h"
+#include "camproj/number_text.h"
 #include "check.h"
 #include "fit/closed_form.h"
 #include "fit/common.h"
@@ -184,6 +185,43 @@ void CheckView(const CalibrationView& view, size_t index) {
 
 std::string ViewName(const CalibrationView& view, size_t index) {
   return view.name.empty() ? "view " + std::to_string(index + 1) : view.name;
+}
+
+// Throws std::invalid_argument for pixels no camera of `size` could have seen: one farther than
+// kMaxImageSide px outside the image (naming its view and point: a pixel of 1e155 overflowed the
+// closed form, refused as "the views do not determine the intrinsics"), or more than half of
+// them outside it (a wrong image size: 64 x 48 for a 640 x 480 camera was calibrated, cx 342).
+void CheckPixelsInImage(const std::vector<CalibrationView>& views, const ImageSize& size) {
+  const Eigen::Vector2d low(-0.5, -0.5);
+  const Eigen::Vector2d high(size.width - 0.5, size.height - 0.5);
+  size_t outside = 0;
+  size_t total = 0;
+  Eigen::Vector2d min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d max = -min;
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (size_t i = 0; i < views[v].pixels.size(); ++i) {
+      const Eigen::Vector2d& pixel = views[v].pixels[i];
+      const double beyond = std::max((low - pixel).maxCoeff(), (pixel - high).maxCoeff());
+      if (beyond > kMaxImageSide) {
+        throw std::invalid_argument(internal::Concat(
+            ViewName(views[v], v), ": point ",
+            views[v].ids.empty() ? std::to_string(i + 1) : views[v].ids[i], ": pixel (",
+            pixel.x(), ", ", pixel.y(), ") lies more than ", kMaxImageSide, " px outside the ",
+            size.width, " x ", size.height, " image"));
+      }
+      outside += beyond > 0.0 ? 1 : 0;
+      ++total;
+      min = min.cwiseMin(pixel);
+      max = max.cwiseMax(pixel);
+    }
+  }
+  if (2 * outside > total) {
+    throw std::invalid_argument(internal::Concat(
+        outside, " of the ", total, " pixels lie outside the ", size.width, " x ", size.height,
+        " image (they span u ", GeneralDouble(min.x(), 4), " to ", GeneralDouble(max.x(), 4),
+        ", v ", GeneralDouble(min.y(), 4), " to ", GeneralDouble(max.y(), 4),
+        "): check the image size"));
+  }
 }
 
 // Throws std::invalid_argument naming two views with the same points and pixels: a view given
@@ -1256,6 +1294,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
   if (views.empty()) throw std::invalid_argument("Calibrate needs at least one view");
   for (size_t i = 0; i < views.size(); ++i) CheckView(views[i], i);
   CheckNoViewRepeated(views);
+  CheckPixelsInImage(views, options.image_size);
   // Before the model selection, whose fits would carry such a view (they do not refuse views).
   if (options.refuse_inconsistent_views) {
     if (auto rest = CalibrateWithout(views, ScrambledPlanarViews(views), options)) return *rest;

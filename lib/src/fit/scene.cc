@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <iomanip>
 #include <memory>
 #include <limits>
 #include <optional>
@@ -97,11 +96,12 @@ void CheckOffset(const std::vector<Eigen::Vector3d>& points_in_world, double sca
   if (rounding_px > kMaxOffsetRoundingPx) {
     throw SceneError(
         SceneError::Reason::kNonFiniteInput,
-        Concat(std::setprecision(2), "the 3D points are ", offset,
+        Concat("the 3D points are ", GeneralDouble(offset, 2),
                " times as far from the origin as from each other: double precision rounds their "
-               "positions relative to each other by ", rounding, " of their spread, which moves "
-               "their pixels by about ", rounding_px, " px, and so would the camera written with "
-               "these coordinates"),
+               "positions relative to each other by ", GeneralDouble(rounding, 2),
+               " of their spread, which moves their pixels by about ",
+               GeneralDouble(rounding_px, 2), " px, and so would the camera written with these "
+               "coordinates"),
         "Subtract a common offset from every point (e.g. the first point), refit, and use the "
         "camera with the offset subtracted");
   }
