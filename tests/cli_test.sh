@@ -332,6 +332,12 @@ PY
     expect_in err "usage: focal is both freed (--model focal+aspect) and fixed (--fovy 40): give one"
     expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --free aspect --fovy 40 -o "$work/c.json"
     expect_in err "usage: aspect is both freed (--free aspect) and fixed (--fovy 40): give one"
+    # A model naming a group twice was taken as naming it once.
+    expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --model focal+focal -o "$work/c.json"
+    expect_in err "usage: --model: \"focal\" is named twice in \"focal+focal\""
+    expect_exit 1 "$bin" calibrate "$data/real/opencv_chessboard/left01.csv" --image-size 640x480 \
+      --model principal-point+k1+principal-point -o "$work/c.json"
+    expect_in err "group \"principal-point\" is named twice in \"principal-point+k1+principal-point\""
     [[ ! -e "$work/c.json" ]] || fail "a refused option left a file"
     expect_exit 1 "$bin" convert --frustum -0.05,0.05,-0.05,0.05,0.1,1 --image-size 100x100 --to gl --near 5
     expect_in err "usage: --skew, --near and --far go with --intrinsics"

@@ -1147,7 +1147,12 @@ CalibrateOptions CalibrateOptionsForModel(const std::string& model,
     }
   } else {
     std::stringstream list(model);
-    for (std::string group; std::getline(list, group, '+');) groups.push_back(group);
+    for (std::string group; std::getline(list, group, '+');) {
+      if (std::find(groups.begin(), groups.end(), group) != groups.end()) {
+        throw std::invalid_argument("group \"" + group + "\" is named twice in \"" + model + "\"");
+      }
+      groups.push_back(group);
+    }
   }
   auto listed = [](const std::vector<std::string>& names, const std::string& name) {
     return std::find(names.begin(), names.end(), name) != names.end();

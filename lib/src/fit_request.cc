@@ -62,6 +62,10 @@ std::vector<std::string> ModelNames(const std::string& model) {
           "\": expected auto, pose, or parameters joined by '+' among focal, aspect, "
           "principal-point, skew, k1, k2 (e.g. focal+principal-point)");
     }
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      throw std::invalid_argument("--model: \"" + name + "\" is named twice in \"" + model +
+                                  "\"");
+    }
     names.push_back(name);
     if (end == std::string::npos) return names;
     begin = end + 1;
