@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -442,6 +443,49 @@ TEST(CalibrateTest, PixelsNoCameraOfTheImageSawAreRefused) {
   }
   views[5].pixels[1].x() = 639.5 + 1e6;  // on the bound: a pixel, if an odd one
   EXPECT_NO_THROW(Calibrate(views, Options()));
+}
+
+// Boards parallel to the image do not determine the focal length (a nearer board and a longer
+// lens give the same image): the advice is other tilts, and fixing only what is still free (it
+// said to fix the principal point and the aspect with both fixed).
+TEST(CalibrateTest, FrontoParallelBoardsAdviseTiltsAndOnlyTheEntriesStillFree) {
+  Camera camera;
+  camera.image_size = kImage;
+  camera.intrinsics = TrueIntrinsics();
+  camera.intrinsics.k1 = camera.intrinsics.k2 = 0.0;
+  std::vector<CalibrationView> views;
+  for (int v = 0; v < 5; ++v) {
+    CalibrationView view;
+    view.name = "flat" + std::to_string(v);
+    camera.cam_from_world.rotation = Eigen::Matrix3d::Identity();
+    camera.cam_from_world.translation = Eigen::Vector3d(-4.0 + 0.3 * v, -2.5, 10.0 + v);
+    for (int y = 0; y < 6; ++y) {
+      for (int x = 0; x < 9; ++x) {
+        view.points_in_world.emplace_back(x, y, 0.0);
+        view.pixels.push_back(*PixelFromWorld(camera, view.points_in_world.back()));
+      }
+    }
+    views.push_back(view);
+  }
+  const std::string tilts =
+      "Add views of the board at other tilts (10-45 degrees, in different directions)";
+  for (const auto& [principal_point_free, aspect_free, fix] :
+       {std::tuple<bool, bool, std::string>{
+            true, true, tilts + ", or fix the principal point and the aspect (--fix "
+                                "principal-point,aspect)"},
+        {true, false, tilts + ", or fix the principal point (--fix principal-point)"},
+        {false, false, tilts}}) {
+    CalibrateOptions options = Options();
+    options.principal_point_free = principal_point_free;
+    options.aspect_free = aspect_free;
+    options.num_radial = 0;
+    try {
+      const Calibration calibration = Calibrate(views, options);
+      ADD_FAILURE() << "fronto-parallel boards calibrated: fx " << calibration.intrinsics.fx;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.fix(), fix) << e.what();
+    }
+  }
 }
 
 TEST(CalibrateTest, BadViewsAreNamed) {

@@ -621,6 +621,22 @@ std::optional<std::pair<size_t, RefusedView>> WorstInconsistentView(const Calibr
 }
 
 
+// What to do where the views do not determine the camera: other tilts, or fix the camera matrix's
+// entries still free (--fix principal-point,aspect names what the options free, and nothing once
+// both are held: the advice said to fix them for views calibrated with them fixed).
+std::string MoreTiltsOrFix(const CalibrateOptions& options) {
+  const std::string tilts = "Add views of the board at other tilts (10-45 degrees, in different "
+                            "directions)";
+  if (options.principal_point_free && options.aspect_free) {
+    return tilts + ", or fix the principal point and the aspect (--fix principal-point,aspect)";
+  }
+  if (options.principal_point_free) {
+    return tilts + ", or fix the principal point (--fix principal-point)";
+  }
+  if (options.aspect_free) return tilts + ", or fix the aspect (--fix aspect)";
+  return tilts;
+}
+
 // Throws SceneError unless the views can determine the free intrinsics: more equations than
 // unknowns, and (planar views alone) no more of K's entries free than twice their number.
 void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
@@ -646,8 +662,7 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
                          std::to_string(2 * planar_views) + " of the camera matrix's " +
                          std::to_string(free_k_entries) +
                          " free entries (a plane gives two constraints)",
-                     "Add views of the board at other tilts, or fix the principal point and the "
-                     "aspect");
+                     MoreTiltsOrFix(options));
   }
 }
 
@@ -1346,7 +1361,7 @@ Calibration Calibrate(const std::vector<CalibrationView>& views, const Calibrate
     throw SceneError(SceneError::Reason::kDegenerate,
                      "the views do not determine the intrinsics in closed form (planar boards "
                      "need at least 2-3 views at different tilts; a 3D view at least 6 points)",
-                     "Add views at other angles, or fix the principal point and the aspect");
+                     MoreTiltsOrFix(options));
   }
   // Views without a start pose are left out by name and the rest calibrated.
   std::vector<internal::StartCamera> starts(views.size());
