@@ -621,9 +621,9 @@ std::optional<std::pair<size_t, RefusedView>> WorstInconsistentView(const Calibr
 }
 
 
-// What to do where the views do not determine the camera: other tilts, or fix the camera matrix's
-// entries still free (--fix principal-point,aspect names what the options free, and nothing once
-// both are held: the advice said to fix them for views calibrated with them fixed).
+// What to do where the views do not determine the camera matrix: other tilts, or fix those of
+// its entries the options still free (the advice named the principal point and the aspect also
+// where both were fixed).
 std::string MoreTiltsOrFix(const CalibrateOptions& options) {
   const std::string tilts = "Add views of the board at other tilts (10-45 degrees, in different "
                             "directions)";
@@ -669,9 +669,9 @@ void CheckDetermined(const std::vector<CalibrationView>& views, int num_points,
 // A joint fit stopped at its iteration cap is short of its minimum: where the views barely
 // determine the model, LM crawls along a valley of cameras that fit about equally well (seen:
 // the same view given twice, fx 13.6 +- 748 px for a true ~534; eight boards tilted 1 degree,
-// fx 41028 +- 22982 px for 800, at 3x the noise's RMS). Never a calibration from there.
-// Its own type: the model selection holds groups of a richest model refused so
-// (RichestCalibration), and no other refusal.
+// fx 41028 +- 22982 px for 800, at 3x the noise's RMS). Never a calibration from there. A type
+// of its own: the model selection holds groups of a richest model refused so
+// (RichestCalibration), and of no other.
 class Unconverged : public SceneError {
  public:
   explicit Unconverged(int iterations)
