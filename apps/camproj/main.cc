@@ -70,16 +70,20 @@ int Run(int argc, char** argv) {
   }
   camproj::InstallTemporaryFileCleanup();
   camproj::SetLibraryLogging(verbose);
+  // Which command is running: a refusal says what it could not do.
+  const char* refused = "fit";
   try {
     for (const Command& command : commands) {
-      if (*command.app) return command.run();
+      if (!*command.app) continue;
+      if (command.app->get_name() == "calibrate") refused = "calibrate";
+      return command.run();
     }
   } catch (const UsageError& e) {
     std::cerr << "camproj: usage: " << camproj::TerminalSafe(e.what()) << "\n(see camproj --help)\n";
     return kExitUsage;
   } catch (const camproj::SceneError& e) {
     // What to do on a line of its own, where the refusal says it apart from why.
-    std::cerr << "camproj: cannot fit: " << camproj::TerminalSafe(e.why()) << '\n';
+    std::cerr << "camproj: cannot " << refused << ": " << camproj::TerminalSafe(e.why()) << '\n';
     const std::string fix = e.fix();
     if (!fix.empty()) std::cerr << "camproj: to fix: " << camproj::TerminalSafe(fix) << '\n';
     return kExitScene;
