@@ -624,9 +624,10 @@ std::optional<std::pair<size_t, RefusedView>> WorstInconsistentView(const Calibr
 // What to do where the views do not determine the camera matrix: other tilts, or fix those of
 // its entries the options still free (the advice named the principal point and the aspect also
 // where both were fixed).
+constexpr char kOtherTilts[] =
+    "Add views of the board at other tilts (10-45 degrees, in different directions)";
 std::string MoreTiltsOrFix(const CalibrateOptions& options) {
-  const std::string tilts = "Add views of the board at other tilts (10-45 degrees, in different "
-                            "directions)";
+  const std::string tilts = kOtherTilts;
   if (options.principal_point_free && options.aspect_free) {
     return tilts + ", or fix the principal point and the aspect (--fix principal-point,aspect)";
   }
@@ -680,8 +681,7 @@ class Unconverged : public SceneError {
                                     iterations, " iterations: the views barely determine the "
                                     "model (boards nearly parallel to the image or to each "
                                     "other)"),
-                   "Add views of the board at other tilts (10-45 degrees, in different "
-                   "directions), or fix intrinsics (--fix, --model)") {}
+                   std::string(kOtherTilts) + ", or fix intrinsics (--fix, --model)") {}
 };
 
 // The views but the refused ones (by index) calibrated, their records first in refused_views.

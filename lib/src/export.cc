@@ -14,6 +14,7 @@
 #include "camproj/number_text.h"
 #include "camproj/world_origin.h"
 #include "check.h"
+#include "exact_stream.h"
 
 namespace camproj {
 
@@ -39,12 +40,7 @@ constexpr FormatName kFormatNames[] = {
     {ExportFormat::kDistortionMesh, "distortion-mesh"},
 };
 
-// A stream that prints doubles so that they read back bit for bit.
-std::ostringstream ExactStream() {
-  std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);
-  return out;
-}
+using internal::ExactStream;
 
 // The GL state a matrix built with `depth` needs, as one comment line per call.
 std::string DepthState(const GlDepth& depth, const std::string& prefix) {

@@ -12,6 +12,7 @@
 
 #include "camproj/world_origin.h"
 #include "check.h"
+#include "exact_stream.h"
 #include "image_codecs.h"
 
 namespace camproj {
@@ -67,11 +68,7 @@ Eigen::Vector2d UvOfPixel(const Eigen::Vector2d& pixel, const ImageSize& size) {
   return {(pixel.x() + 0.5) / size.width, 1.0 - (pixel.y() + 0.5) / size.height};
 }
 
-std::ostringstream ExactStream() {
-  std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);
-  return out;
-}
+using internal::ExactStream;
 
 // A GLSL float literal that reads back to the same float as the double rounds to. Throws for a
 // value beyond float32's range (a literal above 3.4e38 is infinite in GLSL), naming it.
@@ -344,8 +341,8 @@ std::string LensGlslText(const Camera& camera, const GlDepth& depth) {
       << "const float camproj_r2_limit = " << GlslFloat(r_limit * r_limit, "r_limit^2") << ";\n"
       << "const mat4 camproj_projection = "
       << GlslMat4(views.clip_from_gl_eye, "a projection matrix entry") << ";\n"
-      << "const mat4 camproj_view = " << GlslMat4(views.gl_eye_from_origin_world, "a view matrix entry")
-      << ";\n"
+      << "const mat4 camproj_view = "
+      << GlslMat4(views.gl_eye_from_origin_world, "a view matrix entry") << ";\n"
       << "// gl_eye (x right, y up, looking down -z) is cam (x right, y down, z forward) with y "
          "and\n"
       << "// z negated: x = X/Z = x_eye / -z_eye, y = Y/Z = y_eye / z_eye. Only r^2 = x^2 + y^2 "

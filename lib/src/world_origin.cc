@@ -2,15 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
-#include <limits>
-#include <sstream>
 #include <string>
 
 #include "camproj/conventions.h"
 #include "camproj/gl.h"
 #include "camproj/number_text.h"
 #include "check.h"
+#include "exact_stream.h"
 
 namespace camproj {
 
@@ -108,8 +106,7 @@ double Float32PixelError(const Camera& camera, const std::optional<Eigen::Vector
 }
 
 std::string WorldOriginNote(const Camera& camera) {
-  std::ostringstream out;  // doubles that read back bit for bit
-  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  auto out = internal::ExactStream();
   const Eigen::Vector3d auto_origin = AutoOriginOfCamera(camera);
   const double error_without = Float32PixelError(camera, std::nullopt, camera.z_near);
   if (camera.world_origin) {

@@ -184,9 +184,10 @@ struct Calibration {
 // options or on a view with fewer than 4 points, with non-finite numbers, with points and
 // pixels of different counts, or with the same points and pixels as another view (naming the
 // views), for a pixel more than kMaxImageSide px outside the image or more than half of them
-// outside it (a wrong image size); SceneError kDegenerate when the views cannot determine the free intrinsics (fewer
-// equations than unknowns, no closed-form start, or a joint fit that does not reach its minimum
-// within max_iterations: say which intrinsics to fix), kNumerical when the refinement fails.
+// outside it (a wrong image size); SceneError kDegenerate when the views cannot determine the
+// free intrinsics (fewer equations than unknowns, no closed-form start, or a joint fit that does
+// not reach its minimum within max_iterations: say which intrinsics to fix), kNumerical when the
+// refinement fails.
 Calibration Calibrate(const std::vector<CalibrationView>& views, const CalibrateOptions& options);
 
 // The options of a model named by its intrinsics groups (`camproj calibrate --model`, --fix):
