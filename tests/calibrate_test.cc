@@ -18,6 +18,7 @@
 #include "camproj/fit.h"
 #include "camproj/number_text.h"
 #include "camproj/points_file.h"
+#include "camproj/pose.h"
 #include "camproj/synth.h"
 #include "seeds.h"
 
@@ -252,6 +253,48 @@ TEST(CalibrateTest, ChessboardEqualsCalibrateCamera) {
     }
     EXPECT_NEAR(ours.rms_px, cv_rms, kSameOptimumRelative * cv_rms);
     EXPECT_EQ(ours.views.size(), 13u);
+  }
+}
+
+// The intrinsics do not depend on the world's unit or origin (each view's pose absorbs a
+// similarity of its world), so the real chessboards measured in units 1e9 times a square, or
+// 1e9 squares from the origin, calibrate to the same optimum: the same intrinsics, and each view's
+// camera centre moved with its world. (Both were refused or moved: "the covariance is singular",
+// cx 0.8 px off.) The board's corners are whole squares, so the offset adds no rounding.
+TEST(CalibrateTest, TheWorldsUnitAndOriginDoNotChangeTheCalibration) {
+  const std::vector<CalibrationView> views = ChessboardViews("left");
+  const Calibration reference = Calibrate(views, Options());
+  ASSERT_FALSE(reference.views.empty());
+  for (const auto& [scale, offset] : {std::pair<double, Eigen::Vector3d>{1e9, {0.0, 0.0, 0.0}},
+                                      {1e-9, {0.0, 0.0, 0.0}},
+                                      {1.0, {1e9, -2e9, 5e8}}}) {
+    SCOPED_TRACE("world x " + ShortestDouble(scale) + " + (" + ShortestDouble(offset.x()) + ", " +
+                 ShortestDouble(offset.y()) + ", " + ShortestDouble(offset.z()) + ")");
+    std::vector<CalibrationView> moved = views;
+    for (auto& view : moved) {
+      for (auto& p : view.points_in_world) p = scale * p + offset;
+    }
+    const Calibration c = Calibrate(moved, Options());
+    ASSERT_EQ(c.intrinsics_sigma.size(), reference.intrinsics_sigma.size());
+    for (size_t i = 0; i < c.intrinsics_sigma.size(); ++i) {
+      const ParameterSigma& ours = c.intrinsics_sigma[i];
+      const ParameterSigma& theirs = reference.intrinsics_sigma[i];
+      EXPECT_LE(std::abs(ours.value - theirs.value),
+                std::max(kSameOptimumRelative * std::abs(theirs.value),
+                         kSameOptimumSigmas * theirs.sigma))
+          << ours.name << ": " << ours.value << " against " << theirs.value;
+      EXPECT_NEAR(ours.sigma, theirs.sigma, kSameOptimumRelative * theirs.sigma) << ours.name;
+    }
+    EXPECT_NEAR(c.rms_px, reference.rms_px, kSameOptimumRelative * reference.rms_px);
+    ASSERT_EQ(c.views.size(), reference.views.size());
+    for (size_t i = 0; i < c.views.size(); ++i) {
+      const Eigen::Vector3d expected = scale * CameraCenterInWorld(reference.views[i].camera.cam_from_world) + offset;
+      EXPECT_LE((CameraCenterInWorld(c.views[i].camera.cam_from_world) - expected).norm(),
+                kSameOptimumRelative * scale * reference.views[i].camera.z_far)
+          << c.views[i].name;
+      EXPECT_NEAR(c.views[i].camera.z_far, scale * reference.views[i].camera.z_far,
+                  kSameOptimumRelative * scale * reference.views[i].camera.z_far);
+    }
   }
 }
 

@@ -97,18 +97,47 @@ void ExpWithLeftJacobian(const double* w, Eigen::Matrix3d* rotation, Eigen::Matr
   }
 }
 
+// A view's points as the joint problem holds them: x = (X - origin) / unit, the origin their
+// centroid and the unit the power of two at or below their RMS distance from it (scaling by it is
+// exact). The pixels depend on X - C only through its direction, so the camera centre is fitted
+// in this frame: in world units its Jacobian columns scale as 1 / the board's size and the
+// covariance's rank test refused boards measured in units 1e9 times a square (a rotation's
+// columns do not scale); about the world's origin, boards far from it (survey coordinates) lost
+// X - C's digits, and at 1e9 squares from it the calibration moved cx by 0.8 px.
+struct ViewFrame {
+  explicit ViewFrame(const std::vector<Eigen::Vector3d>& points_in_world) {
+    origin = Eigen::Vector3d::Zero();
+    for (const auto& p : points_in_world) origin += p;
+    origin /= static_cast<double>(points_in_world.size());
+    double sum_squares = 0.0;
+    for (const auto& p : points_in_world) sum_squares += (p - origin).squaredNorm();
+    const double rms = std::sqrt(sum_squares / static_cast<double>(points_in_world.size()));
+    unit = rms > 0.0 && std::isfinite(rms) ? std::ldexp(1.0, std::ilogb(rms)) : 1.0;
+    for (const auto& p : points_in_world) points.push_back((p - origin) / unit);
+  }
+  Eigen::Vector3d InWorld(const Eigen::Vector3d& x) const { return origin + unit * x; }
+  Eigen::Vector3d InFrame(const Eigen::Vector3d& point_in_world) const {
+    return (point_in_world - origin) / unit;
+  }
+
+  Eigen::Vector3d origin;
+  double unit;
+  std::vector<Eigen::Vector3d> points;
+};
+
 // All points of one view, analytic: per point the single-view fitter's residual of the camera
-// point (ResidualOfCamPoint). Parameter blocks: the view's pose [w, C] (cam_from_world rotation
-// Exp(w) R0 about the start's R0, the camera centre C; |w| stays far below pi from a closed-form
-// start) and the free intrinsics (FitLayout entries at `free_slots`, the others held at their
+// point (ResidualOfCamPoint). Parameter blocks: the view's pose [w, c] (cam_from_world rotation
+// Exp(w) R0 about the start's R0, the camera centre c in the view's frame; |w| stays far below pi
+// from a closed-form start) and the free intrinsics (FitLayout entries at `free_slots`, the others held at their
 // values in `k`). Plain vectors, no manifolds, one block per view: Ceres' per-block costs (the
 // manifolds' Jacobian products, the evaluation bookkeeping) were 40 % of the joint solve
 // (bench --calibrate, callgrind).
 class ViewCost : public ceres::CostFunction {
  public:
-  ViewCost(const CalibrationView& view, const Eigen::Matrix3d& reference_rotation,
-           const IntrinsicsLayout& k, const std::vector<int>& free_slots)
-      : points_(view.points_in_world), pixels_(view.pixels),
+  ViewCost(const CalibrationView& view, const ViewFrame& frame,
+           const Eigen::Matrix3d& reference_rotation, const IntrinsicsLayout& k,
+           const std::vector<int>& free_slots)
+      : points_(frame.points), pixels_(view.pixels),
         reference_rotation_(reference_rotation), k_(k), free_slots_(free_slots) {
     set_num_residuals(2 * static_cast<int>(pixels_.size()));
     mutable_parameter_block_sizes()->assign({kPoseSize, static_cast<int>(free_slots.size())});
@@ -153,8 +182,8 @@ class ViewCost : public ceres::CostFunction {
   }
 
  private:
-  const std::vector<Eigen::Vector3d>& points_;  // the view outlives the problem
-  const std::vector<Eigen::Vector2d>& pixels_;
+  const std::vector<Eigen::Vector3d>& points_;  // in the view's frame; it and the view outlive
+  const std::vector<Eigen::Vector2d>& pixels_;   // the problem
   Eigen::Matrix3d reference_rotation_;
   const IntrinsicsLayout& k_;  // the joint problem's: fixed entries' values
   std::vector<int> free_slots_;
@@ -744,7 +773,8 @@ std::optional<std::string> ViewStart(const CalibrationView& view,
 // shared by all views.
 struct JointProblem {
   std::vector<Eigen::Matrix3d> reference_rotations;  // each view's start
-  std::vector<std::array<double, kPoseSize>> poses;  // [w, C], see ViewCost
+  std::vector<ViewFrame> frames;
+  std::vector<std::array<double, kPoseSize>> poses;  // [w, c], see ViewCost
   IntrinsicsLayout k;                                 // every entry; free ones as of Solve
   std::vector<int> free_slots;
   std::vector<double> free_k;                         // the shared block
@@ -754,6 +784,8 @@ struct JointProblem {
                const std::vector<internal::StartCamera>& starts, const Intrinsics& start,
                const std::vector<int>& fixed)
       : reference_rotations(views.size()), poses(views.size()), k(FitLayout(start)) {
+    frames.reserve(views.size());  // the costs hold references to the frames' points
+    for (const auto& view : views) frames.emplace_back(view.points_in_world);
     for (int slot = 0; slot < kFitIntrinsicsSize; ++slot) {
       if (std::find(fixed.begin(), fixed.end(), slot) == fixed.end()) {
         free_slots.push_back(slot);
@@ -763,9 +795,11 @@ struct JointProblem {
     for (size_t i = 0; i < views.size(); ++i) {
       const internal::StartCamera& camera = starts[i];
       reference_rotations[i] = camera.rotation;
-      poses[i] = {0.0, 0.0, 0.0, camera.center.x(), camera.center.y(), camera.center.z()};
-      problem.AddResidualBlock(new ViewCost(views[i], reference_rotations[i], k, free_slots),
-                               nullptr, poses[i].data(), free_k.data());
+      const Eigen::Vector3d center = frames[i].InFrame(camera.center);
+      poses[i] = {0.0, 0.0, 0.0, center.x(), center.y(), center.z()};
+      problem.AddResidualBlock(
+          new ViewCost(views[i], frames[i], reference_rotations[i], k, free_slots), nullptr,
+          poses[i].data(), free_k.data());
     }
   }
 
@@ -773,6 +807,9 @@ struct JointProblem {
     Eigen::Matrix3d exp_w;
     ExpWithLeftJacobian(poses[view].data(), &exp_w, nullptr);
     return exp_w * reference_rotations[view];
+  }
+  Eigen::Vector3d CenterInFrame(size_t view) const {
+    return Eigen::Vector3d(poses[view][3], poses[view][4], poses[view][5]);
   }
 
   // DENSE_SCHUR with the poses eliminated first; throws kNumerical when Ceres fails.
@@ -823,20 +860,21 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
   residual_norms->assign(views.size(), {});
   double sum_squares = 0.0;
   for (size_t i = 0; i < views.size(); ++i) {
-    const std::array<double, kPoseSize>& pose = joint.poses[i];
+    const ViewFrame& frame = joint.frames[i];
     const Eigen::Matrix3d rotation = joint.CamFromWorldRotation(i);
+    const Eigen::Vector3d center = joint.CenterInFrame(i);
     CalibratedView view;
     view.name = ViewName(views[i], i);
     view.camera.image_size = options.image_size;
     view.camera.intrinsics = result->intrinsics;
-    const Eigen::Vector3d center(pose[3], pose[4], pose[5]);
-    view.camera.cam_from_world = CamFromWorldFromCenter(rotation, center);
+    view.camera.cam_from_world = CamFromWorldFromCenter(rotation, frame.InWorld(center));
     view.num_points = static_cast<int>(views[i].pixels.size());
     double view_sum = 0.0;
     double min_depth = std::numeric_limits<double>::infinity(), max_depth = 0.0;
     for (size_t j = 0; j < views[i].pixels.size(); ++j) {
       double residual[2];
-      const Eigen::Vector3d point_in_cam = rotation * (views[i].points_in_world[j] - center);
+      // In the frame's unit: the pixel as the joint fit saw it (scaling the unit out is exact).
+      const Eigen::Vector3d point_in_cam = rotation * (frame.points[j] - center);
       if (!(point_in_cam.z() > 0.0)) {
         throw SceneError(SceneError::Reason::kPointsBehindCamera,
                          view.name + ": point " + std::to_string(j + 1) +
@@ -847,8 +885,8 @@ double AssembleViews(const std::vector<CalibrationView>& views, const JointProbl
                                    nullptr, nullptr);
       view_sum += residual[0] * residual[0] + residual[1] * residual[1];
       (*residual_norms)[i].push_back(std::hypot(residual[0], residual[1]));
-      min_depth = std::min(min_depth, point_in_cam.z());
-      max_depth = std::max(max_depth, point_in_cam.z());
+      min_depth = std::min(min_depth, frame.unit * point_in_cam.z());
+      max_depth = std::max(max_depth, frame.unit * point_in_cam.z());
     }
     view.camera.z_near = min_depth / (1.0 + kDepthMargin);
     view.camera.z_far = max_depth * (1.0 + kDepthMargin);
