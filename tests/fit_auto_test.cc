@@ -1406,23 +1406,34 @@ TEST(FitAutoTest, RandomPixelsAreRefused) {
   }
 }
 
-// --keep-all: the mis-click is kept and the scene refused by the gate, naming it.
+// --keep-all: the mis-click is kept and the scene refused, by the gate naming it. Least squares
+// spreads a mis-click over its neighbours, so it is among the worst three named, not
+// necessarily the first. 120 px on one of 10 clicks can also turn the best linear camera's view
+// of some points around (refused before the gate as points behind it, as in 1 of the 20 seeds
+// here); the bound below allows that in up to a quarter of the scenes.
 TEST(FitAutoTest, KeepAllRefusesAContaminatedSceneNamingTheWorstPoint) {
-  SynthScene scene = Clicks(3, 10);
-  std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
-  pixels[4].x() += 120.0;
-  AutoFitOptions options;
-  options.find_outliers = false;
-  options.point_names = {"a", "b", "c", "d", "e", "f", "g", "h", "i", "j"};
-  try {
-    Auto(scene.correspondences.points_in_world, pixels, options);
-    ADD_FAILURE() << "answered";
-  } catch (const SceneError& e) {
-    EXPECT_EQ(e.reason(), SceneError::Reason::kInconsistent);
-    // Least squares spreads a mis-click over its neighbours, so it is among the worst three
-    // named, not necessarily the first.
-    EXPECT_NE(std::string(e.what()).find("e ("), std::string::npos) << e.what();
+  constexpr int kSeeds = 20;
+  int named = 0;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    SynthScene scene = Clicks(seed, 10);
+    std::vector<Eigen::Vector2d> pixels = scene.correspondences.pixels;
+    pixels[4].x() += pixels[4].x() < 960.0 ? 120.0 : -120.0;
+    AutoFitOptions options;
+    options.find_outliers = false;
+    options.point_names = {"a", "b", "c", "d", "e", "f", "g", "h", "i", "j"};
+    try {
+      const FitResult fit = Auto(scene.correspondences.points_in_world, pixels, options);
+      ADD_FAILURE() << "seed " << seed << ": answered " << fit.model << ", rms " << fit.rms_px;
+    } catch (const SceneError& e) {
+      if (e.reason() == SceneError::Reason::kInconsistent) {
+        EXPECT_NE(std::string(e.what()).find("e ("), std::string::npos) << e.what();
+        ++named;
+      } else {
+        EXPECT_EQ(e.reason(), SceneError::Reason::kPointsBehindCamera) << e.what();
+      }
+    }
   }
+  EXPECT_GE(named, kSeeds * 3 / 4);
 }
 
 // A non-finite point is named as the user named it (its id in the points file), or numbered from

@@ -1,5 +1,6 @@
 #include "camproj/synth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -17,6 +18,9 @@ using internal::Require;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// A box face is used where it faces the eye at more than this cosine from its normal (84
+// degrees): a face seen edge-on squeezes its points onto a line in the image.
+constexpr double kMinFaceCosine = 0.1;
 
 // Uniform and standard normal draws from the raw 64-bit engine, so the numbers do not depend on
 // the standard library's distribution implementations.
@@ -68,6 +72,24 @@ SynthObject SynthObjectFromString(const std::string& text) {
   throw std::invalid_argument("object must be cloud, box or plane, got \"" + text + "\"");
 }
 
+// A point on a face of the box with half extents `half`, and that face's outward normal.
+Eigen::Vector3d DrawBoxPoint(std::mt19937_64& rng, const Eigen::Vector3d& half,
+                             Eigen::Vector3d* normal) {
+  Eigen::Vector3d x = UniformVector3(rng, -1, 1);
+  const int axis = static_cast<int>(rng() % 3);
+  x[axis] = x[axis] < 0 ? -1.0 : 1.0;
+  *normal = Eigen::Vector3d::Zero();
+  (*normal)[axis] = x[axis];
+  return x.cwiseProduct(half);
+}
+
+// Whether the eye sees the face with this outward normal at more than kMinFaceCosine from its
+// centre (then every point of the face is in front of it).
+bool FaceSeen(const Eigen::Vector3d& normal, const Eigen::Vector3d& half, const Eigen::Vector3d& eye) {
+  const Eigen::Vector3d to_eye = eye - normal.cwiseProduct(half);
+  return normal.dot(to_eye) > kMinFaceCosine * to_eye.norm();
+}
+
 SynthScene SynthesizeScene(const SynthOptions& options) {
   options.Check();
   std::mt19937_64 rng(options.seed);
@@ -88,6 +110,7 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
   const Eigen::Vector3d half = 0.5 * options.object_size * Eigen::Vector3d(1.0, 0.6, 0.8);
   std::vector<Eigen::Vector3d> points;
   points.reserve(options.num_points);
+  std::vector<Eigen::Vector3d> face_normals;  // the box's: each point's face
   Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitY();
   if (options.object == SynthObject::kPlane) {
     // A plane through the origin tilted 25..60 degrees away from facing the camera.
@@ -98,24 +121,28 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
   const Eigen::Vector3d plane_u = plane_normal.unitOrthogonal();
   const Eigen::Vector3d plane_v = plane_normal.cross(plane_u);
   while (static_cast<int>(points.size()) < options.num_points) {
-    Eigen::Vector3d x = UniformVector3(rng, -1, 1);
+    if (options.object == SynthObject::kBox) {
+      // Keep the point if its face looks towards the eye's direction (and, below, once the
+      // eye's distance is known, if the eye sees it).
+      Eigen::Vector3d normal;
+      const Eigen::Vector3d x = DrawBoxPoint(rng, half, &normal);
+      if (normal.dot(to_eye) <= kMinFaceCosine) continue;
+      points.push_back(x);
+      face_normals.push_back(normal);
+      continue;
+    }
+    const Eigen::Vector3d x = UniformVector3(rng, -1, 1);
     if (options.object == SynthObject::kCloud) {
       points.push_back(x.cwiseProduct(half));
-    } else if (options.object == SynthObject::kPlane) {
-      points.push_back(0.5 * options.object_size * (x.x() * plane_u + x.y() * plane_v));
     } else {
-      // Push the point onto one face of the box; keep it if that face looks towards the eye.
-      const int axis = static_cast<int>(rng() % 3);
-      x[axis] = x[axis] < 0 ? -1.0 : 1.0;
-      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-      normal[axis] = x[axis];
-      if (normal.dot(to_eye) <= 0.1) continue;
-      points.push_back(x.cwiseProduct(half));
+      points.push_back(0.5 * options.object_size * (x.x() * plane_u + x.y() * plane_v));
     }
   }
 
   // Aim the image centre's ray (not the optical axis: the principal point may be off-centre)
   // at the object's centre, with the world's y up, then back off until every point is inside.
+  // Near the box the eye can be inside a face's slab, where that face is hidden (13 % of the
+  // points at fovy 40, 54 % at 150): such points are drawn again on faces the eye sees.
   const Eigen::Vector3d centre_ray =
       CamRayFromPixel(k, Eigen::Vector2d(0.5 * (size.width - 1), 0.5 * (size.height - 1))).normalized();
   const Eigen::Matrix3d tilt_to_centre_ray =
@@ -143,7 +170,28 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
         break;
       }
     }
-    if (inside) break;
+    if (!inside) {
+      distance *= 1.05;
+      continue;
+    }
+    bool redrawn = false;
+    const auto seen = [&](const Eigen::Vector3d& normal) {
+      return FaceSeen(normal, half, look_at.eye);
+    };
+    for (size_t i = 0; i < face_normals.size(); ++i) {
+      if (seen(face_normals[i])) continue;
+      if (!seen(Eigen::Vector3d::UnitX()) && !seen(-Eigen::Vector3d::UnitX()) &&
+          !seen(Eigen::Vector3d::UnitY()) && !seen(-Eigen::Vector3d::UnitY()) &&
+          !seen(Eigen::Vector3d::UnitZ()) && !seen(-Eigen::Vector3d::UnitZ())) {
+        break;  // the eye is inside the box: back off
+      }
+      do {
+        points[i] = DrawBoxPoint(rng, half, &face_normals[i]);
+      } while (!seen(face_normals[i]));
+      redrawn = true;
+    }
+    if (redrawn) continue;  // the new points must be inside the image too
+    if (std::all_of(face_normals.begin(), face_normals.end(), seen)) break;
     distance *= 1.05;
   }
 

@@ -16,7 +16,8 @@ namespace camproj {
 
 enum class SynthObject {
   kCloud,  // points filling a box volume (non-planar)
-  kBox,    // points on the three faces of a box that face the camera (projection mapping)
+  kBox,    // points on the faces of a box the eye sees, each at more than 0.1 cosine from the
+           // face's normal at its centre (projection mapping)
   kPlane,  // points on one plane, tilted against the view
 };
 
