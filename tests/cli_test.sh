@@ -111,6 +111,20 @@ case $case in
     expect_in out "model: pose, 6 free parameters"
     expect_in out "given: pose only"
     ;;
+  fit_fovy_fixes_the_field_of_view)
+    # --fovy fixes fy (and fx = fy at aspect 1) in the automatic model too: the ladder freed the
+    # aspect, and so fy, writing 45.09 degrees for --fovy 45.5.
+    for model in auto principal-point; do
+      expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --fovy 45.5 \
+        --model "$model" -o "$work/fovy.json"
+      py - "$work/fovy.json" <<'PY' || fail "--model $model: the field of view is not --fovy's"
+import json, math, sys
+k = json.load(open(sys.argv[1]))["intrinsics"]
+fovy = 2 * math.degrees(math.atan(400 / k["fy"]))
+sys.exit(0 if abs(fovy - 45.5) < 1e-12 and k["fx"] == k["fy"] else 1)
+PY
+    done
+    ;;
   fit_bad_csv_names_line_and_column)
     printf 'X,Y,Z,u,v\n1,2,3,4,5\n1,2,abc,4,5\n' >"$work/bad.csv"
     expect_exit 2 "$bin" fit "$work/bad.csv" --image-size 640x480

@@ -232,7 +232,9 @@ void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool au
     const double fy = 0.5 * size.height / std::tan(0.5 * args.fovy_deg * M_PI / 180.0);
     const double aspect = args.aspect > 0.0 ? args.aspect : 1.0;
     options.focal = ParameterMode::Fixed(fy / aspect);
-    if (options.aspect.IsFree()) options.aspect = ParameterMode::Default();
+    // Fixed, not the default: in --model auto the default lets the ladder free the aspect, and
+    // fy, so the field of view (45.09 degrees written for --fovy 45.5).
+    options.aspect = ParameterMode::Fixed(aspect);
   }
   if (args.principal_point) {
     options.principal_point = ParameterMode::Fixed(args.principal_point->x(), args.principal_point->y());
