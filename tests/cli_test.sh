@@ -94,6 +94,10 @@ case $case in
     expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --json
     expect_in out '"rms_px"'
     expect_in out '"cam_from_world"'
+    # With --trace the trace goes to stderr: stdout stays one JSON document.
+    expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --json --trace
+    py -c 'import json, sys; json.load(open(sys.argv[1]))' "$work/out" || fail "stdout is not one JSON document"
+    expect_in err "iteration"
     ;;
   fit_planar_refused_then_fixed)
     expect_exit 3 "$bin" fit "$data/plane/points.csv" --image-size 1280x720 --model focal+aspect+principal-point -o "$work/cam.json"

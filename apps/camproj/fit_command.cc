@@ -323,7 +323,7 @@ void AddInputOutputOptions(CLI::App* app, FitArgs* args) {
   app->add_flag("--json", args->json,
                 "print the camera file to stdout instead of the summary; in batch mode one JSON "
                 "object per input and line (file, status, exit_code, detail, camera_file)");
-  app->add_flag("--trace", args->trace, "also print the per-iteration error against time");
+  app->add_flag("--trace", args->trace, "also print the per-iteration error against time (on stderr with --json)");
   app->add_option("--report", args->report_path,
                   "also write plots of the fit, drawn by camproj: .svg (residual per point, "
                   "residuals over the image, the models tried with their criterion) or .html "
@@ -433,7 +433,8 @@ void PrintNotes(const FitRequest& request, const FitResult& fit) {
 }
 
 // One points file: fits it, writes the camera file and the report asked for, prints the summary
-// (or the camera file with --json) and the trace.
+// (or the camera file with --json) and the trace (on stderr with --json: stdout stays one JSON
+// document).
 int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest& request,
                const FitArgs& args) {
   const auto begin = std::chrono::steady_clock::now();
@@ -484,7 +485,7 @@ int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest
     std::printf("wall time: %.3f ms (reading %zu points, fitting, writing)\n", wall_ms,
                 data.pixels.size());
   }
-  if (args.trace) std::cout << FitTraceText(fit);
+  if (args.trace) (args.json ? std::cerr : std::cout) << FitTraceText(fit);
   return kExitOk;
 }
 
