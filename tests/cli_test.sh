@@ -421,6 +421,14 @@ PY
     expect_in out "^note: near .*cover the fitted points' depths only, widened by 10 %.*--bounds"
     # The points file has no ids: its row numbers name the points, as "point N" in sentences.
     expect_in out "^reliability: least checked: point [0-9]*, "
+    # One plane given: it as given, the other from the points (the note said both were).
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --near 1.2
+    expect_in out "^note: near 1.2, far .*: near as given (--near); far covers the fitted points' depths only, widened by 10 %.*--far as well"
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --far 2
+    expect_in out "^note: near .*, far 2: far as given (--far); near covers the fitted points' depths only"
+    # A given plane past every point is refused with the answer's depths (1.317 to 1.794 m).
+    expect_exit 3 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --near 1.85
+    expect_in err "every point is nearer than the given near plane 1.85: the fitted camera sees the points at depths 1.31"
     # --bounds-mesh: the box's 8 corners' depths, widened by 10 % (docs: the fit's margin rule),
     # checked against the written camera to 1e-12 relative (the same doubles, a few roundings).
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \

@@ -15,6 +15,7 @@
 #include "camproj/camera_file.h"
 #include "camproj/fit_request.h"
 #include "camproj/model_select.h"
+#include "camproj/number_text.h"
 #include "camproj/synth.h"
 #include "seeds.h"
 #include "test_scenes.h"
@@ -427,10 +428,15 @@ TEST(FitTest, AGivenNearOrFarPastEveryPointIsRefused) {
   const FitResult free = FitCamera(scene.points_in_world, scene.observed_pixels, camera.size);
   const double nearest = free.camera.z_near * 1.1;
   const double farthest = free.camera.z_far / 1.1;
-  for (const bool near_given : {true, false}) {
+  // Past every point by far, and only just: a near plane between the farthest point and the
+  // tight far plane (1.1 x its depth), or a far plane between the tight near plane and the
+  // nearest point, made a frustum that held no point (answered, exit 0).
+  for (const auto& [near_given, factor] : {std::pair<bool, double>{true, 2.0}, {true, 1.05},
+                                           {false, 0.5}, {false, 1.0 / 1.05}}) {
+    SCOPED_TRACE(std::string(near_given ? "near" : "far") + " x " + ShortestDouble(factor));
     FitOptions options;
-    if (near_given) options.z_near = 2.0 * farthest;
-    else options.z_far = 0.5 * nearest;
+    if (near_given) options.z_near = factor * farthest;
+    else options.z_far = factor * nearest;
     try {
       FitCamera(scene.points_in_world, scene.observed_pixels, camera.size, options);
       ADD_FAILURE() << "not refused";
@@ -450,6 +456,38 @@ TEST(FitTest, AGivenNearOrFarPastEveryPointIsRefused) {
     } catch (const SceneError& e) {
       EXPECT_EQ(e.reason(), SceneError::Reason::kPointsBehindCamera) << e.what();
     }
+  }
+  // In the automatic model the planes are the answer's: the same camera as without them (the
+  // selection judged its candidates with the given planes, refusing those whose depths they did
+  // not hold), the given plane as given and the other tight around the answer's points.
+  AutoFitOptions tight;
+  const FitResult answer =
+      FitCameraAuto(scene.points_in_world, scene.observed_pixels, camera.size, tight);
+  const double answer_nearest = answer.camera.z_near * 1.1;
+  const double answer_farthest = answer.camera.z_far / 1.1;
+  for (const bool near_given : {true, false}) {
+    AutoFitOptions given = tight;
+    if (near_given) given.fit.z_near = 0.5 * (answer_nearest + answer_farthest);
+    else given.fit.z_far = 0.5 * (answer_nearest + answer_farthest);
+    const FitResult fit =
+        FitCameraAuto(scene.points_in_world, scene.observed_pixels, camera.size, given);
+    EXPECT_EQ(fit.model, answer.model);
+    EXPECT_EQ(fit.camera.cam_from_world.rotation, answer.camera.cam_from_world.rotation);
+    EXPECT_EQ(fit.camera.cam_from_world.translation, answer.camera.cam_from_world.translation);
+    EXPECT_EQ(fit.rms_px, answer.rms_px);
+    // The tight plane from the points' depths in the world's frame rather than the fit's:
+    // rounding of ~1e-16 relative.
+    if (near_given) {
+      EXPECT_EQ(fit.camera.z_near, *given.fit.z_near);
+      EXPECT_NEAR(fit.camera.z_far, answer.camera.z_far, 1e-12 * answer.camera.z_far);
+    } else {
+      EXPECT_EQ(fit.camera.z_far, *given.fit.z_far);
+      EXPECT_NEAR(fit.camera.z_near, answer.camera.z_near, 1e-12 * answer.camera.z_near);
+    }
+    // The views are the camera's with its planes.
+    ASSERT_TRUE(fit.views.frustum.has_value());
+    EXPECT_EQ(fit.views.frustum->z_near, fit.camera.z_near);
+    EXPECT_EQ(fit.views.frustum->z_far, fit.camera.z_far);
   }
   FitOptions both;
   both.z_near = 2.0 * farthest;

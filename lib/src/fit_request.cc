@@ -420,6 +420,14 @@ std::string NearFarNote(const FitRequest& request, const FitResult& fit) {
     return range + std::string("cover the --bounds box (its 8 corners' depths") + margin + ")" +
            (options.z_near ? "; near as given" : options.z_far ? "; far as given" : "") + "\n";
   }
+  if (options.z_near || options.z_far) {
+    const std::string given = options.z_near ? "near as given (--near); far covers"
+                                             : "far as given (--far); near covers";
+    return range + given + " the fitted points' depths only" + margin +
+           ": the rest of the model may be clipped: give --bounds X0,Y0,Z0,X1,Y1,Z1 or "
+           "--bounds-mesh model.obj (or .ply) to cover it, or " +
+           (options.z_near ? "--far" : "--near") + " as well\n";
+  }
   return range + std::string("cover the fitted points' depths only") + margin +
          "; the rest of the model may be clipped: give --bounds X0,Y0,Z0,X1,Y1,Z1 or "
          "--bounds-mesh model.obj (or .ply) to cover it, or --near/--far\n";

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "check.h"
+#include "fit/assess.h"
 #include "fit/candidate.h"
 #include "fit/closed_form.h"
 #include "fit/common.h"
@@ -755,7 +756,18 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
           " points");
   internal::CheckCorrespondences(points_in_world, observed_pixels, options.point_names);
   try {
-    FitResult result = Pipeline(points_in_world, observed_pixels, image_size, options).Run(start);
+    FitResult result;
+    if (options.fit.z_near || options.fit.z_far) {
+      // The given planes are the answer's: the candidates are judged with tight ones (a given
+      // plane refused those whose depths it did not hold, and named their depths).
+      AutoFitOptions tight = options;
+      tight.fit.z_near.reset();
+      tight.fit.z_far.reset();
+      result = Pipeline(points_in_world, observed_pixels, image_size, tight).Run(start);
+      internal::SetGivenDepthRange(options.fit, points_in_world, &result);
+    } else {
+      result = Pipeline(points_in_world, observed_pixels, image_size, options).Run(start);
+    }
     RequireRepresentableCamera(result.camera);
     return result;
   } catch (const SceneError&) {

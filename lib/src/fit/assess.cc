@@ -394,13 +394,35 @@ CameraViews ViewsOfFittedCamera(const Camera& camera, double target_distance) {
   }
 }
 
+void SetGivenDepthRange(const FitOptions& options, const std::vector<Eigen::Vector3d>& points_in_world,
+                        FitResult* fit) {
+  if (!options.z_near && !options.z_far) return;
+  Camera& camera = fit->camera;
+  std::vector<double> depths;
+  for (size_t i = 0; i < points_in_world.size(); ++i) {
+    if (std::find(fit->outliers.begin(), fit->outliers.end(), static_cast<int>(i)) != fit->outliers.end()) {
+      continue;
+    }
+    depths.push_back((camera.cam_from_world * points_in_world[i]).z());
+  }
+  const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
+  const DepthRange range = DepthRangeOfPoints(options, *min_depth, *max_depth);
+  camera.z_near = range.z_near;
+  camera.z_far = range.z_far;
+  const CameraViews& views = fit->views;
+  fit->views = ViewsOfFittedCamera(camera, (views.look_at.target - views.look_at.eye).stableNorm());
+}
+
 DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, double max_depth) {
   DepthRange range;
   range.z_near = options.z_near.value_or(min_depth / (1.0 + options.depth_margin));
   range.z_far = options.z_far.value_or(max_depth * (1.0 + options.depth_margin));
-  if (range.z_far > range.z_near) return range;
-  // FitOptions::Check orders two given planes, so one is unset here and the given one is past
-  // every point: the tight plane would fall on its wrong side.
+  // FitOptions::Check orders two given planes. One given alone clips every point where it is
+  // past them all; the tight plane then falls on its wrong side, or (a given near plane
+  // between the farthest point and the tight far plane) a frustum holds none of them.
+  const bool near_past_every_point = options.z_near && !options.z_far && !(*options.z_near < max_depth);
+  const bool far_before_every_point = options.z_far && !options.z_near && !(*options.z_far > min_depth);
+  if (range.z_far > range.z_near && !near_past_every_point && !far_before_every_point) return range;
   const std::string depths = Concat(": the fitted camera sees the points at depths ",
                                     GeneralDouble(min_depth, 6), " to ",
                                     GeneralDouble(max_depth, 6), ", so its frustum would clip "

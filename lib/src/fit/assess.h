@@ -36,8 +36,16 @@ struct DepthRange {
 // The depth range of a fitted camera whose points lie at depths min_depth..max_depth: a given
 // FitOptions::z_near / z_far as given, an unset one tight around the points (widened by
 // depth_margin). Throws SceneError kPointsBehindCamera where a given plane has every point on
-// its far side and the other plane is unset (no range could then hold a point).
+// its far side and the other plane is unset (the frustum would clip every point).
 DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, double max_depth);
+
+// Sets the given FitOptions::z_near / z_far (if any) on a fitted camera, the other plane tight
+// around the depths of the points not in fit->outliers, and its views again
+// (DepthRangeOfPoints; throws as it does). The automatic selection judges its candidates with
+// tight planes and sets the given ones on its answer here: a plane is the answer's, and in each
+// candidate's assessment it refused candidates whose depths it did not hold.
+void SetGivenDepthRange(const FitOptions& options, const std::vector<Eigen::Vector3d>& points_in_world,
+                        FitResult* fit);
 
 }  // namespace internal
 }  // namespace camproj
