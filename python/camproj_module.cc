@@ -318,7 +318,7 @@ const std::map<std::string, OptionReader>& OptionReaders() {
        [](const OptionValue& v, FitArguments& a) {
          if (const auto path = PathOf(v.value())) {
            CorrespondencesLimits limits;  // as --object-points reads its file: pixels optional
-           limits.require_pixels = false;
+           limits.read_pixels = false;
            a.object_points_in_world = ReadCorrespondencesFile(*path, limits).points_in_world;
          } else {
            a.object_points_in_world = Rows<3>(v.value(), "object_points_in_world");

@@ -654,6 +654,20 @@ PY
     [[ $(wc -l <"$work/out") -eq 21 ]] || fail "expected 20 rows"
     printf 'X,Y,Z\n0,0,0\n' >"$work/xyz.csv"
     expect_exit 0 "$bin" project "$data/projector/truth.json" "$work/xyz.csv"
+    # Its own output reads back (u, v are not read: a point behind the camera has them empty,
+    # which was "expected a number").
+    py - "$data/projector/truth.json" "$work/ids.csv" <<'PY'
+import json, sys
+pose = json.load(open(sys.argv[1]))["cam_from_world"]
+R, t = pose["R"], pose["t"]
+eye = [-sum(R[r][c] * t[r] for r in range(3)) for c in range(3)]
+with open(sys.argv[2], "w") as f:  # the origin, and a point as far behind the eye
+    f.write("id,X,Y,Z\nfront,0,0,0\nbehind,%r,%r,%r\n" % tuple(2 * e for e in eye))
+PY
+    "$bin" project "$data/projector/truth.json" "$work/ids.csv" >"$work/projected.csv" || fail "project"
+    grep -q '^behind,.*,,,' "$work/projected.csv" || fail "the point behind has pixels: $(cat "$work/projected.csv")"
+    expect_exit 0 "$bin" project "$data/projector/truth.json" "$work/projected.csv"
+    cmp -s "$work/out" "$work/projected.csv" || fail "project of its own output differs"
     ;;
   convert_round_trip)
     expect_exit 0 "$bin" convert --intrinsics 1000,1000,959.5,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum

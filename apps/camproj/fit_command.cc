@@ -174,7 +174,7 @@ FitRequest RequestFrom(const FitArgs& args, const ImageSize& size) {
       arguments.object_points_in_world = {Eigen::Vector3d::Zero()};
       FitRequestFrom(arguments, size);
       CorrespondencesLimits limits;
-      limits.require_pixels = false;
+      limits.read_pixels = false;
       arguments.object_points_in_world =
           ReadCorrespondencesFile(args.object_points_path, limits).points_in_world;
     }

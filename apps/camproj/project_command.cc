@@ -44,7 +44,7 @@ Command AddProjectCommand(CLI::App& root) {
                                       ? ReadCameraFile(args->camera_path)
                                       : ReadCalibrationView(args->camera_path, args->view);
             CorrespondencesLimits limits;
-            limits.require_pixels = false;
+            limits.read_pixels = false;
             const Correspondences points = ReadCorrespondencesFile(args->points_path, limits);
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             std::cout << "id,X,Y,Z,u,v,depth\n";

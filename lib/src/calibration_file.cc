@@ -6,6 +6,7 @@
 
 #include "camproj/look_at.h"
 #include "camproj/number_text.h"
+#include "camproj/points_file.h"
 
 namespace camproj {
 
@@ -81,23 +82,6 @@ std::string CalibrationToJsonText(const Calibration& calibration,
   file["outliers"] = outliers;
   return file.dump(2) + "\n";
 }
-
-namespace {
-
-// A CSV field as RFC 4180 writes it: quoted, its quotes doubled, where it holds a comma, a quote
-// or a line break (a view named by its file, "a,b.csv", made a row of 23 fields before session
-// 37); as it is otherwise.
-std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
-
-}  // namespace
 
 std::string CalibrationPosesCsvText(const Calibration& calibration,
                                     const CameraFileOptions& options) {

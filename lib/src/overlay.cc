@@ -13,6 +13,7 @@
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/image_header.h"
+#include "camproj/points_file.h"
 #include "check.h"
 #include "drawing.h"
 #include "image_codecs.h"
@@ -558,13 +559,7 @@ std::string OverlayLabelsCsv(const OverlayStats& stats) {
   out.precision(10);
   out << "id,kind,u,v,left,top,width,height,residual_px\n";
   for (const OverlayLabel& l : stats.labels) {
-    std::string id = l.id;
-    if (id.find_first_of(",\"\n\r") != std::string::npos) {
-      std::string quoted = "\"";
-      for (char c : id) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-      id = quoted + "\"";
-    }
-    out << id << ',' << l.kind << ',' << l.anchor.x() << ',' << l.anchor.y() << ',' << l.box[0]
+    out << CsvField(l.id) << ',' << l.kind << ',' << l.anchor.x() << ',' << l.anchor.y() << ',' << l.box[0]
         << ',' << l.box[1] << ',' << l.box[2] << ',' << l.box[3] << ',' << l.residual_px << '\n';
   }
   return out.str();

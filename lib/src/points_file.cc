@@ -185,9 +185,7 @@ class CsvParser {
                          " is also " + Printable(fields_[i]));
       }
     }
-    // Without required pixels, u and v may be absent together (a points-only file).
-    has_pixels_ = limits_.require_pixels || index_of_name.count("u") > 0 ||
-                  index_of_name.count("v") > 0;
+    has_pixels_ = limits_.read_pixels;
     std::string missing;
     int missing_count = 0;
     for (size_t c = 0; c < (has_pixels_ ? kRequiredColumns.size() : 3); ++c) {
@@ -476,6 +474,16 @@ std::string CorrespondencesToCsvText(const Correspondences& correspondences) {
     text += '\n';
   }
   return text;
+}
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
 }
 
 }  // namespace camproj

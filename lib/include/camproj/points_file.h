@@ -47,8 +47,10 @@ struct Correspondences {
 struct CorrespondencesLimits {
   size_t max_line_bytes = size_t{1} << 20;  // per line, without the line ending
   size_t max_points = 50'000'000;           // data rows
-  // false: a file without both u and v columns is read as points only, with pixels (0, 0).
-  bool require_pixels = true;
+  // false: the file is read as points only, with pixels (0, 0): u and v columns are neither
+  // required nor read (a point with an empty u, as `camproj project` writes one behind the
+  // camera, is a point).
+  bool read_pixels = true;
   void Check() const;  // throws std::invalid_argument unless both are positive
 };
 
@@ -103,6 +105,11 @@ void CheckPointIds(const std::vector<std::string>& ids);
 // bit for bit. line_numbers is ignored. Throws std::invalid_argument when the sizes disagree,
 // there are no points, a value is not finite, or an id would not read back (CheckPointIds).
 std::string CorrespondencesToCsvText(const Correspondences& correspondences);
+
+// A field of a CSV file camproj writes (overlay's labels, calibrate's poses) as RFC 4180 writes
+// it: quoted, its quotes doubled, where it holds a comma, a quote or a line break; as it is
+// otherwise. (Points files are read unquoted: see CorrespondencesFromCsvText.)
+std::string CsvField(const std::string& text);
 
 }  // namespace camproj
 
