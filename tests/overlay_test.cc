@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include "camproj/errors.h"
 #include "camproj/file_io.h"
 #include "camproj/points_file.h"
+#include "camproj/pose.h"
 
 namespace camproj {
 namespace {
@@ -129,6 +131,46 @@ TEST(OverlayTest, ObservedPixelsOutsideTheImageBecomeArrowsAtTheBorder) {
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
   EXPECT_FALSE(image.empty());
   fs::remove_all(path.parent_path());
+}
+
+// A point outside the image keeps what else it is in its label (an outlier, behind the camera:
+// "outside" overwrote both), and its position, like the labels file's, is in the user's pixel
+// convention (the corner convention's were written in the centre's).
+TEST(OverlayTest, LabelsOfPointsOutsideTheImageSayWhatTheyAreInTheUsersConvention) {
+  Scene scene = Projector();
+  // kCenter pixels a quarter pixel off the whole ones: the corner convention's are a half on.
+  scene.points.pixels[0] = Eigen::Vector2d(-300.25, 500.25);
+  scene.points.pixels[1] = Eigen::Vector2d(2500.0, 400.0);
+  scene.points.points_in_world[2] = 3.0 * CameraCenterInWorld(scene.camera.cam_from_world);
+  scene.points.pixels[2] = Eigen::Vector2d(100.25, -200.25);
+  OverlayOptions options;
+  options.outliers = {1};
+  options.pixel_origin = PixelOrigin::kCorner;
+  const OverlayStats stats =
+      DrawOverlayImage(scene.camera, scene.points, options, ImageFormat::kPng).stats;
+  EXPECT_EQ(stats.outside, 3);
+  const std::vector<OverlayLabel>& labels = stats.labels;
+  EXPECT_EQ(labels[0].text, labels[0].id + " (at -300, 501)");  // -299.75, 500.75
+  EXPECT_EQ(labels[1].text.rfind(labels[1].id + " (at 2500, 400; ", 0), 0u) << labels[1].text;
+  EXPECT_EQ(labels[1].kind, "outside");
+  EXPECT_NE(labels[1].text.find(" px off)"), std::string::npos) << labels[1].text;
+  EXPECT_EQ(labels[2].text, labels[2].id + " (at 101, -200; behind)");  // 100.75, -199.75
+  // The labels file: u, v and left, top half a pixel on from the (kCenter) labels, to its 10
+  // significant digits (5e-7 px at 1e3 px).
+  constexpr double kCsvPx = 1e-6;
+  std::istringstream csv(OverlayLabelsCsv(stats, PixelOrigin::kCorner));
+  std::string line;
+  std::getline(csv, line);
+  for (size_t i = 0; std::getline(csv, line); ++i) {
+    std::vector<double> values;
+    std::istringstream fields(line.substr(line.find(',', line.find(',') + 1) + 1));
+    for (std::string field; std::getline(fields, field, ',');) values.push_back(std::stod(field));
+    ASSERT_EQ(values.size(), 7u) << line;
+    EXPECT_NEAR(values[0], labels[i].anchor.x() + 0.5, kCsvPx) << line;
+    EXPECT_NEAR(values[1], labels[i].anchor.y() + 0.5, kCsvPx) << line;
+    EXPECT_NEAR(values[2], labels[i].box[0] + 0.5, kCsvPx) << line;
+    EXPECT_NEAR(values[3], labels[i].box[1] + 0.5, kCsvPx) << line;
+  }
 }
 
 // A reprojection 2^28 px away: its residual line runs to the image's edge along the true

@@ -74,6 +74,7 @@ Command AddOverlayCommand(CLI::App& root) {
             options.magnify = args->magnify;
             options.background_path = args->image_path;
             options.outliers = OutlierIndicesFromJsonText(camera_text, args->camera_path);
+            options.pixel_origin = origin;
             OverlayPicture picture;
             try {
               picture = DrawOverlayImage(camera, points, options, ImageFormatOfPath(args->output_path));
@@ -83,7 +84,7 @@ Command AddOverlayCommand(CLI::App& root) {
             const OverlayStats& stats = picture.stats;
             std::vector<OutputFile> outputs = {{args->output_path, picture.encoded, "-o"}};
             if (!args->labels_path.empty()) {
-              outputs.push_back({args->labels_path, OverlayLabelsCsv(stats), "--labels"});
+              outputs.push_back({args->labels_path, OverlayLabelsCsv(stats, origin), "--labels"});
             }
             WriteFilesAtomically(outputs);
             std::cout << "wrote " << args->output_path << " (" << stats.drawn << " points";

@@ -345,6 +345,7 @@ struct OverlayPoint {
   std::optional<Eigen::Vector2d> predicted;  // its reprojection (kCenter); none behind the camera
   double residual_px = -1.0;                 // |predicted - observed|; -1 without a reprojection
   std::string kind;                          // as OverlayLabel::kind
+  std::string kind_if_inside;                // what "outside" overrides: "point", "outlier", ...
   cv::Scalar colour;
   Eigen::Vector2d anchor;  // where its label goes: the observed pixel, or its border arrow's tip
   std::pair<Eigen::Vector2d, Eigen::Vector2d> arrow;  // kind "outside" only
@@ -400,6 +401,7 @@ std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Corresponden
       point.colour = Viridis(point.residual_px / colour_top);
       ++stats.drawn;
     }
+    point.kind_if_inside = point.kind;
     if (!inside(observed)) {
       point.kind = "outside";
       ++stats.outside;
@@ -435,23 +437,27 @@ void DrawMarkers(cv::Mat& image, const std::vector<OverlayPoint>& points,
 }
 
 // A point's label: its id (printable, cut to 24 characters), and for an outlier how far off it
-// is, for a point outside the image where it is.
+// is, for a point outside the image where it is (in `origin`'s convention) and whether it is an
+// outlier or behind the camera.
 std::string LabelText(const OverlayPoint& point, const std::string& id,
-                      const Eigen::Vector2d& observed) {
+                      const Eigen::Vector2d& observed, PixelOrigin origin) {
   std::string text = id;
   if (text.size() > 24) text = text.substr(0, 23) + "~";
   for (char& c : text) {
     if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
   }
-  if (point.kind == "outlier") text += " (" + FormatPx(point.residual_px) + " px off)";
-  if (point.kind == "behind") text += " (behind)";
-  if (point.kind == "no-pixel") text += " (no pixel)";
+  const std::string& kind = point.kind_if_inside;
+  std::string state;
+  if (kind == "outlier") state = FormatPx(point.residual_px) + " px off";
+  if (kind == "behind") state = "behind";
+  if (kind == "no-pixel") state = "no pixel";
   if (point.kind == "outside") {
-    char at[64];
-    std::snprintf(at, sizeof at, " (at %.0f, %.0f)", observed.x(), observed.y());
-    text += at;
+    const Eigen::Vector2d at = ConvertPixelOrigin(observed, PixelOrigin::kCenter, origin);
+    char where[64];
+    std::snprintf(where, sizeof where, "at %.0f, %.0f", at.x(), at.y());
+    state = state.empty() ? std::string(where) : std::string(where) + "; " + state;
   }
-  return text;
+  return state.empty() ? text : text + " (" + state + ")";
 }
 
 // The labels, placed around `anchors` (the points' OverlayPoint::anchor) clear of each other
@@ -460,14 +466,14 @@ std::string LabelText(const OverlayPoint& point, const std::string& id,
 void DrawLabels(cv::Mat& image, const std::vector<OverlayPoint>& points,
                 const std::vector<Eigen::Vector2d>& anchors,
                 const Correspondences& correspondences, const Box& legend_box, const Style& s,
-                OverlayStats* stats) {
+                PixelOrigin origin, OverlayStats* stats) {
   const int w = image.cols;
   const int h = image.rows;
   const size_t n = points.size();
   std::vector<std::string> texts(n);
   std::vector<cv::Size> sizes(n);
   for (size_t i = 0; i < n; ++i) {
-    texts[i] = LabelText(points[i], correspondences.ids[i], correspondences.pixels[i]);
+    texts[i] = LabelText(points[i], correspondences.ids[i], correspondences.pixels[i], origin);
     int baseline = 0;
     const cv::Size size =
         cv::getTextSize(texts[i], cv::FONT_HERSHEY_SIMPLEX, s.font_scale, s.text_thickness, &baseline);
@@ -496,6 +502,7 @@ void DrawLabels(cv::Mat& image, const std::vector<OverlayPoint>& points,
     label.anchor = point.kind == "outside" ? correspondences.pixels[i] : point.anchor;
     label.box = Eigen::Vector4d(b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
     label.residual_px = point.residual_px;
+    label.text = texts[i];
     stats->labels.push_back(label);
   }
 }
@@ -536,7 +543,7 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
   for (size_t i = 0; i < n; ++i) anchors[i] = points[i].anchor;
   const Box legend_box = DrawLegend(image, stats, anchors, s);
   DrawMarkers(image, points, correspondences, stats.magnify, s);
-  DrawLabels(image, points, anchors, correspondences, legend_box, s, &stats);
+  DrawLabels(image, points, anchors, correspondences, legend_box, s, options.pixel_origin, &stats);
 
   std::vector<uchar> encoded;
   const char* extension = format == ImageFormat::kPng ? ".png" : ".jpg";
@@ -554,13 +561,17 @@ OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& corr
   return std::move(picture.stats);
 }
 
-std::string OverlayLabelsCsv(const OverlayStats& stats) {
+std::string OverlayLabelsCsv(const OverlayStats& stats, PixelOrigin pixel_origin) {
   std::ostringstream out;
   out.precision(10);
   out << "id,kind,u,v,left,top,width,height,residual_px\n";
   for (const OverlayLabel& l : stats.labels) {
-    out << CsvField(l.id) << ',' << l.kind << ',' << l.anchor.x() << ',' << l.anchor.y() << ',' << l.box[0]
-        << ',' << l.box[1] << ',' << l.box[2] << ',' << l.box[3] << ',' << l.residual_px << '\n';
+    const Eigen::Vector2d anchor = ConvertPixelOrigin(l.anchor, PixelOrigin::kCenter, pixel_origin);
+    const Eigen::Vector2d top_left = ConvertPixelOrigin(Eigen::Vector2d(l.box[0], l.box[1]),
+                                                        PixelOrigin::kCenter, pixel_origin);
+    out << CsvField(l.id) << ',' << l.kind << ',' << anchor.x() << ',' << anchor.y() << ','
+        << top_left.x() << ',' << top_left.y() << ',' << l.box[2] << ',' << l.box[3] << ','
+        << l.residual_px << '\n';
   }
   return out.str();
 }

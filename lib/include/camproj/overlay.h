@@ -30,6 +30,9 @@ struct OverlayOptions {
   // 0-based indices of the points the fit left out (the camera file's fit.outliers;
   // OutlierIndicesFromJsonText): crossed rings, no residual line, not in the colour scale.
   std::vector<int> outliers;
+  // The convention of the user's pixels, in which a label writes one (the "(at u, v)" of a point
+  // outside the image); the correspondences' pixels are kCenter whatever it is.
+  PixelOrigin pixel_origin = PixelOrigin::kCenter;
   void Check() const;
 };
 
@@ -42,6 +45,7 @@ struct OverlayLabel {
   Eigen::Vector2d anchor;    // the marker the label belongs to, kCenter px
   Eigen::Vector4d box;       // the text's box: left, top, width, height in image px
   double residual_px = -1;   // |reprojected - observed|; -1 behind the camera or no pixel
+  std::string text;          // as drawn: "c4 (12 px off)", "c9 (at -300, 500; behind)"
 };
 
 struct OverlayStats {
@@ -75,8 +79,10 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
 OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
                                const OverlayOptions& options, const std::string& output_path);
 
-// The labels as CSV: id,kind,u,v,left,top,width,height,residual_px (u, v: the anchor, kCenter).
-std::string OverlayLabelsCsv(const OverlayStats& stats);
+// The labels as CSV: id,kind,u,v,left,top,width,height,residual_px; u, v (the anchor) and left,
+// top in `pixel_origin`'s convention.
+std::string OverlayLabelsCsv(const OverlayStats& stats,
+                             PixelOrigin pixel_origin = PixelOrigin::kCenter);
 
 }  // namespace camproj
 
