@@ -320,6 +320,12 @@ PY
     done
     expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --focal -1
     expect_in err "^--focal: must be positive, got -1"
+    # A seed is a uint64 as written: -1 was taken as 2^64 - 1, 2^64 and beyond capped there.
+    for seed in -1 18446744073709551616 1e3; do
+      expect_exit 1 "$bin" synth --seed "$seed" -o "$work/s.csv" --truth "$work/t.json"
+      expect_in err "^--seed: must be a whole number from 0 to 18446744073709551615, got $seed"
+    done
+    [[ ! -e "$work/s.csv" ]] || fail "a refused synth wrote its points"
     expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --far inf
     expect_in err "^--far: \"inf\" is not a finite number"
     expect_exit 1 "$bin" export "$data/projector/truth.json" --to gl --near nan

@@ -1,4 +1,6 @@
 // camproj synth: a reproducible synthetic scene and its true camera.
+#include <charconv>
+#include <cstdint>
 #include <iostream>
 #include <memory>
 
@@ -25,6 +27,22 @@ struct SynthArgs {
   std::string truth_path;
 };
 
+// A seed as written: digits only, within uint64_t (CLI11 converts "-1" to 2^64 - 1 and caps
+// values beyond 2^64 - 1 there, so different seeds gave one scene).
+const CLI::Validator& SeedText() {
+  static const CLI::Validator validator(
+      [](std::string& text) -> std::string {
+        uint64_t value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+          return "must be a whole number from 0 to 18446744073709551615, got " + text;
+        }
+        return "";
+      },
+      "0..2^64-1");
+  return validator;
+}
+
 }  // namespace
 
 Command AddSynthCommand(CLI::App& root) {
@@ -35,7 +53,7 @@ Command AddSynthCommand(CLI::App& root) {
       "Example (a projector with lens shift to the bottom edge, points on a box):\n"
       "  camproj synth --seed 7 --points 20 --noise 1 --object box --principal-point-offset 0,0.5 \\\n"
       "      -o points.csv --truth truth.json");
-  app->add_option("--seed", args->seed, "random seed");
+  app->add_option("--seed", args->seed, "random seed")->check(SeedText());
   app->add_option("--points", args->points, "number of points")->check(CLI::Range(1, 100000000));
   app->add_option("--noise", args->noise, "pixel noise sigma per axis (px)")->check(NonNegativeFinite());
   app->add_flag("--planar", args->planar, "points on a plane (same as --object plane)");
