@@ -89,6 +89,10 @@ case $case in
     grep -q '"fit"' "$work/cam.json" || fail "camera file lacks fit"
     expect_exit 0 "$bin" export "$work/cam.json" --to gl
     expect_in out "^projection "
+    # An orthographic model the points refuse: no outlier search ran, and the refusal says so
+    # (it said RANSAC "found no camera that most points agree on ()").
+    expect_exit 3 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --model orthographic+aspect
+    expect_in err "RANSAC, which samples perspective cameras only, did not run for the orthographic model"
     ;;
   fit_json_stdout)
     expect_exit 0 "$bin" fit "$data/synthetic/points.csv" --image-size 1280x800 --json

@@ -200,8 +200,10 @@ OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
   search.method = "lo-ransac";
   const double threshold = RansacThresholdPx(n, options, noise);
   std::string last_refusal;
+  bool tried = false;
   for (FitOptions model : DetectionModels(options)) {
     if (model.projection != Projection::kPerspective) break;
+    tried = true;
     model.ransac = true;
     model.ransac_threshold_px = threshold;
     try {
@@ -213,8 +215,11 @@ OutlierSearch LoRansac(const std::vector<Eigen::Vector3d>& points,
       last_refusal = e.what();
     }
   }
-  search.why_not = "RANSAC at " + Px(threshold) + " found no camera that most points agree on (" +
-                   last_refusal + ")";
+  search.why_not =
+      tried ? "RANSAC at " + Px(threshold) + " found no camera that most points agree on (" +
+                  last_refusal + ")"
+            : std::string("RANSAC, which samples perspective cameras only, did not run for the "
+                          "orthographic model");
   return search;
 }
 
