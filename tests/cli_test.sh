@@ -170,9 +170,14 @@ PY
       "$data/synthetic/points.csv" >"$work/clicked.csv"
     expect_exit 0 "$bin" fit "$work/clicked.csv" --image-size 1280x800 --ransac 4 -o "$work/cam.json"
     expect_in out "left out of the fit (found by ransac): 2 of 50 points"
+    # The model line counts the points fitted (it said 50).
+    expect_in out "^model: .*, 48 of 50 points, "
     expect_in out "  3 is "
     expect_in out "  7 is "
-    grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"
+    grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"    # A forced model is no automatic choice (the summary said "chosen automatically by BIC").
+    expect_exit 0 "$bin" fit "$work/clicked.csv" --image-size 1280x800 --model focal+principal-point
+    expect_in out "^  the only model open; BIC at pixel noise"
+    expect_not_in out "chosen automatically"
     ;;
   fit_batch_reports_every_file)
     mkdir -p "$work/in"

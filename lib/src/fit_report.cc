@@ -112,11 +112,15 @@ void WriteModel(const FitResult& fit, std::ostream& out) {
   for (const std::string& name : fit.free_parameters) {
     if (name.rfind("rotation", 0) != 0 && name.rfind("eye", 0) != 0) out << ", " << name;
   }
-  out << "), " << n << " points" << (fit.planar ? " (coplanar)" : "") << ", start "
-      << fit.start_method << "\n";
+  // The points fitted (those left out are listed below, "left out of the fit").
+  const int kept = n - static_cast<int>(fit.outliers.size());
+  out << "), " << (kept < n ? std::to_string(kept) + " of " : "") << n << " points"
+      << (fit.planar ? " (coplanar)" : "") << ", start " << fit.start_method << "\n";
   if (!fit.candidates.empty()) {
-    out << "  chosen automatically by " << fit.criterion << " at pixel noise "
-        << Format("%.3g", fit.selection_sigma_px) << " px; models tried:\n";
+    // One candidate is no choice: the model was forced (--model), or nothing else was open.
+    out << "  " << (fit.candidates.size() > 1 ? "chosen automatically by " : "the only model open; ")
+        << fit.criterion << " at pixel noise " << Format("%.3g", fit.selection_sigma_px)
+        << " px; models tried:\n";
     for (const ModelCandidate& c : fit.candidates) {
       out << "    " << c.name;
       if (c.fitted) {
