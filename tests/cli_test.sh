@@ -174,7 +174,8 @@ PY
     expect_in out "^model: .*, 48 of 50 points, "
     expect_in out "  3 is "
     expect_in out "  7 is "
-    grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"    # A forced model is no automatic choice (the summary said "chosen automatically by BIC").
+    grep -q '"outliers"' "$work/cam.json" || fail "camera file lacks the outliers"
+    # A forced model is no automatic choice (the summary said "chosen automatically by BIC").
     expect_exit 0 "$bin" fit "$work/clicked.csv" --image-size 1280x800 --model focal+principal-point
     expect_in out "^  the only model open; BIC at pixel noise"
     expect_not_in out "chosen automatically"
