@@ -330,6 +330,16 @@ PY
     done
     expect_exit 1 "$bin" fit "$local_points" --image-size 1920x1080 --focal -1
     expect_in err "^--focal: must be positive, got -1"
+    # convert: a bad value names its option (exit 1, as every bad option value; it was exit 2,
+    # "fx must be positive"), and options the conversion does not read are refused, not dropped.
+    expect_exit 1 "$bin" convert --intrinsics -500,1000,959.5,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum
+    expect_in err "^camproj: usage: --intrinsics: fx must be positive, got -500"
+    expect_exit 1 "$bin" convert --frustum 1,-1,-1,1,0.1,10 --image-size 1920x1080 --to gl
+    expect_in err "^camproj: usage: --frustum: frustum left must be less than right"
+    expect_exit 1 "$bin" convert --intrinsics 1000,1000,959.5,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum --depth zo
+    expect_in err "^camproj: usage: --depth and --reversed-z go with --to gl"
+    expect_exit 1 "$bin" convert --frustum -0.096,0.096,-0.054,0.054,0.1,100 --image-size 1920x1080 --to perspective --pixel-origin corner
+    expect_in err "^camproj: usage: --pixel-origin is the convention of cx, cy"
     # A seed is a uint64 as written: -1 was taken as 2^64 - 1, 2^64 and beyond capped there.
     for seed in -1 18446744073709551616 1e3; do
       expect_exit 1 "$bin" synth --seed "$seed" -o "$work/s.csv" --truth "$work/t.json"
@@ -383,8 +393,8 @@ PY
     expect_in err "the frustum's intrinsics are not finite"
     expect_exit 2 "$bin" convert --intrinsics 100,100,49.5,49.5 --image-size 100x100 --near 0.1 --far 1 --to gl --skew 1e308
     expect_in err "the projection matrix of fx = 100, fy = 100 on a 100x100 image with near 0.1.* cannot be represented in a double"
-    expect_exit 2 "$bin" convert --frustum -1e308,1e308,-0.1,0.1,1e-308,1 --image-size 100x100 --to gl
-    expect_in err "the frustum's width and height must be finite"
+    expect_exit 1 "$bin" convert --frustum -1e308,1e308,-0.1,0.1,1e-308,1 --image-size 100x100 --to gl
+    expect_in err "^camproj: usage: --frustum: the frustum's width and height must be finite"
     expect_exit 2 "$bin" convert --intrinsics 100,100,1e308,50 --image-size 100x100 --near 0.1 --far 1 --to frustum
     expect_in err "frustum left must be less than right"
     expect_exit 0 "$bin" --help

@@ -58,17 +58,32 @@ Command AddConvertCommand(CLI::App& root) {
       ->check(FiniteNumber());
   app->add_option("--to", args->to, "output")
       ->required()->check(CLI::IsMember({"frustum", "perspective", "gl", "intrinsics"}));
-  app->add_option("--depth", args->depth, "gl: no = [-1,1], zo = [0,1]")->check(CLI::IsMember({"no", "zo"}));
-  app->add_flag("--reversed-z", args->reversed_z, "gl: reversed-Z");
-  app->add_option("--pixel-origin", args->pixel_origin, "convention of cx, cy")
-      ->check(CLI::IsMember({"center", "corner"}));
-  return {app, [args]() {
+  CLI::Option* depth = app->add_option("--depth", args->depth, "gl: no = [-1,1], zo = [0,1]")
+                           ->check(CLI::IsMember({"no", "zo"}));
+  CLI::Option* reversed_z = app->add_flag("--reversed-z", args->reversed_z, "gl: reversed-Z");
+  CLI::Option* pixel_origin =
+      app->add_option("--pixel-origin", args->pixel_origin, "convention of cx, cy")
+          ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args, depth, reversed_z, pixel_origin]() {
+            // Options the conversion asked for would not read are refused, not dropped.
+            if (args->to != "gl" && (depth->count() > 0 || reversed_z->count() > 0)) {
+              throw UsageError("--depth and --reversed-z go with --to gl");
+            }
+            if (pixel_origin->count() > 0 && !args->frustum.empty() && args->to != "intrinsics") {
+              throw UsageError("--pixel-origin is the convention of cx, cy: it goes with "
+                               "--intrinsics or --to intrinsics");
+            }
             const ImageSize size = ParseImageSize(args->image_size, "--image-size");
             const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
             std::cout << std::setprecision(std::numeric_limits<double>::max_digits10);
             if (!args->frustum.empty()) {
               const std::vector<double> f = ParseNumbers(args->frustum, 6, "--frustum");
               const Frustum frustum{f[0], f[1], f[2], f[3], f[4], f[5]};
+              try {
+                frustum.Check();
+              } catch (const std::invalid_argument& e) {
+                throw UsageError(std::string("--frustum: ") + e.what());
+              }
               if (args->to != "intrinsics" && args->to != "gl" && args->to != "perspective") {
                 throw UsageError("--frustum converts --to intrinsics, perspective or gl");
               }
@@ -96,6 +111,11 @@ Command AddConvertCommand(CLI::App& root) {
             k.cx = v[2];
             k.cy = v[3];
             k.skew = args->skew;
+            try {
+              k.Check();
+            } catch (const std::invalid_argument& e) {
+              throw UsageError(std::string("--intrinsics: ") + e.what());
+            }
             if (args->to == "intrinsics") throw UsageError("--intrinsics converts --to frustum, perspective or gl");
             if (!(args->z_near > 0.0) || !(args->z_far > args->z_near)) {
               throw UsageError("--near and --far are needed, with 0 < near < far");
