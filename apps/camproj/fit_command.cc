@@ -323,7 +323,8 @@ void AddInputOutputOptions(CLI::App* app, FitArgs* args) {
   app->add_flag("--json", args->json,
                 "print the camera file to stdout instead of the summary; in batch mode one JSON "
                 "object per input and line (file, status, exit_code, detail, camera_file)");
-  app->add_flag("--trace", args->trace, "also print the per-iteration error against time (on stderr with --json)");
+  app->add_flag("--trace", args->trace,
+                "also print the per-iteration error against time (on stderr with --json)");
   app->add_option("--report", args->report_path,
                   "also write plots of the fit, drawn by camproj: .svg (residual per point, "
                   "residuals over the image, the models tried with their criterion) or .html "

@@ -57,7 +57,8 @@ Command AddSynthCommand(CLI::App& root) {
   app->add_option("--points", args->points, "number of points")->check(CLI::Range(1, 100000000));
   app->add_option("--noise", args->noise, "pixel noise sigma per axis (px)")->check(NonNegativeFinite());
   app->add_flag("--planar", args->planar, "points on a plane (same as --object plane)");
-  app->add_option("--object", args->object, "cloud (in a box volume), box (on the faces the camera sees), plane")
+  app->add_option("--object", args->object,
+                  "cloud (in a box volume), box (on the faces the camera sees), plane")
       ->check(CLI::IsMember({"cloud", "box", "plane"}));
   app->add_option("--fovy", args->fovy_deg, "vertical field of view (degrees)")
       ->check(FiniteNumber());

@@ -128,10 +128,10 @@ struct ViewFrame {
 // All points of one view, analytic: per point the single-view fitter's residual of the camera
 // point (ResidualOfCamPoint). Parameter blocks: the view's pose [w, c] (cam_from_world rotation
 // Exp(w) R0 about the start's R0, the camera centre c in the view's frame; |w| stays far below pi
-// from a closed-form start) and the free intrinsics (FitLayout entries at `free_slots`, the others held at their
-// values in `k`). Plain vectors, no manifolds, one block per view: Ceres' per-block costs (the
-// manifolds' Jacobian products, the evaluation bookkeeping) were 40 % of the joint solve
-// (bench --calibrate, callgrind).
+// from a closed-form start) and the free intrinsics (FitLayout entries at `free_slots`, the
+// others held at their values in `k`). Plain vectors, no manifolds, one block per view: Ceres'
+// per-block costs (the manifolds' Jacobian products, the evaluation bookkeeping) were 40 % of the
+// joint solve (bench --calibrate, callgrind).
 class ViewCost : public ceres::CostFunction {
  public:
   ViewCost(const CalibrationView& view, const ViewFrame& frame,

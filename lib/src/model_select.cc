@@ -764,7 +764,7 @@ FitResult FitCameraAuto(const std::vector<Eigen::Vector3d>& points_in_world,
       tight.fit.z_near.reset();
       tight.fit.z_far.reset();
       result = Pipeline(points_in_world, observed_pixels, image_size, tight).Run(start);
-      internal::SetGivenDepthRange(options.fit, points_in_world, &result);
+      internal::SetGivenDepthRange(options.fit, Kept(points_in_world, result.outliers), &result);
     } else {
       result = Pipeline(points_in_world, observed_pixels, image_size, options).Run(start);
     }

@@ -85,7 +85,8 @@ Eigen::Vector3d DrawBoxPoint(std::mt19937_64& rng, const Eigen::Vector3d& half,
 
 // Whether the eye sees the face with this outward normal at more than kMinFaceCosine from its
 // centre (then every point of the face is in front of it).
-bool FaceSeen(const Eigen::Vector3d& normal, const Eigen::Vector3d& half, const Eigen::Vector3d& eye) {
+bool FaceSeen(const Eigen::Vector3d& normal, const Eigen::Vector3d& half,
+              const Eigen::Vector3d& eye) {
   const Eigen::Vector3d to_eye = eye - normal.cwiseProduct(half);
   return normal.dot(to_eye) > kMinFaceCosine * to_eye.norm();
 }
@@ -174,25 +175,26 @@ SynthScene SynthesizeScene(const SynthOptions& options) {
       distance *= 1.05;
       continue;
     }
-    bool redrawn = false;
     const auto seen = [&](const Eigen::Vector3d& normal) {
       return FaceSeen(normal, half, look_at.eye);
     };
+    bool any_face_seen = face_normals.empty();  // not a box: nothing to see
+    for (int axis = 0; axis < 3 && !any_face_seen; ++axis) {
+      any_face_seen = seen(Eigen::Vector3d::Unit(axis)) || seen(-Eigen::Vector3d::Unit(axis));
+    }
+    if (!any_face_seen) {  // the eye is inside the box
+      distance *= 1.05;
+      continue;
+    }
+    bool redrawn = false;
     for (size_t i = 0; i < face_normals.size(); ++i) {
       if (seen(face_normals[i])) continue;
-      if (!seen(Eigen::Vector3d::UnitX()) && !seen(-Eigen::Vector3d::UnitX()) &&
-          !seen(Eigen::Vector3d::UnitY()) && !seen(-Eigen::Vector3d::UnitY()) &&
-          !seen(Eigen::Vector3d::UnitZ()) && !seen(-Eigen::Vector3d::UnitZ())) {
-        break;  // the eye is inside the box: back off
-      }
       do {
         points[i] = DrawBoxPoint(rng, half, &face_normals[i]);
       } while (!seen(face_normals[i]));
       redrawn = true;
     }
-    if (redrawn) continue;  // the new points must be inside the image too
-    if (std::all_of(face_normals.begin(), face_normals.end(), seen)) break;
-    distance *= 1.05;
+    if (!redrawn) break;  // else the new points are checked against the image again
   }
 
   double min_depth = kInfinity;

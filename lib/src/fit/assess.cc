@@ -394,16 +394,13 @@ CameraViews ViewsOfFittedCamera(const Camera& camera, double target_distance) {
   }
 }
 
-void SetGivenDepthRange(const FitOptions& options, const std::vector<Eigen::Vector3d>& points_in_world,
-                        FitResult* fit) {
+void SetGivenDepthRange(const FitOptions& options,
+                        const std::vector<Eigen::Vector3d>& kept_points_in_world, FitResult* fit) {
   if (!options.z_near && !options.z_far) return;
   Camera& camera = fit->camera;
   std::vector<double> depths;
-  for (size_t i = 0; i < points_in_world.size(); ++i) {
-    if (std::find(fit->outliers.begin(), fit->outliers.end(), static_cast<int>(i)) != fit->outliers.end()) {
-      continue;
-    }
-    depths.push_back((camera.cam_from_world * points_in_world[i]).z());
+  for (const Eigen::Vector3d& x : kept_points_in_world) {
+    depths.push_back((camera.cam_from_world * x).z());
   }
   const auto [min_depth, max_depth] = std::minmax_element(depths.begin(), depths.end());
   const DepthRange range = DepthRangeOfPoints(options, *min_depth, *max_depth);
@@ -420,8 +417,10 @@ DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, doubl
   // FitOptions::Check orders two given planes. One given alone clips every point where it is
   // past them all; the tight plane then falls on its wrong side, or (a given near plane
   // between the farthest point and the tight far plane) a frustum holds none of them.
-  const bool near_past_every_point = options.z_near && !options.z_far && !(*options.z_near < max_depth);
-  const bool far_before_every_point = options.z_far && !options.z_near && !(*options.z_far > min_depth);
+  const bool near_past_every_point =
+      options.z_near && !options.z_far && !(*options.z_near < max_depth);
+  const bool far_before_every_point =
+      options.z_far && !options.z_near && !(*options.z_far > min_depth);
   if (range.z_far > range.z_near && !near_past_every_point && !far_before_every_point) return range;
   const std::string depths = Concat(": the fitted camera sees the points at depths ",
                                     GeneralDouble(min_depth, 6), " to ",

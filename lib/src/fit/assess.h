@@ -40,12 +40,12 @@ struct DepthRange {
 DepthRange DepthRangeOfPoints(const FitOptions& options, double min_depth, double max_depth);
 
 // Sets the given FitOptions::z_near / z_far (if any) on a fitted camera, the other plane tight
-// around the depths of the points not in fit->outliers, and its views again
+// around the depths of the points it kept (those not in fit->outliers), and its views again
 // (DepthRangeOfPoints; throws as it does). The automatic selection judges its candidates with
 // tight planes and sets the given ones on its answer here: a plane is the answer's, and in each
 // candidate's assessment it refused candidates whose depths it did not hold.
-void SetGivenDepthRange(const FitOptions& options, const std::vector<Eigen::Vector3d>& points_in_world,
-                        FitResult* fit);
+void SetGivenDepthRange(const FitOptions& options,
+                        const std::vector<Eigen::Vector3d>& kept_points_in_world, FitResult* fit);
 
 }  // namespace internal
 }  // namespace camproj
