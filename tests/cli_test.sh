@@ -133,6 +133,39 @@ sys.exit(0 if abs(fovy - 45.5) < 1e-12 and k["fx"] == k["fy"] else 1)
 PY
     done
     ;;
+  fit_summary_in_the_users_pixel_origin)
+    # With --pixel-origin corner the summary's cx, cy (intrinsics, sigmas, a fixed principal
+    # point) are the file's, in the corner convention (they were printed in the centre's); and a
+    # forced --model says that it, not the user, held the intrinsics it leaves out (they were
+    # "(given)").
+    expect_exit 0 "$bin" synth --seed 1 --points 30 --noise 0.5 -o "$work/c.csv" --truth "$work/t.json"
+    expect_exit 0 "$bin" fit "$work/c.csv" --image-size 1920x1080 --model focal --pixel-origin corner -o "$work/c.json"
+    expect_in out "fixed principal point = 960, 540 (default: not in --model focal)"
+    expect_in out "fixed aspect = 1 (default: not in --model focal)"
+    expect_in out " cx 960 cy 540 (px, pixel corners at integers)"
+    py -c "
+import json, sys
+fixed = json.load(open(sys.argv[1]))['fit']['fixed']
+assert {'name': 'principal point', 'value': '960, 540 (default: not in --model focal)'} in fixed, fixed
+" "$work/c.json" || fail "the camera file's fixed principal point is not the summary's"
+    expect_exit 0 "$bin" fit "$work/c.csv" --image-size 1920x1080 --model focal+principal-point \
+      --skew 0 --pixel-origin corner -o "$work/c.json"
+    expect_in out "fixed skew = 0 (given)"
+    expect_in out "fixed k1 = 0 (default: not in --model focal+principal-point)"
+    py - "$work/c.json" "$work/out" <<'PY' || fail "the summary's cx, cy are not the file's"
+import json, re, sys
+camera = json.load(open(sys.argv[1]))
+assert camera["pixel_origin"] == "corner"
+k = camera["intrinsics"]
+text = open(sys.argv[2]).read()
+line = re.search(r"intrinsics: fx \S+ fy \S+ cx (\S+) cy (\S+) \(px, pixel corners", text)
+assert line and float(line.group(1)) == float("%.6g" % k["cx"]), (line, k)
+assert float(line.group(2)) == float("%.6g" % k["cy"]), (line, k)
+for name in ("cx", "cy"):
+    value = float(re.search(r"  %s = (\S+) \+- " % name, text).group(1))
+    assert abs(value - k[name]) < 0.05, (name, value, k[name])  # to the printed digits
+PY
+    ;;
   fit_bad_csv_names_line_and_column)
     printf 'X,Y,Z,u,v\n1,2,3,4,5\n1,2,abc,4,5\n' >"$work/bad.csv"
     expect_exit 2 "$bin" fit "$work/bad.csv" --image-size 640x480

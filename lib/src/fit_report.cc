@@ -6,6 +6,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "camproj/conventions.h"
+
 namespace camproj {
 
 namespace {
@@ -145,8 +147,10 @@ void WriteUncertainty(const FitResult& fit, std::ostream& out) {
     }
     out << "parameters (+- 1 sigma, pixel noise " << Format("%.3g", fit.pixel_sigma) << " px "
         << source << "):\n";
-    for (const ParameterSigma& s : fit.sigmas) {
+    const double shift = PixelOriginShift(PixelOrigin::kCenter, fit.pixel_origin);
+    for (ParameterSigma s : fit.sigmas) {
       if (s.name.rfind("rotation", 0) == 0) continue;
+      if (s.name == "cx" || s.name == "cy") s.value += shift;  // the sigmas' cx, cy are kCenter
       out << "  " << ParameterSigmaText(s) << "\n";
     }
     double rotation_sigma = 0.0;
@@ -165,7 +169,8 @@ void WriteUncertainty(const FitResult& fit, std::ostream& out) {
 
 // The camera: intrinsics, look-at, the GL view (ortho, perspective or frustum), near and far.
 void WriteCamera(const FitResult& fit, std::ostream& out) {
-  const Intrinsics& k = fit.camera.intrinsics;
+  const Intrinsics k =
+      ConvertPixelOrigin(fit.camera.intrinsics, PixelOrigin::kCenter, fit.pixel_origin);
   out << "intrinsics: fx " << Format("%.6g", k.fx) << " fy " << Format("%.6g", k.fy) << " cx "
       << Format("%.6g", k.cx) << " cy " << Format("%.6g", k.cy);
   if (k.skew != 0.0) out << " skew " << Format("%.6g", k.skew);
@@ -174,7 +179,8 @@ void WriteCamera(const FitResult& fit, std::ostream& out) {
     out << " p1 " << Format("%.6g", k.p1) << " p2 " << Format("%.6g", k.p2) << " k3 "
         << Format("%.6g", k.k3);
   }
-  out << " (px, pixel centres at integers)\n";
+  out << (fit.pixel_origin == PixelOrigin::kCenter ? " (px, pixel centres at integers)\n"
+                                                    : " (px, pixel corners at integers)\n");
   const LookAt& look = fit.views.look_at;
   auto vec = [](const Eigen::Vector3d& v) {
     return Format("%.6g", v.x()) + " " + Format("%.6g", v.y()) + " " + Format("%.6g", v.z());

@@ -249,6 +249,32 @@ void SetIntrinsicValues(const FitArguments& args, const ImageSize& size, bool au
   }
 }
 
+// FitRequest::held_by_model: the intrinsics the forced --model leaves out that no --free,
+// --fix or value names.
+void SetHeldByModel(const FitArguments& args, FitRequest* request) {
+  const std::string orthographic_name = "orthographic";
+  const bool orthographic = args.model.rfind(orthographic_name, 0) == 0;
+  // "orthographic+aspect" lists aspect; "orthographic" alone nothing.
+  const std::vector<std::string> listed =
+      !orthographic ? ModelNames(args.model)
+      : args.model.size() > orthographic_name.size()
+          ? ModelNames(args.model.substr(orthographic_name.size() + 1))
+          : std::vector<std::string>();
+  std::vector<std::string> named = args.free;
+  named.insert(named.end(), args.fix.begin(), args.fix.end());
+  for (const GivenValue& value : GivenValues(args)) named.push_back(value.name);
+  auto in = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  for (const std::string& name : kParameterNames) {
+    // An orthographic camera's scale is always free and its principal point never determined.
+    if (name == "focal" || (orthographic && name == "principal-point")) continue;
+    if (in(listed, name) || in(named, name)) continue;
+    request->held_by_model.push_back(name == "principal-point" ? "principal point" : name);
+  }
+  request->held_why = "default: not in --model " + args.model;
+}
+
 // The refinement: --loss, --refiner, --ransac, --sigma, --near, --far.
 void SetSolver(const FitArguments& args, FitOptions* options_out) {
   FitOptions& options = *options_out;
@@ -325,6 +351,7 @@ FitRequest FitRequestFrom(const FitArguments& args, const ImageSize& size) {
   }
   request.auto_options.criterion = args.criterion == "aic" ? ModelCriterion::kAic : ModelCriterion::kBic;
   SetIntrinsicValues(args, size, request.automatic, &options);
+  if (forced) SetHeldByModel(args, &request);
   SetSolver(args, &options);
   SetRegionAndOrigin(args, options, &request);
   options.max_iterations = args.max_iterations;
@@ -370,6 +397,12 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
     AutoFitOptions options = request.auto_options;
     if (ids.size() == pixels.size()) options.point_names = ids;
     result = FitCameraAuto(points_in_world, pixels, size, options);
+  }
+  for (FixedParameter& p : result.fixed_parameters) {
+    if (p.why == "given" && std::find(request.held_by_model.begin(), request.held_by_model.end(),
+                                      p.name) != request.held_by_model.end()) {
+      p.why = request.held_why;
+    }
   }
   if (request.auto_world_origin) {
     std::vector<Eigen::Vector3d> kept;

@@ -208,8 +208,9 @@ struct ParameterSigma {
   std::string unit;  // "px", "deg", "world", ""
 };
 
-// An intrinsic the fit did not estimate: its value (in kCenter pixels) and why: "given" (fixed
-// by the caller), "default: ..." (left at its default), "given: pose only" (known intrinsics).
+// An intrinsic the fit did not estimate: its value (cx, cy in FitResult::pixel_origin) and why:
+// "given" (fixed by the caller), "default: ..." (left at its default), "given: pose only" (known
+// intrinsics).
 struct FixedParameter {
   std::string name;   // "aspect", "principal point", "skew", "k1", ...
   std::string value;
@@ -345,6 +346,9 @@ inline constexpr double kMaxLinearityDeviation = 1.0;
 struct FitResult {
   Camera camera;      // intrinsics (kCenter), cam_from_world, z_near / z_far
   CameraViews views;  // look_at (target at the points' median depth), frustum, perspective, GL
+  // The input's convention (FitOptions::pixel_origin): that of fixed_parameters' cx, cy, of the
+  // checks' summaries and of FitSummaryText; the camera and the sigmas are in kCenter.
+  PixelOrigin pixel_origin = PixelOrigin::kCenter;
 
   // Per point: predicted - observed, px, in input order (infinite for a point behind the camera,
   // possible only among RANSAC's outliers).

@@ -24,7 +24,7 @@ std::string ParameterSigmaText(const ParameterSigma& parameter);
 // A few lines: the model (free and fixed parameters and why), each parameter +- sigma in its
 // unit, fovy in degrees, eye and look-at, RMS / median / max residual, the linearity check, the
 // `worst` largest residuals by id (ids[i] names point i; numbers from 1 when empty), and the fit
-// time.
+// time. cx, cy and pixels in fit.pixel_origin, the input's convention.
 std::string FitSummaryText(const FitResult& fit, const std::vector<std::string>& ids,
                            int worst = 5);
 

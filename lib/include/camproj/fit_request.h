@@ -74,6 +74,11 @@ struct FitRequest {
   std::optional<BoxInWorld> bounds_in_world;  // applied by RunFitRequest after the fit
   std::optional<Eigen::Vector3d> world_origin;  // also applied after the fit (FitArguments)
   bool auto_world_origin = false;
+  // The intrinsics a forced --model holds at their defaults (FixedParameter names: "aspect",
+  // "principal point", ...), which RunFitRequest reports as `held_why` ("default: not in --model
+  // focal"), not as "given": no value was.
+  std::vector<std::string> held_by_model;
+  std::string held_why;
   const FitOptions& options() const { return auto_options.fit; }
 };
 
@@ -88,7 +93,8 @@ FitRequest FitRequestFrom(const FitArguments& arguments, const ImageSize& size);
 // behind the camera without --near, or lies wholly behind it, throws std::invalid_argument
 // naming --bounds, the corner and its depth. With world_origin or auto_world_origin the camera
 // gets that world origin (auto: AutoOriginOfPoints of the points not among result.outliers) and
-// views.gl_eye_from_origin_world matches it; the fit itself does not depend on it.
+// views.gl_eye_from_origin_world matches it; the fit itself does not depend on it. The
+// intrinsics held_by_model are reported with held_why.
 FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
                         const std::vector<Eigen::Vector2d>& pixels,
                         const std::vector<std::string>& ids, const ImageSize& size,

@@ -349,6 +349,7 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   const std::vector<std::string> names = ParameterNames(model);
   result.free_parameters = names;
   result.model = ModelName(model);
+  result.pixel_origin = options.pixel_origin;
   if (effort.describe) result.fixed_parameters = DescribeFixed(options, scene.image_size);
 
   // Uncertainty, in u = [omega, center, free slots] (ComputeNormalEquations). Fixed-capacity

@@ -50,8 +50,7 @@ Model MakeModel(const FitOptions& options, const ImageSize& size) {
 std::vector<FixedParameter> DescribeFixed(const FitOptions& options, const ImageSize& size) {
   std::vector<FixedParameter> fixed;
   if (options.known_intrinsics) {
-    const Intrinsics k = ConvertPixelOrigin(*options.known_intrinsics, options.pixel_origin,
-                                            PixelOrigin::kCenter);
+    const Intrinsics& k = *options.known_intrinsics;  // in options.pixel_origin, as given
     std::string text = Concat("fx ", k.fx, ", fy ", k.fy, ", cx ", k.cx, ", cy ", k.cy, ", skew ",
                               k.skew, ", k1 ", k.k1, ", k2 ", k.k2);
     if (k.HasBeyondTwoRadial()) text += Concat(", p1 ", k.p1, ", p2 ", k.p2, ", k3 ", k.k3);
@@ -59,16 +58,19 @@ std::vector<FixedParameter> DescribeFixed(const FitOptions& options, const Image
     return fixed;
   }
   const Model model = MakeModel(options, size);
-  const double shift = PixelOriginShift(options.pixel_origin, PixelOrigin::kCenter);
+  // The principal point in options.pixel_origin: a given one as given, the default shifted.
+  const double shift = PixelOriginShift(PixelOrigin::kCenter, options.pixel_origin);
   auto describe = [&](int slot, const ParameterMode& mode, const char* default_why) {
     if (mode.IsFree()) return;
     std::string name = kSlotNames[slot];
     std::string value = ValueText(model.value[slot]);
     if (slot == 2) {  // cy is described with cx
       name = "principal point";
-      value += ", " + ValueText(mode.kind == ParameterMode::Kind::kFixed
-                                    ? options.principal_point.value2 + shift
-                                    : 0.5 * (size.height - 1.0));
+      value = mode.kind == ParameterMode::Kind::kFixed
+                  ? ValueText(options.principal_point.value) + ", " +
+                        ValueText(options.principal_point.value2)
+                  : ValueText(0.5 * (size.width - 1.0) + shift) + ", " +
+                        ValueText(0.5 * (size.height - 1.0) + shift);
     }
     fixed.push_back({name, value, mode.kind == ParameterMode::Kind::kFixed ? "given" : default_why});
   };

@@ -57,7 +57,8 @@ struct Model {
 Model MakeModel(const FitOptions& options, const ImageSize& size);
 
 // FitResult::fixed_parameters of MakeModel(options, size): every fixed slot with its value and
-// why ("given", or the default's reason); known intrinsics as one entry. Only a described fit
+// why ("given", or the default's reason), cx and cy in options.pixel_origin; known intrinsics
+// as one entry. Only a described fit
 // reports them (assess.cc): a candidate of the model selection is scored without them, and at six
 // points their text cost ~2 % of the default path when every fit made it.
 std::vector<FixedParameter> DescribeFixed(const FitOptions& options, const ImageSize& size);

@@ -367,6 +367,7 @@ double DescribeOrthographic(const AffineScene& scene, const FitOptions& options,
   std::nth_element(depths_sorted.begin(), depths_sorted.begin() + n / 2, depths_sorted.end());
   result->views = ViewsOfFittedCamera(camera, depths_sorted[n / 2]);
   result->start_method = "affine";
+  result->pixel_origin = options.pixel_origin;
   result->planar = false;
   result->free_parameters = linearization.names;
   result->model = std::string("orthographic") + (model.aspect_free ? "+aspect" : "") +
@@ -382,7 +383,8 @@ double DescribeOrthographic(const AffineScene& scene, const FitOptions& options,
   }
   if (!model.aspect_free) fixed("aspect", Concat(p.k[1]), options.aspect, "default: square pixels");
   if (!model.skew_free) fixed("skew", Concat(camera.intrinsics.skew), options.skew, "default: no skew");
-  fixed("principal point", Concat(place.principal.x(), ", ", place.principal.y()),
+  fixed("principal point",
+        Concat(place.principal.x() - scene.shift, ", ", place.principal.y() - scene.shift),
         options.principal_point,
         "not determined: it trades exactly with the position in an orthographic view");
   return sum_squares;
