@@ -731,6 +731,9 @@ PY
   convert_round_trip)
     expect_exit 0 "$bin" convert --intrinsics 1000,1000,959.5,539.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum
     expect_in out "left -0.096"
+    # A principal point on the bottom row's centre puts the frustum's bottom at 0 ("-0" before).
+    expect_exit 0 "$bin" convert --intrinsics 1000,1000,959.5,1079.5 --image-size 1920x1080 --near 0.1 --far 100 --to frustum
+    expect_in out "^bottom 0$"
     expect_exit 0 "$bin" convert --frustum -0.096,0.096,-0.054,0.054,0.1,100 --image-size 1920x1080 --to intrinsics
     expect_in out "fx 1000"
     expect_in out "cx 959.5"
@@ -743,6 +746,18 @@ PY
     expect_exit 0 "$bin" synth --seed 5 --points 12 --noise 0.5 -o "$work/b.csv" --truth "$work/b.json"
     cmp -s "$work/a.csv" "$work/b.csv" || fail "same seed, different points"
     cmp -s "$work/a.json" "$work/b.json" || fail "same seed, different truth"
+    # The CSV's first line is the command that makes the scene again, every option spelled out
+    # (it named --seed and --points only).
+    expect_exit 0 "$bin" synth --seed 5 --points 12 --noise 0.5 --object box --fovy 50 \
+      --principal-point-offset 0,0.5 --image-size 1280x720 --aspect 1.01 -o "$work/c.csv" --truth "$work/c.json"
+    command=$(head -1 "$work/c.csv" | sed -e 's/^# camproj //' -e 's/ (pixels: OpenCV convention)$//')
+    # shellcheck disable=SC2086
+    expect_exit 0 "$bin" $command -o "$work/d.csv" --truth "$work/d.json"
+    cmp -s "$work/c.csv" "$work/d.csv" || fail "the recorded command made another scene: $command"
+    cmp -s "$work/c.json" "$work/d.json" || fail "the recorded command made another truth: $command"
+    # --planar is --object plane: beside another --object it was dropped without a word.
+    expect_exit 1 "$bin" synth --object box --planar -o "$work/e.csv" --truth "$work/e.json"
+    expect_in err "excludes"
     ;;
   overlay_png)
     expect_exit 0 "$bin" overlay "$data/projector/truth.json" "$data/projector/points.csv" -o "$work/o.png"

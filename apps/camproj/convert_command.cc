@@ -26,11 +26,20 @@ struct ConvertArgs {
   std::string pixel_origin = "center";
 };
 
+// A value as printed: a zero without its sign ("bottom -0" for a frustum whose bottom edge is
+// the principal point's row: -0 is +0 in every formula here).
+double Shown(double value) { return value + 0.0; }
+
 // The library refuses a matrix that is not finite (gl.h), so every entry prints as a number.
 void PrintMatrix(const Eigen::Matrix4d& m) {
   std::cout << "projection (column-major)";
-  for (int i = 0; i < 16; ++i) std::cout << ' ' << m.data()[i];
+  for (int i = 0; i < 16; ++i) std::cout << ' ' << Shown(m.data()[i]);
   std::cout << '\n';
+}
+
+void PrintPerspective(const Perspective& p) {
+  std::cout << "fovy_deg " << Shown(p.fovy_deg) << "\naspect " << Shown(p.aspect) << "\nnear "
+            << Shown(p.z_near) << "\nfar " << Shown(p.z_far) << "\n";
 }
 
 }  // namespace
@@ -93,12 +102,10 @@ Command AddConvertCommand(CLI::App& root) {
               }
               if (args->to == "intrinsics") {
                 const Intrinsics k = IntrinsicsFromFrustum(frustum, size, origin);
-                std::cout << "fx " << k.fx << "\nfy " << k.fy << "\ncx " << k.cx << "\ncy " << k.cy
-                          << "\n";
+                std::cout << "fx " << Shown(k.fx) << "\nfy " << Shown(k.fy) << "\ncx "
+                          << Shown(k.cx) << "\ncy " << Shown(k.cy) << "\n";
               } else if (args->to == "perspective") {
-                const Perspective p = PerspectiveFromFrustum(frustum);
-                std::cout << "fovy_deg " << p.fovy_deg << "\naspect " << p.aspect << "\nnear "
-                          << p.z_near << "\nfar " << p.z_far << "\n";
+                PrintPerspective(PerspectiveFromFrustum(frustum));
               } else {
                 PrintMatrix(ClipFromGlEye(frustum, {ClipDepthFromString(args->depth), args->reversed_z}));
               }
@@ -122,12 +129,11 @@ Command AddConvertCommand(CLI::App& root) {
             }
             if (args->to == "frustum") {
               const Frustum f = FrustumFromIntrinsics(k, size, args->z_near, args->z_far, origin);
-              std::cout << "left " << f.left << "\nright " << f.right << "\nbottom " << f.bottom
-                        << "\ntop " << f.top << "\nnear " << f.z_near << "\nfar " << f.z_far << "\n";
+              std::cout << "left " << Shown(f.left) << "\nright " << Shown(f.right) << "\nbottom "
+                        << Shown(f.bottom) << "\ntop " << Shown(f.top) << "\nnear "
+                        << Shown(f.z_near) << "\nfar " << Shown(f.z_far) << "\n";
             } else if (args->to == "perspective") {
-              const Perspective p = PerspectiveFromIntrinsics(k, size, args->z_near, args->z_far, origin);
-              std::cout << "fovy_deg " << p.fovy_deg << "\naspect " << p.aspect << "\nnear "
-                        << p.z_near << "\nfar " << p.z_far << "\n";
+              PrintPerspective(PerspectiveFromIntrinsics(k, size, args->z_near, args->z_far, origin));
             } else {
               PrintMatrix(ClipFromGlEye(k, size, args->z_near, args->z_far,
                                         {ClipDepthFromString(args->depth), args->reversed_z}, origin));

@@ -6,6 +6,7 @@
 
 #include "camproj/camera_file.h"
 #include "camproj/file_io.h"
+#include "camproj/number_text.h"
 #include "camproj/synth.h"
 #include "cli.h"
 
@@ -56,10 +57,13 @@ Command AddSynthCommand(CLI::App& root) {
   app->add_option("--seed", args->seed, "random seed")->check(SeedText());
   app->add_option("--points", args->points, "number of points")->check(CLI::Range(1, 100000000));
   app->add_option("--noise", args->noise, "pixel noise sigma per axis (px)")->check(NonNegativeFinite());
-  app->add_flag("--planar", args->planar, "points on a plane (same as --object plane)");
+  CLI::Option* planar =
+      app->add_flag("--planar", args->planar, "points on a plane (same as --object plane)");
   app->add_option("--object", args->object,
                   "cloud (in a box volume), box (on the faces the camera sees), plane")
-      ->check(CLI::IsMember({"cloud", "box", "plane"}));
+      ->check(CLI::IsMember({"cloud", "box", "plane"}))
+      // --object box --planar made a plane without a word.
+      ->excludes(planar);
   app->add_option("--fovy", args->fovy_deg, "vertical field of view (degrees)")
       ->check(FiniteNumber());
   app->add_option("--principal-point-offset", args->principal_point_offset,
@@ -87,9 +91,17 @@ Command AddSynthCommand(CLI::App& root) {
             }
             RequireDistinctOptionOutputs({{"-o", args->output_path}, {"--truth", args->truth_path}});
             const SynthScene scene = SynthesizeScene(options);
+            // The command that makes the scene again, every option spelled out (the defaults
+            // may change; --planar is --object plane).
             const std::string csv =
                 "# camproj synth --seed " + std::to_string(args->seed) + " --points " +
-                std::to_string(args->points) + " (pixels: OpenCV convention)\n" +
+                std::to_string(args->points) + " --noise " + ShortestDouble(args->noise) +
+                " --object " + (args->planar ? std::string("plane") : args->object) + " --fovy " +
+                ShortestDouble(args->fovy_deg) + " --principal-point-offset " +
+                ShortestDouble(offset[0]) + "," + ShortestDouble(offset[1]) + " --image-size " +
+                std::to_string(options.image_size.width) + "x" +
+                std::to_string(options.image_size.height) + " --aspect " +
+                ShortestDouble(args->aspect) + " (pixels: OpenCV convention)\n" +
                 CorrespondencesToCsvText(scene.correspondences);
             WriteFilesAtomically({{args->output_path, csv, "-o"},
                                   {args->truth_path, CameraToJsonText(scene.truth), "--truth"}});
