@@ -809,6 +809,31 @@ open(sys.argv[2], 'w').write('\\n'.join(out) + '\\n')" "$data/projector/points.c
     expect_in_file "$work/r.html" "model: pose+focal+principal-point"
     expect_exit 1 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --report "$work/r.png"
     expect_in err "a report is .svg or .html"
+    # Exact points: no arrows of rounding magnified 1e15 times, ticks that differ (all "0.00"
+    # before session 43). Ids cut by character and a Latin-1 byte shown as U+FFFD: the SVG stays
+    # XML (a 12-byte cut split a u-umlaut); a pixel observed outside the image is an arrow at
+    # the border pointing at it (drawn outside the picture before).
+    expect_exit 0 "$bin" synth --seed 3 --points 12 --noise 0 -o "$work/exact.csv" --truth "$work/exact_truth.json"
+    expect_exit 0 "$bin" fit "$work/exact.csv" --image-size 1920x1080 --report "$work/exact.svg"
+    expect_in_file "$work/exact.svg" "all below 1e-06 px (rounding), no arrows"
+    expect_in_file "$work/exact.svg" "text-anchor='end'>0.0002<"
+    py - "$work/exact.csv" "$work/ids.csv" <<'PY'
+import sys
+rows = [l.strip().split(',') for l in open(sys.argv[1]) if not l.startswith('#')][1:]
+with open(sys.argv[2], 'wb') as out:
+    out.write(b'id,X,Y,Z,u,v\n')
+    for i, r in enumerate(rows):
+        if i == 2:
+            r[3:5] = ['-300', '500']
+        name = {0: b'corner_nord\xc3\xbc1', 1: b'S\xfcd'}.get(i, b'p%d' % i)
+        out.write(name + b',' + ','.join(r).encode() + b'\n')
+PY
+    expect_exit 0 "$bin" fit "$work/ids.csv" --image-size 1920x1080 --report "$work/ids.svg"
+    py -c "import sys, xml.dom.minidom as m; m.parse(sys.argv[1])" "$work/ids.svg" \
+      || fail "the report with non-ASCII ids is not well-formed XML"
+    expect_in_file "$work/ids.svg" $'corner_nord\xc3\xbc<'
+    expect_in_file "$work/ids.svg" "p2: observed at (-300, 500), outside the image"
+    expect_in_file "$work/ids.svg" "p2 (outside)"
     expect_exit 1 "$bin" fit "$data/projector/points.csv" "$data/plane/points.csv" --image-size 1920x1080 -o "$work/batch" --report "$work/b.svg"
     expect_in err "--report is for one points file"
     ;;

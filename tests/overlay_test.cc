@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -229,6 +230,35 @@ TEST(OverlayTest, APointInFrontWithAPixelBeyondADoubleIsNotCalledBehind) {
   EXPECT_EQ(picture.stats.labels[0].kind, "no-pixel");
   EXPECT_EQ(picture.stats.labels[0].residual_px, -1.0);
   EXPECT_EQ(picture.stats.labels[1].kind, "behind");
+}
+
+// A residual beyond a double's range (a reprojection at 1.7e308 px) is the colour scale's top, as
+// an infinite one is: inf / inf reached the lookup as NaN, whose lround picked the bottom (the
+// colour of a perfect point) on x86.
+TEST(OverlayTest, AnOverflowingResidualIsTheTopOfTheColourScale) {
+  Camera camera;
+  camera.image_size = {1000, 800};
+  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
+  camera.intrinsics.cx = 499.5;
+  camera.intrinsics.cy = 399.5;
+  camera.z_near = 0.5;
+  camera.z_far = 10.0;
+  Correspondences points;
+  points.points_in_world = {{0.0, 0.0, 2.0}, {1.7e305, 0.0, 1.0}};
+  points.pixels = {{499.5, 399.5}, {300.0, 399.5}};
+  points.ids = {"a", "far"};
+  OverlayOptions options;
+  options.magnify = 1.0;
+  const OverlayPicture picture = DrawOverlayImage(camera, points, options, ImageFormat::kPng);
+  EXPECT_EQ(picture.stats.largest_residual_px, std::numeric_limits<double>::infinity());
+  const cv::Mat image =
+      cv::imdecode(std::vector<uchar>(picture.encoded.begin(), picture.encoded.end()), cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  // The far point's observed ring (radius 6 x 1.48 px at 800 rows, at (300, 399.5)) is in
+  // viridis's top, yellow (BGR 37, 231, 253); nothing else drawn within 10 px of it is yellow
+  // (before session 43 the ring was viridis's bottom, purple, and this found no yellow).
+  const Eigen::Vector2d observed(300.0, 399.5);
+  EXPECT_LE(ClosestColourDistance(image, observed, cv::Vec3b(37, 231, 253), 10), 40);
 }
 
 // A JPEG background cut short is refused (libjpeg decoded it with a warning and garbage below

@@ -14,6 +14,7 @@ namespace camproj {
 
 using internal::MarkupEscape;
 using internal::NiceFloor;
+using internal::Utf8Prefix;
 
 namespace {
 
@@ -36,10 +37,23 @@ std::string Viridis(double t) {
   return text;
 }
 
+// x in 7 significant digits: a coordinate of any size (Num's %f of 1e300 is 300 digits).
+std::string Short(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.7g", x);
+  return text;
+}
+
 std::string Num(double x, int digits = 2) {
   char text[32];
   std::snprintf(text, sizeof text, "%.*f", digits, x);
   return text;
+}
+
+// The decimals that tell ticks `step` apart (NiceStep's steps are 1, 2 or 5 times a power of ten):
+// 0.0002 for a step of 2e-4, where a fixed 2 wrote 0.00 at every tick.
+int TickDecimals(double step) {
+  return std::clamp(static_cast<int>(-std::floor(std::log10(step) + 1e-9)), 0, 12);
 }
 
 double NiceStep(double range, int ticks) {
@@ -112,7 +126,7 @@ double DrawResidualBars(const FitResult& fit, const ReportResiduals& residuals,
     const double yy = top + h - v / axis_max * h;
     body << "<line x1='" << kMargin << "' x2='" << kMargin + kPlotWidth << "' y1='" << yy << "' y2='"
          << yy << "' class='grid'/><text x='" << kMargin - 6 << "' y='" << yy + 4
-         << "' class='tick' text-anchor='end'>" << Num(v, step < 0.1 ? 2 : step < 1 ? 1 : 0)
+         << "' class='tick' text-anchor='end'>" << Num(v, TickDecimals(step))
          << "</text>\n";
   }
   const double slot = kPlotWidth / std::max<size_t>(n, 1);
@@ -134,7 +148,7 @@ double DrawResidualBars(const FitResult& fit, const ReportResiduals& residuals,
     }
     if (show_ids) {
       body << "<text transform='translate(" << x + slot / 2 + 3 << "," << top + h + 8
-           << ") rotate(-90)' class='tick' text-anchor='end'>" << MarkupEscape(ids[i].substr(0, 12))
+           << ") rotate(-90)' class='tick' text-anchor='end'>" << MarkupEscape(Utf8Prefix(ids[i], 12))
            << "</text>\n";
     }
   }
@@ -156,22 +170,48 @@ double DrawResidualsOverImage(const FitResult& fit, const ReportResiduals& resid
   const double w_img = fit.camera.image_size.width, h_img = fit.camera.image_size.height;
   const double scale = std::min(kPlotWidth / w_img, 420.0 / h_img);
   const double x0 = kMargin, y0 = y + 30;
+  // Residuals below kRoundingPx are a double's rounding (exact data: 1e-13 px), not drawn
+  // magnified 1e15 times as if they were a pattern.
+  constexpr double kRoundingPx = 1e-6;
   const double magnify =
-      largest > 0 ? NiceFloor(0.15 * std::min(w_img, h_img) / largest) : 1.0;
+      largest > kRoundingPx ? NiceFloor(0.15 * std::min(w_img, h_img) / largest) : 1.0;
   char title[160];
-  std::snprintf(title, sizeof title,
-                "Residuals over the image (%gx%g px): arrows x %g, the largest (%s px) drawn %s px",
-                w_img, h_img, magnify, Num(largest, 2).c_str(), Num(largest * magnify, 0).c_str());
+  if (largest > kRoundingPx) {
+    std::snprintf(title, sizeof title,
+                  "Residuals over the image (%gx%g px): arrows x %g, the largest (%s px) drawn %s px",
+                  w_img, h_img, magnify, Num(largest, 2).c_str(), Num(largest * magnify, 0).c_str());
+  } else {
+    std::snprintf(title, sizeof title,
+                  "Residuals over the image (%gx%g px): all below %g px (rounding), no arrows",
+                  w_img, h_img, kRoundingPx);
+  }
   body << "<text x='" << kMargin << "' y='" << y0 - 12 << "' class='title'>" << title << "</text>\n";
   body << "<rect x='" << x0 << "' y='" << y0 << "' width='" << w_img * scale << "' height='"
        << h_img * scale << "' class='image'/>\n";
   // kCenter pixel p lies at (p + 0.5) * scale from the image's outer corner.
   const auto sx = [&](double u) { return x0 + (u + 0.5) * scale; };
   const auto sy = [&](double v) { return y0 + (v + 0.5) * scale; };
+  // An observed pixel outside the image (kCenter: it spans -0.5 to w - 0.5) is an arrow at the
+  // border pointing at it, 24 report px long, with its id and where it is.
+  const double border_arrow_px = 24.0 / scale;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& o = observed_pixels[i];
     const std::string id = MarkupEscape(ids[i]);
-    if (outlier[i] || !std::isfinite(length[i])) {
+    const bool left_out = outlier[i] || !std::isfinite(length[i]);
+    if (!(o.x() >= -0.5 && o.x() <= w_img - 0.5 && o.y() >= -0.5 && o.y() <= h_img - 0.5)) {
+      const auto [tail, tip] = internal::BorderArrow(o, fit.camera.image_size.width,
+                                                     fit.camera.image_size.height, border_arrow_px);
+      const std::string colour = left_out ? kOutlier : Viridis(length[i] / colour_top);
+      body << "<line x1='" << sx(tail.x()) << "' y1='" << sy(tail.y()) << "' x2='" << sx(tip.x())
+           << "' y2='" << sy(tip.y()) << "' stroke='" << colour
+           << "' stroke-width='2' marker-end='url(#head)'><title>" << id << ": observed at ("
+           << Short(o.x()) << ", " << Short(o.y()) << "), outside the image; " << Num(length[i], 3)
+           << " px" << (left_out ? ", left out" : "") << "</title></line>\n";
+      body << "<text x='" << sx(tail.x()) + 5 << "' y='" << sy(tail.y()) + 12 << "' class='id'>"
+           << id << " (outside)</text>\n";
+      continue;
+    }
+    if (left_out) {
       const double r = 4;
       body << "<g stroke='" << kOutlier << "' stroke-width='2'><line x1='" << sx(o.x()) - r
            << "' y1='" << sy(o.y()) - r << "' x2='" << sx(o.x()) + r << "' y2='" << sy(o.y()) + r
@@ -228,7 +268,7 @@ double DrawLadder(const FitResult& fit, double y, std::ostream& body) {
            << Num(c.criterion, 1) << ", RMS " << Num(c.rms_px, 2) << " px</text>\n";
     } else {
       body << "<text x='" << bar_x << "' y='" << yy + 14 << "' class='refused'>"
-           << MarkupEscape(c.verdict.substr(0, 90)) << "</text>\n";
+           << MarkupEscape(Utf8Prefix(c.verdict, 90)) << "</text>\n";
     }
   }
   return top + fit.candidates.size() * row + 10;

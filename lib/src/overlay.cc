@@ -85,7 +85,8 @@ cv::Scalar Viridis(double t) {
     cv::applyColorMap(ramp, coloured, cv::COLORMAP_VIRIDIS);
     return coloured;
   }();
-  const int i = static_cast<int>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0));
+  // NaN (a residual that overflowed, inf / inf) is off the scale at its top, as inf is.
+  const int i = static_cast<int>(std::lround((std::isnan(t) ? 1.0 : std::clamp(t, 0.0, 1.0)) * 255.0));
   const cv::Vec3b c = lut.at<cv::Vec3b>(0, i);
   return cv::Scalar(c[0], c[1], c[2]);
 }
@@ -185,17 +186,6 @@ void Cross(cv::Mat& image, const Eigen::Vector2d& c, double half, const Style& s
   const Eigen::Vector2d b = diagonal ? Eigen::Vector2d(half, -half) : Eigen::Vector2d(0, half);
   HaloLine(image, c - a, c + a, s, colour);
   HaloLine(image, c - b, c + b, s, colour);
-}
-
-// An arrow inside the image's border pointing at `target` (outside the image): tail, tip.
-std::pair<Eigen::Vector2d, Eigen::Vector2d> BorderArrow(const Eigen::Vector2d& target, int w, int h,
-                                                        const Style& s) {
-  const double margin = 4.0 * s.ring;
-  const Eigen::Vector2d tip(std::clamp(target.x(), margin, w - 1 - margin),
-                            std::clamp(target.y(), margin, h - 1 - margin));
-  Eigen::Vector2d direction = target - tip;
-  direction.normalize();
-  return {tip - 4.0 * s.ring * direction, tip};
 }
 
 void DrawArrow(cv::Mat& image, const std::pair<Eigen::Vector2d, Eigen::Vector2d>& arrow,
@@ -405,7 +395,7 @@ std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Corresponden
     if (!inside(observed)) {
       point.kind = "outside";
       ++stats.outside;
-      point.arrow = BorderArrow(observed, w, h, s);
+      point.arrow = internal::BorderArrow(observed, w, h, 4.0 * s.ring);
       point.anchor = point.arrow.first;
     }
   }
