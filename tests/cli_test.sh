@@ -883,6 +883,17 @@ PY
     expect_exit 2 "$bin" view "$data/projector/truth.json" --image "$work/cut.png" -o "$work/s.html"
     expect_in err "cut.png: the PNG ends before its IEND chunk: the file is truncated"
     [[ ! -e "$work/s.html" ]] || fail "wrote a page for a truncated photo"
+    # The camera file's fit record goes into the page's HTML: a field of another type than camproj
+    # fit writes is left out with a note (a num_points of '<img onerror=...>' ran as script, and
+    # a left_out of "none" stopped the page's script, before session 43).
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 -o "$work/fitted.json"
+    py -c "import json,sys; c=json.load(open(sys.argv[1])); c['fit']['num_points']='<img src=x onerror=alert(1)>'; c['fit']['left_out']='none'; json.dump(c, open(sys.argv[2],'w'))" \
+      "$work/fitted.json" "$work/xss.json"
+    expect_exit 0 "$bin" view "$work/xss.json" "$data/projector/points.csv" -o "$work/xss.html"
+    if grep -q "onerror" "$work/xss.html"; then fail "the page holds the camera file's markup"; fi
+    grep -q "the camera file's fit.left_out is not as camproj fit writes it" "$work/xss.html" \
+      || fail "no note for the mistyped fit.left_out"
+    grep -q '"rms_px":' "$work/xss.html" || fail "the well-typed fit fields are not in the page"
     cp "$data/projector/truth.json" "$work/cam.html"
     expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
     expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"

@@ -356,7 +356,10 @@ function Render() {
 }
 
 // ---- The report beside the view.
+// Every value from the data goes into the page's HTML through Escape or Fixed (the camera file's
+// fit record is checked by camproj view, src/view.cc FitRecordForPage, and escaped here as well).
 function Escape(text) {
+  if (text === null || text === undefined) return '–';
   return String(text).replace(/[&<>"]/g, c => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;',
                                                  '"': '&quot;' })[c]);
 }
@@ -382,12 +385,12 @@ function Report() {
   const fit = data.fit;
   let html = '';
   const rows = (pairs) => pairs.map(([k, v]) => `<tr><td>${Escape(k)}</td><td>${v}</td></tr>`).join('');
-  const summary = [['image', `${W} × ${H} px, ${data.projection}`],
+  const summary = [['image', `${W} × ${H} px, ${Escape(data.projection)}`],
                    ['three.js', `r${data.three_version.split('.')[1]}`]];
   if (fit) {
     summary.unshift(['model', Escape(fit.model)]);
     summary.push(['residuals', `RMS ${Fixed(fit.rms_px, 3)}, median ${Fixed(fit.median_px, 3)},
-                                max ${Fixed(fit.max_px, 3)} px over ${fit.num_points} points`]);
+                                max ${Fixed(fit.max_px, 3)} px over ${Escape(fit.num_points)} points`]);
     if (fit.outliers && fit.outliers.length) {
       summary.push(['outliers', `${fit.outliers.length} left out (${Escape(fit.outlier_method || '')})`]);
     }
@@ -395,7 +398,7 @@ function Report() {
       // The camera file's linearity check (docs/camera-file.md).
       const l = fit.linearity;
       const factor = typeof l.worst_deviation === 'number' ? Fixed(1 + l.worst_deviation, 2) : 'unbounded';
-      summary.push(['σ', l.linear ? `hold out to the ${l.level * 100} % region (error inflation ≤ ${factor})`
+      summary.push(['σ', l.linear ? `hold out to the ${Escape(l.level * 100)} % region (error inflation ≤ ${factor})`
                                   : `first-order only: curved within the noise's reach (inflation ${factor} along ${Escape(l.worst_direction)})`]);
     }
   }

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -275,6 +279,75 @@ std::string FillTemplate(const std::string& page_template,
   return page;
 }
 
+// The page's reading of the camera file's `fit` record (docs/camera-file.md): each field it
+// shows, of the type it shows it as. Only the camera is checked when its file is read; the
+// record is free text to that reader, and the page puts its values in HTML. A field of another
+// type ("num_points": "<img onerror=...>" ran as script, "left_out": "none" stopped the page's
+// script, before session 43) is left out with a note, so the page shows only what a fit writes.
+using FieldCheck = std::function<bool(const json&)>;
+using FieldChecks = std::vector<std::pair<std::string, FieldCheck>>;
+
+bool IsNumber(const json& v) { return v.is_number(); }
+bool IsText(const json& v) { return v.is_string(); }
+bool IsBool(const json& v) { return v.is_boolean(); }
+
+FieldCheck ArrayOf(FieldCheck element) {
+  return [element](const json& v) { return v.is_array() && std::all_of(v.begin(), v.end(), element); };
+}
+
+// An object of any keys whose values pass `value`.
+FieldCheck MapOf(FieldCheck value) {
+  return [value](const json& v) { return v.is_object() && std::all_of(v.begin(), v.end(), value); };
+}
+
+// An object holding the keys `required`, each passing its check, and the keys `optional` absent or
+// passing theirs.
+FieldCheck Record(FieldChecks required, FieldChecks optional = {}) {
+  return [required, optional](const json& v) {
+    if (!v.is_object()) return false;
+    for (const auto& [key, check] : required) {
+      if (!v.contains(key) || !check(v[key])) return false;
+    }
+    for (const auto& [key, check] : optional) {
+      if (v.contains(key) && !check(v[key])) return false;
+    }
+    return true;
+  };
+}
+
+// The fields of `fit` the page shows (web/view.js, Report) that pass their check; a note in
+// `notes` for each that does not.
+json FitRecordForPage(const json& fit, json& notes) {
+  const FieldChecks fields = {
+      {"model", IsText},
+      {"rms_px", IsNumber},
+      {"median_px", IsNumber},
+      {"max_px", IsNumber},
+      {"num_points", IsNumber},
+      {"outliers", ArrayOf(IsNumber)},
+      {"outlier_method", IsText},
+      {"linearity", Record({{"linear", IsBool}, {"level", IsNumber}},
+                           {{"worst_deviation", IsNumber}, {"worst_direction", IsText}})},
+      {"sigma", MapOf(IsNumber)},
+      {"left_out", ArrayOf(Record({{"name", IsText}, {"why", IsText}}))},
+      {"selection",
+       Record({{"criterion", IsText},
+               {"candidates", ArrayOf(Record({{"name", IsText}, {"verdict", IsText}},
+                                             {{"rms_px", IsNumber}, {"criterion", IsNumber}}))}})},
+  };
+  json shown = json::object();
+  for (const auto& [key, check] : fields) {
+    if (!fit.contains(key)) continue;
+    if (check(fit[key])) {
+      shown[key] = fit[key];
+    } else {
+      notes.push_back(Concat("the camera file's fit.", key,
+                             " is not as camproj fit writes it (docs/camera-file.md): not shown"));
+    }
+  }
+  return shown;
+}
+
 }  // namespace
 
 std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_text,
@@ -293,7 +366,8 @@ std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_te
   }
   json data = SceneJson(camera, OutlierIndicesFromJsonText(camera_file_text, camera_name),
                         correspondences, stats);
-  data["fit"] = fit;
+  const json fit_shown = fit.is_null() ? json(nullptr) : FitRecordForPage(fit, data["notes"]);
+  data["fit"] = fit_shown;
   data["camera_name"] = camera_name;
   data["image"] = options.image_path.empty() ? json(nullptr) : ImageJson(options.image_path, camera);
   data["mesh"] = options.mesh_path.empty() ? json(nullptr) : MeshJson(options.mesh_path, stats);
