@@ -174,15 +174,27 @@ TEST(OverlayTest, LabelsOfPointsOutsideTheImageSayWhatTheyAreInTheUsersConventio
   }
 }
 
-// A reprojection 2^28 px away: its residual line runs to the image's edge along the true
-// direction, and nothing is drawn where the wrapped fixed-point coordinate would land (before
-// session 37 the cross was drawn at the image centre).
-TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
+// A 1000 x 800 camera looking down +z, f 1000 px, its principal point at the image's centre; near,
+// far as each test needs.
+Camera ThousandPixelCamera() {
   Camera camera;
   camera.image_size = {1000, 800};
   camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
   camera.intrinsics.cx = 499.5;
   camera.intrinsics.cy = 399.5;
+  return camera;
+}
+
+cv::Mat Decoded(const OverlayPicture& picture) {
+  return cv::imdecode(std::vector<uchar>(picture.encoded.begin(), picture.encoded.end()),
+                      cv::IMREAD_COLOR);
+}
+
+// A reprojection 2^28 px away: its residual line runs to the image's edge along the true
+// direction, and nothing is drawn where the wrapped fixed-point coordinate would land (before
+// session 37 the cross was drawn at the image centre).
+TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
+  Camera camera = ThousandPixelCamera();
   camera.z_near = 0.5;
   camera.z_far = 10.0;
   Correspondences points;
@@ -192,8 +204,7 @@ TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
   OverlayOptions options;
   options.magnify = 1.0;
   const OverlayPicture picture = DrawOverlayImage(camera, points, options, ImageFormat::kPng);
-  const cv::Mat image =
-      cv::imdecode(std::vector<uchar>(picture.encoded.begin(), picture.encoded.end()), cv::IMREAD_COLOR);
+  const cv::Mat image = Decoded(picture);
   ASSERT_FALSE(image.empty());
   const cv::Vec3b background = image.at<cv::Vec3b>(700, 100);
   // The wrapped place: u = 268435956 px, x 16 = 4294975296 = 2^32 + 8000 -> 500 px. The
@@ -212,11 +223,7 @@ TEST(OverlayTest, FarReprojectionIsClippedNotWrapped) {
 // reprojection like a point behind, but is counted and labelled as what it is (it was counted
 // "behind the camera" before).
 TEST(OverlayTest, APointInFrontWithAPixelBeyondADoubleIsNotCalledBehind) {
-  Camera camera;
-  camera.image_size = {1000, 800};
-  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
-  camera.intrinsics.cx = 499.5;
-  camera.intrinsics.cy = 399.5;
+  Camera camera = ThousandPixelCamera();
   camera.z_near = 1e-12;
   camera.z_far = 10.0;
   Correspondences points;
@@ -236,11 +243,7 @@ TEST(OverlayTest, APointInFrontWithAPixelBeyondADoubleIsNotCalledBehind) {
 // an infinite one is: inf / inf reached the lookup as NaN, whose lround picked the bottom (the
 // colour of a perfect point) on x86.
 TEST(OverlayTest, AnOverflowingResidualIsTheTopOfTheColourScale) {
-  Camera camera;
-  camera.image_size = {1000, 800};
-  camera.intrinsics.fx = camera.intrinsics.fy = 1000.0;
-  camera.intrinsics.cx = 499.5;
-  camera.intrinsics.cy = 399.5;
+  Camera camera = ThousandPixelCamera();
   camera.z_near = 0.5;
   camera.z_far = 10.0;
   Correspondences points;
@@ -251,8 +254,7 @@ TEST(OverlayTest, AnOverflowingResidualIsTheTopOfTheColourScale) {
   options.magnify = 1.0;
   const OverlayPicture picture = DrawOverlayImage(camera, points, options, ImageFormat::kPng);
   EXPECT_EQ(picture.stats.largest_residual_px, std::numeric_limits<double>::infinity());
-  const cv::Mat image =
-      cv::imdecode(std::vector<uchar>(picture.encoded.begin(), picture.encoded.end()), cv::IMREAD_COLOR);
+  const cv::Mat image = Decoded(picture);
   ASSERT_FALSE(image.empty());
   // The far point's observed ring (radius 6 x 1.48 px at 800 rows, at (300, 399.5)) is in
   // viridis's top, yellow (BGR 37, 231, 253); nothing else drawn within 10 px of it is yellow
