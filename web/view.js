@@ -2,7 +2,10 @@
 // every geometric quantity (rays, frustum corners, residuals, the three.js camera) comes computed
 // in the page's data. Pixels in the data are kCenter (OpenCV: (0,0) is the centre of the top-left
 // pixel); three.js, the canvas and SVG use the corner convention: CornerFromCenter is the one
-// place that converts (docs/conventions.md).
+// place that converts (docs/conventions.md). Positions are in the page's frame, the world moved
+// so that the eye is its origin (`*_in_page` = point_in_world - page_origin_in_world; WebGL's
+// float32 keeps survey coordinates to centimetres only), and the three.js camera is exported
+// relative to that origin.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
@@ -83,18 +86,18 @@ function Segments(pairs, colour, opacity = 1) {
   return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({
     color: colour, transparent: opacity < 1, opacity }));
 }
-const eye = V3(data.eye_in_world);
+const eye = V3(data.eye_in_page);
 const fr = data.frustum;
 {
-  const near = fr.near_corners_in_world, far = fr.far_corners_in_world;
+  const near = fr.near_corners_in_page, far = fr.far_corners_in_page;
   const lines = [];
   for (let i = 0; i < 4; ++i) {
     lines.push([near[i], near[(i + 1) % 4]], [far[i], far[(i + 1) % 4]], [near[i], far[i]]);
-    if (data.projection === 'perspective') lines.push([data.eye_in_world, near[i]]);
+    if (data.projection === 'perspective') lines.push([data.eye_in_page, near[i]]);
   }
   orbitOnly.add(Segments(lines, 0xd8dce3, 0.85));
   // The image's top edge, so that the frustum's up is obvious.
-  const img = fr.image_corners_in_world;
+  const img = fr.image_corners_in_page;
   orbitOnly.add(Segments([[img[0], img[1]]], 0x56b4e9));
   const plane = new THREE.BufferGeometry();
   plane.setAttribute('position', new THREE.Float32BufferAttribute(
@@ -123,12 +126,12 @@ const fr = data.frustum;
   const rays = [], outlierRays = [], gaps = [];
   const gapColours = [];
   for (const p of points) {
-    if (!p.ray_end_in_world) continue;
-    const start = data.projection === 'perspective' ? data.eye_in_world
-        : p.ray_end_in_world.map((x, k) => x + (fr.near_corners_in_world[0][k] -
-                                                fr.far_corners_in_world[0][k]));
-    (p.outlier ? outlierRays : rays).push([start, p.ray_end_in_world]);
-    gaps.push([p.ray_end_in_world, p.point_in_world]);
+    if (!p.ray_end_in_page) continue;
+    const start = data.projection === 'perspective' ? data.eye_in_page
+        : p.ray_end_in_page.map((x, k) => x + (fr.near_corners_in_page[0][k] -
+                                                fr.far_corners_in_page[0][k]));
+    (p.outlier ? outlierRays : rays).push([start, p.ray_end_in_page]);
+    gaps.push([p.ray_end_in_page, p.point_in_page]);
     const c = new THREE.Color(ResidualCss(p));
     gapColours.push(c.r, c.g, c.b, c.r, c.g, c.b);
   }
@@ -149,7 +152,7 @@ orbitOnly.add(new THREE.Points(
 // The model.
 if (data.mesh) {
   const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.Float32BufferAttribute(data.mesh.positions, 3));
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(data.mesh.positions_in_page, 3));
   geometry.setIndex(data.mesh.triangles);
   geometry.computeVertexNormals();
   scene.add(new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({
@@ -197,7 +200,7 @@ const markerUniforms = { size: { value: 11 }, cross: { value: 0 } };
 const markers = (() => {
   const positions = [], colours = [], kinds = [];
   for (const p of points) {
-    positions.push(...p.point_in_world);
+    positions.push(...p.point_in_page);
     const c = new THREE.Color(ResidualCss(p));
     colours.push(c.r, c.g, c.b);
     kinds.push(p.outlier ? 1 : 0);
@@ -217,8 +220,8 @@ scene.add(markers);
 // the frustum and the eye.
 const centre = new THREE.Vector3();
 const bounds = new THREE.Box3();
-for (const p of points) bounds.expandByPoint(V3(p.point_in_world));
-for (const c of fr.image_corners_in_world) bounds.expandByPoint(V3(c));
+for (const p of points) bounds.expandByPoint(V3(p.point_in_page));
+for (const c of fr.image_corners_in_page) bounds.expandByPoint(V3(c));
 bounds.expandByPoint(eye);
 const sphere = bounds.getBoundingSphere(new THREE.Sphere());
 centre.copy(sphere.center);
@@ -342,7 +345,7 @@ function Render() {
     renderer.render(scene, orbitCamera);
     const w = renderer.domElement.clientWidth, h = renderer.domElement.clientHeight;
     points.forEach((p, i) => {
-      projected.fromArray(p.point_in_world).project(orbitCamera);
+      projected.fromArray(p.point_in_page).project(orbitCamera);
       const div = labelDivs[i];
       if (!div) return;
       const visible = projected.z < 1 && Math.abs(projected.x) < 1.2 && Math.abs(projected.y) < 1.2;
@@ -465,11 +468,11 @@ function MeasureThrough() {
     const r = { id: p.id, u: null, v: null };
     results.push(r);
     if (!p.predicted_linear_px) continue;
-    projected.fromArray(p.point_in_world).project(throughCamera);
+    projected.fromArray(p.point_in_page).project(throughCamera);
     const xw = (projected.x + 1) / 2 * W, yw = (projected.y + 1) / 2 * H;
     r.three_math = [xw - 0.5, H - yw - 0.5];
     if (!(xw > kHalf && xw < W - kHalf && yw > kHalf && yw < H - kHalf)) continue;  // at the edge
-    position.setXYZ(0, ...p.point_in_world);
+    position.setXYZ(0, ...p.point_in_page);
     position.needsUpdate = true;
     renderer.setRenderTarget(target);
     renderer.render(alone, throughCamera);

@@ -61,6 +61,17 @@ std::string Base64(std::string_view bytes) {
 json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
 
+// The page's frame: the world moved so that the eye is its origin. The page's buffers are
+// float32 (WebGL's): survey coordinates (UTM, 5e5 m) held to 0.03 m put points 10-16 px off in
+// the view through the camera, before session 43; about the eye they keep float32's 6e-8
+// relative to the scene's size. Every `*_in_page` of the page's data is point_in_world - origin.
+struct PageFrame {
+  Eigen::Vector3d origin_in_world;
+  json operator()(const Eigen::Vector3d& point_in_world) const {
+    return Vec(Eigen::Vector3d(point_in_world - origin_in_world));
+  }
+};
+
 // The cam-frame point at `depth` (z_cam) whose pixel is `pixel` (kCenter), through `intrinsics`
 // (distortion inverted when present); for an orthographic camera the parallel ray's point.
 Eigen::Vector3d PointInCamAtDepth(const Camera& camera, const Intrinsics& intrinsics,
@@ -86,8 +97,8 @@ double Median(std::vector<double> values) {
 // and where the camera puts it (with and without the lens; none behind the camera).
 // `ray_depth_behind` is the depth its ray is drawn to when the point is behind the camera;
 // `max_distortion_px` gets the largest lens displacement seen.
-json PointJson(const Camera& camera, const Correspondences& correspondences, size_t i,
-               bool outlier, double ray_depth_behind, double* max_distortion_px,
+json PointJson(const Camera& camera, const PageFrame& in_page,
+               const Correspondences& correspondences, size_t i, bool outlier, double ray_depth_behind, double* max_distortion_px,
                ViewStats& stats) {
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
@@ -96,7 +107,7 @@ json PointJson(const Camera& camera, const Correspondences& correspondences, siz
   const double depth = (camera.cam_from_world * x).z();
   const std::optional<Eigen::Vector2d> predicted = PixelFromWorld(camera, x);
   json point = {{"id", correspondences.ids[i]},
-                {"point_in_world", Vec(x)},
+                {"point_in_page", in_page(x)},
                 {"observed_px", Vec(observed)},
                 {"outlier", outlier}};
   ++stats.points;
@@ -104,11 +115,11 @@ json PointJson(const Camera& camera, const Correspondences& correspondences, siz
   // point behind the camera); beyond the distortion's fold there is no ray.
   try {
     const double ray_depth = depth > 0.0 ? depth : ray_depth_behind;
-    point["ray_end_in_world"] =
-        Vec(Inverse(camera.cam_from_world) *
+    point["ray_end_in_page"] =
+        in_page(Inverse(camera.cam_from_world) *
             PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
   } catch (const std::domain_error&) {
-    point["ray_end_in_world"] = nullptr;
+    point["ray_end_in_page"] = nullptr;
   }
   if (!predicted) {
     point["predicted_px"] = nullptr;
@@ -135,7 +146,8 @@ json PointJson(const Camera& camera, const Correspondences& correspondences, siz
 
 // The frustum drawn: near plane, the image plane at the points' median depth, a far plane just
 // beyond the farthest point (the camera's own far plane is often far beyond the scene).
-json FrustumJson(const Camera& camera, double median_depth, double max_depth) {
+json FrustumJson(const Camera& camera, const PageFrame& in_page, double median_depth,
+                 double max_depth) {
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
   const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
@@ -147,7 +159,7 @@ json FrustumJson(const Camera& camera, double median_depth, double max_depth) {
     const Eigen::Vector2d image_corners[4] = {
         {-0.5, -0.5}, {w - 0.5, -0.5}, {w - 0.5, h - 0.5}, {-0.5, h - 0.5}};
     for (const Eigen::Vector2d& c : image_corners) {
-      corners.push_back(Vec(world_from_cam * PointInCamAtDepth(camera, pinhole, c, depth)));
+      corners.push_back(in_page(world_from_cam * PointInCamAtDepth(camera, pinhole, c, depth)));
     }
     return corners;
   };
@@ -155,12 +167,13 @@ json FrustumJson(const Camera& camera, double median_depth, double max_depth) {
           {"far", std::isfinite(camera.z_far) ? json(camera.z_far) : json("inf")},
           {"far_drawn", far_drawn},
           {"image_depth", image_depth},
-          {"near_corners_in_world", corners_at(camera.z_near)},
-          {"image_corners_in_world", corners_at(image_depth)},
-          {"far_corners_in_world", corners_at(far_drawn)}};
+          {"near_corners_in_page", corners_at(camera.z_near)},
+          {"image_corners_in_page", corners_at(image_depth)},
+          {"far_corners_in_page", corners_at(far_drawn)}};
 }
 
-json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
+json SceneJson(const Camera& camera, const PageFrame& in_page,
+               const std::vector<int>& outlier_indices,
                const Correspondences* correspondences, ViewStats& stats) {
   std::vector<bool> outlier(correspondences ? correspondences->pixels.size() : 0, false);
   json notes = json::array();
@@ -188,7 +201,7 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
   json points = json::array();
   double max_distortion_px = 0.0;
   for (size_t i = 0; correspondences && i < correspondences->pixels.size(); ++i) {
-    points.push_back(PointJson(camera, *correspondences, i, outlier[i], median_depth,
+    points.push_back(PointJson(camera, in_page, *correspondences, i, outlier[i], median_depth,
                                &max_distortion_px, stats));
   }
   if (max_distortion_px > 0.0) {
@@ -200,15 +213,16 @@ json SceneJson(const Camera& camera, const std::vector<int>& outlier_indices,
   json scene = {{"image_size", {camera.image_size.width, camera.image_size.height}},
                 {"projection", camera.projection == Projection::kOrthographic ? "orthographic"
                                                                                : "perspective"},
-                {"eye_in_world", Vec(Inverse(camera.cam_from_world).translation)},
-                {"frustum", FrustumJson(camera, median_depth, max_depth)},
+                {"page_origin_in_world", Vec(in_page.origin_in_world)},
+                {"eye_in_page", in_page(Inverse(camera.cam_from_world).translation)},
+                {"frustum", FrustumJson(camera, in_page, median_depth, max_depth)},
                 {"points", points},
                 {"notes", notes}};
   ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
-  // The page draws the points in absolute world coordinates, so its camera is absolute too.
-  Camera absolute = camera;
-  absolute.world_origin.reset();
-  scene["three"] = json::parse(ExportCamera(absolute, ExportFormat::kThree, export_options));
+  // The page draws in its frame, so its camera is exported relative to the page's origin.
+  Camera in_page_camera = camera;
+  in_page_camera.world_origin = in_page.origin_in_world;
+  scene["three"] = json::parse(ExportCamera(in_page_camera, ExportFormat::kThree, export_options));
   return scene;
 }
 
@@ -225,7 +239,7 @@ json ImageJson(const std::string& path, const Camera& camera) {
   return {{"name", path}, {"data_url", std::string("data:") + mime + ";base64," + Base64(bytes)}};
 }
 
-json MeshJson(const std::string& path, ViewStats& stats) {
+json MeshJson(const std::string& path, const PageFrame& in_page, ViewStats& stats) {
   const internal::ObjMesh mesh = internal::ParseObjMesh(ReadWholeFile(path, kMaxMeshFileBytes), path);
   // ParseObjMesh skips the lines it does not know (OBJ has many): a file of none it knows is
   // not a mesh, and drawing nothing would hide that.
@@ -233,7 +247,11 @@ json MeshJson(const std::string& path, ViewStats& stats) {
     throw InputError(path + ": no faces (f lines with vertices from v lines): not an OBJ mesh");
   }
   stats.mesh_triangles = static_cast<int>(mesh.triangles.size() / 3);
-  return {{"name", path}, {"positions", mesh.positions}, {"triangles", mesh.triangles}};
+  std::vector<double> positions_in_page = mesh.positions;
+  for (size_t i = 0; i < positions_in_page.size(); ++i) {
+    positions_in_page[i] -= in_page.origin_in_world[static_cast<int>(i % 3)];
+  }
+  return {{"name", path}, {"positions_in_page", positions_in_page}, {"triangles", mesh.triangles}};
 }
 
 // JSON inside a <script> element: '<' escaped so that no "</script" or "<!--" can end or change
@@ -364,13 +382,14 @@ std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_te
       fit = document["fit"];
     }
   }
-  json data = SceneJson(camera, OutlierIndicesFromJsonText(camera_file_text, camera_name),
+  const PageFrame in_page{Inverse(camera.cam_from_world).translation};
+  json data = SceneJson(camera, in_page, OutlierIndicesFromJsonText(camera_file_text, camera_name),
                         correspondences, stats);
   const json fit_shown = fit.is_null() ? json(nullptr) : FitRecordForPage(fit, data["notes"]);
   data["fit"] = fit_shown;
   data["camera_name"] = camera_name;
   data["image"] = options.image_path.empty() ? json(nullptr) : ImageJson(options.image_path, camera);
-  data["mesh"] = options.mesh_path.empty() ? json(nullptr) : MeshJson(options.mesh_path, stats);
+  data["mesh"] = options.mesh_path.empty() ? json(nullptr) : MeshJson(options.mesh_path, in_page, stats);
   const internal::ViewAssets& assets = internal::EmbeddedViewAssets();
   data["three_version"] = std::string(assets.three_version);
 
