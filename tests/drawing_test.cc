@@ -41,13 +41,21 @@ TEST(DrawingTest, MarkupEscapeWritesOnlyWellFormedUtf8) {
   EXPECT_EQ(MarkupEscape("x\xC3"), "x\xEF\xBF\xBD");
 }
 
+// kCenter: a w x h image spans -0.5 to w - 0.5, its edges included.
+TEST(DrawingTest, InsideImageSpansHalfAPixelBeyondTheOuterCentres) {
+  EXPECT_TRUE(InsideImage({-0.5, -0.5}, 30, 20));
+  EXPECT_TRUE(InsideImage({29.5, 19.5}, 30, 20));
+  EXPECT_FALSE(InsideImage({29.5 + 1e-9, 10.0}, 30, 20));
+  EXPECT_FALSE(InsideImage({10.0, -0.5 - 1e-9}, 30, 20));
+}
+
 // The arrow stays inside the image and points at the target for every image size, down to those
 // smaller than two arrow lengths (std::clamp's bounds crossed there: undefined behaviour).
 TEST(DrawingTest, BorderArrowsStayInsideImagesOfAnySize) {
   constexpr double kLength = 24.0;
   constexpr double kExact = 1e-12;  // px: a clamp and one normalisation
   for (const auto& [w, h] : {std::pair{1000, 800}, std::pair{30, 20}, std::pair{1, 1}}) {
-    for (const Eigen::Vector2d target : {Eigen::Vector2d(-50.0, 10.0), Eigen::Vector2d(5000.0, -3.0),
+    for (const Eigen::Vector2d& target : {Eigen::Vector2d(-50.0, 10.0), Eigen::Vector2d(5000.0, -3.0),
                                          Eigen::Vector2d(12.0, 1e6)}) {
       const auto [tail, tip] = BorderArrow(target, w, h, kLength);
       EXPECT_GE(tip.x(), 0.0);

@@ -194,13 +194,13 @@ double DrawResidualsOverImage(const FitResult& fit, const ReportResiduals& resid
   // An observed pixel outside the image (kCenter: it spans -0.5 to w - 0.5) is an arrow at the
   // border pointing at it, 24 report px long, with its id and where it is.
   const double border_arrow_px = 24.0 / scale;
+  const int w = fit.camera.image_size.width, h = fit.camera.image_size.height;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& o = observed_pixels[i];
     const std::string id = MarkupEscape(ids[i]);
     const bool left_out = outlier[i] || !std::isfinite(length[i]);
-    if (!(o.x() >= -0.5 && o.x() <= w_img - 0.5 && o.y() >= -0.5 && o.y() <= h_img - 0.5)) {
-      const auto [tail, tip] = internal::BorderArrow(o, fit.camera.image_size.width,
-                                                     fit.camera.image_size.height, border_arrow_px);
+    if (!internal::InsideImage(o, w, h)) {
+      const auto [tail, tip] = internal::BorderArrow(o, w, h, border_arrow_px);
       const std::string colour = left_out ? kOutlier : Viridis(length[i] / colour_top);
       body << "<line x1='" << sx(tail.x()) << "' y1='" << sy(tail.y()) << "' x2='" << sx(tip.x())
            << "' y2='" << sy(tip.y()) << "' stroke='" << colour

@@ -86,7 +86,8 @@ cv::Scalar Viridis(double t) {
     return coloured;
   }();
   // NaN (a residual that overflowed, inf / inf) is off the scale at its top, as inf is.
-  const int i = static_cast<int>(std::lround((std::isnan(t) ? 1.0 : std::clamp(t, 0.0, 1.0)) * 255.0));
+  const double on_scale = std::isnan(t) ? 1.0 : std::clamp(t, 0.0, 1.0);
+  const int i = static_cast<int>(std::lround(on_scale * 255.0));
   const cv::Vec3b c = lut.at<cv::Vec3b>(0, i);
   return cv::Scalar(c[0], c[1], c[2]);
 }
@@ -351,9 +352,7 @@ std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Corresponden
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
   const size_t n = correspondences.pixels.size();
-  const auto inside = [&](const Eigen::Vector2d& p) {
-    return p.x() >= -0.5 && p.x() <= w - 0.5 && p.y() >= -0.5 && p.y() <= h - 0.5;
-  };
+  const auto inside = [&](const Eigen::Vector2d& p) { return internal::InsideImage(p, w, h); };
   std::vector<OverlayPoint> points(n);
   for (size_t i = 0; i < n; ++i) {
     OverlayPoint& point = points[i];

@@ -98,8 +98,8 @@ double Median(std::vector<double> values) {
 // `ray_depth_behind` is the depth its ray is drawn to when the point is behind the camera;
 // `max_distortion_px` gets the largest lens displacement seen.
 json PointJson(const Camera& camera, const PageFrame& in_page,
-               const Correspondences& correspondences, size_t i, bool outlier, double ray_depth_behind, double* max_distortion_px,
-               ViewStats& stats) {
+               const Correspondences& correspondences, size_t i, bool outlier,
+               double ray_depth_behind, double* max_distortion_px, ViewStats& stats) {
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
   const Eigen::Vector3d& x = correspondences.points_in_world[i];
@@ -137,8 +137,7 @@ json PointJson(const Camera& camera, const PageFrame& in_page,
   point["predicted_px"] = Vec(*predicted);
   point["predicted_linear_px"] = Vec(linear);
   point["residual_px"] = (*predicted - observed).norm();
-  const bool inside = predicted->x() >= -0.5 && predicted->x() <= w - 0.5 &&
-                      predicted->y() >= -0.5 && predicted->y() <= h - 0.5;
+  const bool inside = internal::InsideImage(*predicted, w, h);
   point["inside_image"] = inside;
   if (!inside) ++stats.outside_image;
   return point;
