@@ -485,6 +485,31 @@ PY
     expect_in out "^note: near 1.2, far .*: near as given (--near); far covers the fitted points' depths only, widened by 10 %.*--far as well"
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --far 2
     expect_in out "^note: near .*, far 2: far as given (--far); near covers the fitted points' depths only"
+    expect_not_in out "clips"
+    # Given planes between the points' depths (1.317 to 1.794) clip some: the note counts them,
+    # the farthest beyond each plane first, checked against the written camera's depths.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --near 1.35 \
+      --far 1.4 -o "$work/clipped.json"
+    py - "$work/clipped.json" "$data/projector/points.csv" "$work/out" <<'PY' || fail "the clipped-points notes do not match the camera's depths"
+import csv, json, re, sys
+c = json.load(open(sys.argv[1]))
+R, t = c["cam_from_world"]["R"], c["cam_from_world"]["t"]
+rows = list(csv.DictReader(l for l in open(sys.argv[2]) if not l.startswith("#")))
+depth = {str(i + 1): sum(R[2][k] * float(r[a]) for k, a in enumerate("XYZ")) + t[2]
+         for i, r in enumerate(rows)}
+near = sorted((d, i) for i, d in depth.items() if d < 1.35)
+far = sorted(((d, i) for i, d in depth.items() if d > 1.4), reverse=True)
+out = open(sys.argv[3]).read()
+want = [f"note: --near 1.35 clips {len(near)} of the 20 fitted points, nearer than it "
+        f"(point {near[0][1]} at depth {near[0][0]:.6g}, point {near[1][1]} at {near[1][0]:.6g}",
+        f"note: --far 1.4 clips {len(far)} of the 20 fitted points, farther than it "
+        f"(point {far[0][1]} at depth {far[0][0]:.6g}, point {far[1][1]} at {far[1][0]:.6g}",
+        f"give --near below {near[0][0]:.6g} to draw them",
+        f"give --far beyond {far[0][0]:.6g} to draw them"]
+missing = [w for w in want if w not in out]
+print(missing)
+sys.exit(1 if missing or not near or not far else 0)
+PY
     # A given plane past every point is refused with the answer's depths (1.317 to 1.794 m).
     expect_exit 3 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --near 1.85
     expect_in err "every point is nearer than the given near plane 1.85: the fitted camera sees the points at depths 1.31"
@@ -493,6 +518,12 @@ PY
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
       --bounds-mesh "$data/projector/box.obj" -o "$work/mesh.json"
     expect_in out "^note: near .*cover the --bounds box (its 8 corners' depths, widened by 10 %)"
+    expect_not_in out "clips"
+    # A box smaller than the points: its near plane clips the nearest, and the note says how to
+    # keep them.
+    expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
+      --bounds=-0.1,-0.1,-0.1,0.1,0.1,0.1
+    expect_in out "^note: the near plane .* (covering the --bounds box) clips [0-9]* of the 20 fitted points, nearer than it (.*): an OpenGL render of this camera draws them nowhere; widen --bounds to hold them, or give --near below "
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 \
       --bounds=-0.5,-0.3,-0.4,0.5,0.3,0.4 -o "$work/box.json"
     py -c "import json, sys; a, b = (json.load(open(f))['frustum'] for f in sys.argv[1:]); sys.exit(not (a['near'], a['far']) == (b['near'], b['far']))" \

@@ -410,9 +410,14 @@ void AddViewOptions(CLI::App* app, FitArgs* args) {
       ->check(CLI::NonNegativeNumber);
 }
 
-// The notes after the summary: near and far, the region judged, the world origin or float32.
-void PrintNotes(const FitRequest& request, const FitResult& fit) {
+// The notes after the summary: near and far, the fitted points they clip, the region judged,
+// the world origin or float32.
+void PrintNotes(const FitRequest& request, const FitResult& fit, const Correspondences& data) {
   std::cout << "note: " << NearFarNote(request, fit);
+  std::istringstream clipped(ClippedPointsNote(request, fit, data.points_in_world, data.ids));
+  for (std::string line; std::getline(clipped, line);) {
+    std::cout << "note: " << TerminalSafe(line) << '\n';
+  }
   if (const std::string judged = JudgedRegionNote(request, fit); !judged.empty()) {
     std::cout << "note: " << judged;
   }
@@ -477,7 +482,7 @@ int FitOneFile(const std::string& input, const ImageSize& size, const FitRequest
     std::cout << text;
   } else {
     std::cout << TerminalSafe(FitSummaryText(fit, data.ids));
-    PrintNotes(request, fit);
+    PrintNotes(request, fit, data);
     if (!args.output_path.empty()) std::cout << "wrote " << TerminalSafe(args.output_path) << "\n";
     // The summary's time is the fit's; reading and writing the files add to it.
     const double wall_ms =

@@ -5,8 +5,10 @@
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camproj/errors.h"
@@ -15,6 +17,7 @@
 #include "camproj/number_text.h"
 #include "camproj/world_origin.h"
 #include "check.h"
+#include "fit/scene.h"
 #include "view/obj_mesh.h"
 #include "view/ply_vertices.h"
 
@@ -464,6 +467,68 @@ std::string NearFarNote(const FitRequest& request, const FitResult& fit) {
   return range + std::string("cover the fitted points' depths only") + margin +
          "; the rest of the model may be clipped: give --bounds X0,Y0,Z0,X1,Y1,Z1 or "
          "--bounds-mesh model.obj (or .ply) to cover it, or --near/--far\n";
+}
+
+namespace {
+
+// The note of one plane (ClippedPointsNote): `clipped` holds (depth, index) of each kept point
+// beyond it, the farthest beyond first.
+std::string ClippedByPlane(bool near, double plane, bool given,
+                           const std::vector<std::pair<double, int>>& clipped, int kept,
+                           const std::vector<std::string>& ids) {
+  using internal::Concat;
+  const char* option = near ? "--near" : "--far";
+  const std::string which =
+      given ? Concat(option, " ", ShortestDouble(plane))
+            : Concat("the ", near ? "near" : "far", " plane ", GeneralDouble(plane, 6),
+                     " (covering the --bounds box)");
+  std::string names;
+  constexpr size_t kNamed = 3;
+  for (size_t i = 0; i < std::min(clipped.size(), kNamed); ++i) {
+    const auto [depth, index] = clipped[i];
+    const std::string id = index < static_cast<int>(ids.size()) ? ids[index]
+                                                                : std::to_string(index + 1);
+    names += Concat(i == 0 ? "" : ", ", internal::PointName(id), i == 0 ? " at depth " : " at ",
+                    GeneralDouble(depth, 6));
+  }
+  if (clipped.size() > kNamed) names += Concat(" and ", clipped.size() - kNamed, " more");
+  const std::string keep = Concat("give ", option, near ? " below " : " beyond ",
+                                  GeneralDouble(clipped.front().first, 6), " to draw them");
+  return Concat(which, " clips ", clipped.size(), " of the ", kept, " fitted points, ",
+                near ? "nearer" : "farther", " than it (", names,
+                "): an OpenGL render of this camera draws them nowhere; ",
+                given ? keep : Concat("widen --bounds to hold them, or ", keep), "\n");
+}
+
+}  // namespace
+
+std::string ClippedPointsNote(const FitRequest& request, const FitResult& fit,
+                              const std::vector<Eigen::Vector3d>& points_in_world,
+                              const std::vector<std::string>& ids) {
+  const FitOptions& options = request.options();
+  // The planes a fit sets itself cover its points (DepthRangeOfPoints).
+  if (!options.z_near && !options.z_far && !request.bounds_in_world) return "";
+  std::vector<bool> left_out(points_in_world.size(), false);
+  for (const int i : fit.outliers) left_out.at(static_cast<size_t>(i)) = true;
+  std::vector<std::pair<double, int>> nearer, farther;
+  int kept = 0;
+  for (size_t i = 0; i < points_in_world.size(); ++i) {
+    if (left_out[i]) continue;
+    ++kept;
+    const double depth = (fit.camera.cam_from_world * points_in_world[i]).z();
+    if (depth < fit.camera.z_near) nearer.emplace_back(depth, static_cast<int>(i));
+    if (depth > fit.camera.z_far) farther.emplace_back(depth, static_cast<int>(i));
+  }
+  std::sort(nearer.begin(), nearer.end());
+  std::sort(farther.begin(), farther.end(), std::greater<>());
+  std::string note;
+  if (!nearer.empty()) {
+    note += ClippedByPlane(true, fit.camera.z_near, options.z_near.has_value(), nearer, kept, ids);
+  }
+  if (!farther.empty()) {
+    note += ClippedByPlane(false, fit.camera.z_far, options.z_far.has_value(), farther, kept, ids);
+  }
+  return note;
 }
 
 std::string JudgedRegionNote(const FitRequest& request, const FitResult& fit) {

@@ -104,6 +104,16 @@ FitResult RunFitRequest(const std::vector<Eigen::Vector3d>& points_in_world,
 // points' depths only (the default; with how to cover the whole model), the box, or the options.
 std::string NearFarNote(const FitRequest& request, const FitResult& fit);
 
+// A line (ending in '\n') for each of the fitted camera's near and far planes -- given (--near,
+// --far) or covering the --bounds box -- that clips points the fit kept, which an OpenGL render
+// of the camera then draws nowhere: how many, the farthest beyond the plane first by id and
+// depth, and what to give to keep them. `points_in_world` and `ids` are the fit's input (ids may be empty: rows
+// numbered from 1). Empty where every kept point lies between the planes, as it always does
+// with the planes a fit sets itself.
+std::string ClippedPointsNote(const FitRequest& request, const FitResult& fit,
+                              const std::vector<Eigen::Vector3d>& points_in_world,
+                              const std::vector<std::string>& ids);
+
 // One line (ending in '\n') where the fit's determination check judged the camera over the box
 // the fitted points span alone (no --object-points or --bounds-mesh): beyond that box the camera is
 // extrapolated, and what to give to have it judged there too. Empty otherwise.
