@@ -925,6 +925,60 @@ PY
     grep -q "the camera file's fit.left_out is not as camproj fit writes it" "$work/xss.html" \
       || fail "no note for the mistyped fit.left_out"
     grep -q '"rms_px":' "$work/xss.html" || fail "the well-typed fit fields are not in the page"
+    # A lens: the image plane is drawn through it, each vertex on its pixel's ray (the photo's
+    # pixel where the ray through it meets the plane), and the note names the lens's terms; an
+    # orthographic camera's rays start on the near plane, along the view axis (they started
+    # behind the camera, from the eye's side, before session 44).
+    py - "$data/projector/truth.json" "$work" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+for k in ("gl", "look_at"): del c[k]
+c["frustum"] = {"near": c["frustum"]["near"], "far": c["frustum"]["far"]}
+c["intrinsics"].update(k1=-0.15, k2=0.02)
+json.dump(c, open(sys.argv[2] + "/lens.json", "w"))
+c["projection"] = "orthographic"
+c["intrinsics"] = dict(fx=800.0, fy=800.0, cx=959.5, cy=539.5, skew=0.0)
+c["frustum"] = {"near": 0.5, "far": 3.0}
+json.dump(c, open(sys.argv[2] + "/ortho.json", "w"))
+PY
+    expect_exit 0 "$bin" view "$work/lens.json" "$data/projector/points.csv" -o "$work/lens.html"
+    expect_exit 0 "$bin" view "$work/ortho.json" "$data/projector/points.csv" -o "$work/ortho.html"
+    py - "$work/lens.json" "$work/lens.html" "$work/ortho.json" "$work/ortho.html" <<'PY' || fail "the page's image plane or rays are not the camera's"
+import json, re, sys
+def page_data(path):
+    text = open(path).read()
+    m = re.search(r'<script type="application/json" id="camproj-data">(.*?)</script>', text, re.S)
+    return json.loads(m.group(1))
+def cam_point(c, X):
+    R, t = c["cam_from_world"]["R"], c["cam_from_world"]["t"]
+    return [sum(R[i][k] * X[k] for k in range(3)) + t[i] for i in range(3)]
+# Each vertex at the image plane's depth, on its pixel's ray: projected with the lens (k1, k2 as
+# OpenCV's model) onto the pixel its texture coordinate names, to double rounding at 2000 px.
+c, d = json.load(open(sys.argv[1])), page_data(sys.argv[2])
+K, (W, H) = c["intrinsics"], c["image_size"]
+o, img, depth = d["page_origin_in_world"], d["frustum"]["image_plane"], d["frustum"]["image_depth"]
+assert img["through_lens"] and len(img["triangles"]) > 2, "the lens's image plane is not a grid"
+worst = 0.0
+for p, (s, tv) in zip(img["positions_in_page"], img["uv"]):
+    x = cam_point(c, [p[k] + o[k] for k in range(3)])
+    assert abs(x[2] - depth) <= 1e-9 * depth, (x[2], depth)
+    xn, yn = x[0] / x[2], x[1] / x[2]
+    r2 = xn * xn + yn * yn
+    f = 1 + K["k1"] * r2 + K["k2"] * r2 * r2
+    u, v = K["fx"] * xn * f + K["cx"], K["fy"] * yn * f + K["cy"]
+    worst = max(worst, abs(u - (-0.5 + s * W)), abs(v - (-0.5 + (1 - tv) * H)))
+assert worst <= 1e-6, worst
+assert any("the lens (k1 = -0.15, k2 = 0.02)" in n for n in d["notes"]), d["notes"]
+c, d = json.load(open(sys.argv[3])), page_data(sys.argv[4])
+o, rays = d["page_origin_in_world"], 0
+for p in d["points"]:
+    a = cam_point(c, [p["ray_start_in_page"][k] + o[k] for k in range(3)])
+    b = cam_point(c, [p["ray_end_in_page"][k] + o[k] for k in range(3)])
+    assert abs(a[2] - c["frustum"]["near"]) <= 1e-9, a
+    assert abs(a[0] - b[0]) <= 1e-9 and abs(a[1] - b[1]) <= 1e-9, (a, b)
+    rays += 1
+assert rays == 20 and not d["frustum"]["image_plane"]["through_lens"]
+PY
     cp "$data/projector/truth.json" "$work/cam.html"
     expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
     expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"

@@ -96,14 +96,19 @@ const fr = data.frustum;
     if (data.projection === 'perspective') lines.push([data.eye_in_page, near[i]]);
   }
   orbitOnly.add(Segments(lines, 0xd8dce3, 0.85));
-  // The image's top edge, so that the frustum's up is obvious.
-  const img = fr.image_corners_in_page;
-  orbitOnly.add(Segments([[img[0], img[1]]], 0x56b4e9));
+  // The image plane through the lens (computed by camproj: a grid whose vertices lie on their
+  // pixels' rays). Its top edge in colour, so that the frustum's up is obvious.
+  const img = fr.image_plane;
+  const Polyline = (vertices, closed) => vertices.slice(0, closed ? vertices.length : -1)
+      .map((v, i) => [v, vertices[(i + 1) % vertices.length]]);
+  if (img.top_edge_in_page.length > 1) {
+    orbitOnly.add(Segments(Polyline(img.top_edge_in_page, false), 0x56b4e9));
+  }
   const plane = new THREE.BufferGeometry();
-  plane.setAttribute('position', new THREE.Float32BufferAttribute(
-      [img[0], img[1], img[2], img[0], img[2], img[3]].flat(), 3));
-  // Texture v runs up: the image's top row (corners 0, 1) at v = 1.
-  plane.setAttribute('uv', new THREE.Float32BufferAttribute([0, 1, 1, 1, 1, 0, 0, 1, 1, 0, 0, 0], 2));
+  plane.setAttribute('position', new THREE.Float32BufferAttribute(img.positions_in_page.flat(), 3));
+  // Texture v runs up: the image's top row at v = 1.
+  plane.setAttribute('uv', new THREE.Float32BufferAttribute(img.uv.flat(), 2));
+  plane.setIndex(img.triangles.flat());
   const material = new THREE.MeshBasicMaterial({ color: 0x60656e, side: THREE.DoubleSide,
                                                  transparent: true, opacity: 0.35,
                                                  depthWrite: false });
@@ -117,8 +122,9 @@ const fr = data.frustum;
     });
   }
   orbitOnly.add(new THREE.Mesh(plane, material));
-  orbitOnly.add(Segments([[img[0], img[1]], [img[1], img[2]], [img[2], img[3]], [img[3], img[0]]],
-                         0x9aa0a6));
+  if (img.outline_in_page.length > 1) {
+    orbitOnly.add(Segments(Polyline(img.outline_in_page, true), 0x9aa0a6));
+  }
 }
 // Rays from the eye through each observed pixel, to the point's depth, and the residual in the
 // world: from the ray's end to the point.
@@ -127,10 +133,7 @@ const fr = data.frustum;
   const gapColours = [];
   for (const p of points) {
     if (!p.ray_end_in_page) continue;
-    const start = data.projection === 'perspective' ? data.eye_in_page
-        : p.ray_end_in_page.map((x, k) => x + (fr.near_corners_in_page[0][k] -
-                                                fr.far_corners_in_page[0][k]));
-    (p.outlier ? outlierRays : rays).push([start, p.ray_end_in_page]);
+    (p.outlier ? outlierRays : rays).push([p.ray_start_in_page, p.ray_end_in_page]);
     gaps.push([p.ray_end_in_page, p.point_in_page]);
     const c = new THREE.Color(ResidualCss(p));
     gapColours.push(c.r, c.g, c.b, c.r, c.g, c.b);
@@ -221,7 +224,7 @@ scene.add(markers);
 const centre = new THREE.Vector3();
 const bounds = new THREE.Box3();
 for (const p of points) bounds.expandByPoint(V3(p.point_in_page));
-for (const c of fr.image_corners_in_page) bounds.expandByPoint(V3(c));
+for (const c of fr.image_plane.outline_in_page) bounds.expandByPoint(V3(c));
 bounds.expandByPoint(eye);
 const sphere = bounds.getBoundingSphere(new THREE.Sphere());
 centre.copy(sphere.center);
@@ -367,6 +370,16 @@ function Escape(text) {
                                                  '"': '&quot;' })[c]);
 }
 function Fixed(x, digits) { return x === null || x === undefined ? '–' : Number(x).toFixed(digits); }
+// The unit of a parameter's sigma as the camera file names it (docs/camera-file.md, `sigma`).
+function SigmaUnit(name) {
+  if (name.endsWith('_deg')) return '°';
+  if (name.startsWith('eye_')) return 'world units';
+  if (['fx', 'fy', 'skew'].includes(name)) {
+    return data.projection === 'perspective' ? 'px' : 'px per world unit';
+  }
+  if (['cx', 'cy'].includes(name)) return 'px';
+  return '';  // k1, k2, p1, p2, k3: no unit
+}
 function Report() {
   document.getElementById('title').textContent = data.camera_name;
   const bar = kViridis.map(c => `rgb(${c})`).join(',');
@@ -377,9 +390,13 @@ function Report() {
       <span>${Fixed(scaleMaxPx, 2)} px</span></div>
     ${points.some(p => p.outlier) ? `<div><span style="color:${kOutlierCss}">◯ ring, dashed
       circle</span>: left out by the fit (outlier)</div>` : ''}
-    <div class="muted">Orbit: frustum (near plane, image plane at the points' median depth
-      ${Fixed(fr.image_depth, 3)}, far plane drawn at ${Fixed(fr.far_drawn, 3)}; the camera's far
-      is ${typeof fr.far === 'number' ? Number(fr.far).toPrecision(4) : fr.far}), rays eye → observed pixel, coloured segment = the residual in the world.
+    <div class="muted">Orbit: frustum (near plane, image plane at ${data.image_depth_is_median
+      ? "the points' median depth" : 'depth'} ${Fixed(fr.image_depth, 3)}${fr.image_plane.through_lens
+      ? ' drawn through the lens (its edges bend where the linear frustum\'s are straight)' : ''},
+      far plane drawn at ${Fixed(fr.far_drawn, 3)}; the camera's far
+      is ${typeof fr.far === 'number' ? Number(fr.far).toPrecision(4) : fr.far}), ${data.projection ===
+      'perspective' ? 'rays eye → observed pixel' : 'rays (parallel) from the near plane through each observed pixel'},
+      coloured segment = the residual in the world.
       Through the camera: circle = observed pixel, cross = where three.js renders the point with
       the exported camera, line = residual.</div>`;
   for (const n of data.notes) legend += `<div class="note">${Escape(n)}</div>`;
@@ -409,7 +426,8 @@ function Report() {
   if (fit && fit.sigma) {
     html += '<h2>Parameters ± σ</h2><table>' +
         Object.entries(fit.sigma).map(([k, v]) =>
-            `<tr><td>${Escape(k)}</td><td class="num">± ${Number(v).toPrecision(3)}</td></tr>`)
+            `<tr><td>${Escape(k)}</td><td class="num">± ${Number(v).toPrecision(3)}</td>
+             <td class="muted">${SigmaUnit(k)}</td></tr>`)
             .join('') + '</table>';
   }
   if (fit && fit.left_out && fit.left_out.length) {

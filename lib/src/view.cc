@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,12 +114,19 @@ json PointJson(const Camera& camera, const PageFrame& in_page,
   ++stats.points;
   // The observed pixel's ray, drawn from the eye to the point's depth (the median depth for a
   // point behind the camera); beyond the distortion's fold there is no ray.
+  // An orthographic camera's rays are parallel: drawn from the near plane, not from the eye.
   try {
+    const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
     const double ray_depth = depth > 0.0 ? depth : ray_depth_behind;
+    point["ray_start_in_page"] =
+        camera.projection == Projection::kOrthographic
+            ? in_page(world_from_cam *
+                      PointInCamAtDepth(camera, camera.intrinsics, observed, camera.z_near))
+            : in_page(world_from_cam.translation);
     point["ray_end_in_page"] =
-        in_page(Inverse(camera.cam_from_world) *
-            PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
+        in_page(world_from_cam * PointInCamAtDepth(camera, camera.intrinsics, observed, ray_depth));
   } catch (const std::domain_error&) {
+    point["ray_start_in_page"] = nullptr;
     point["ray_end_in_page"] = nullptr;
   }
   if (!predicted) {
@@ -143,8 +151,66 @@ json PointJson(const Camera& camera, const PageFrame& in_page,
   return point;
 }
 
-// The frustum drawn: near plane, the image plane at the points' median depth, a far plane just
-// beyond the farthest point (the camera's own far plane is often far beyond the scene).
+// The image plane at `depth` as the lens sees it: a grid of pixels from the image's outer
+// corner to corner (kCenter -0.5 .. W - 0.5), each vertex on its pixel's ray (the lens inverted;
+// with distortion the plane's edges bend where the linear frustum's are straight), with the
+// photo's texture coordinate (v up) and two triangles per cell. A pinhole camera needs one cell;
+// a lens gets kLensCells along the image's longer side, so that the photo's pixel is within
+// a fraction of a pixel of its ray between vertices. A vertex beyond the lens's fold (no ray) is
+// left out with its cells. `top` gets the vertices of the image's top row, `outline` of its
+// border in order round it (both in page coordinates, those with a ray).
+json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth) {
+  constexpr int kLensCells = 48;
+  const int w = camera.image_size.width;
+  const int h = camera.image_size.height;
+  const bool lens = camera.intrinsics.HasDistortion();
+  const int cols = lens ? (w >= h ? kLensCells : std::max(2, kLensCells * w / h)) : 1;
+  const int rows = lens ? (h >= w ? kLensCells : std::max(2, kLensCells * h / w)) : 1;
+  const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
+  std::vector<std::optional<json>> vertex((cols + 1) * (rows + 1));
+  json positions = json::array(), uv = json::array(), index = json::array();
+  std::vector<int> slot(vertex.size(), -1);
+  for (int r = 0; r <= rows; ++r) {
+    for (int c = 0; c <= cols; ++c) {
+      const double s = static_cast<double>(c) / cols, t = static_cast<double>(r) / rows;
+      const Eigen::Vector2d pixel(-0.5 + s * w, -0.5 + t * h);
+      try {
+        const json p = in_page(world_from_cam *
+                               PointInCamAtDepth(camera, camera.intrinsics, pixel, depth));
+        slot[r * (cols + 1) + c] = static_cast<int>(positions.size());
+        vertex[r * (cols + 1) + c] = p;
+        positions.push_back(p);
+        uv.push_back({s, 1.0 - t});
+      } catch (const std::domain_error&) {
+        // beyond the lens's fold: no ray
+      }
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const int a = slot[r * (cols + 1) + c], b = slot[r * (cols + 1) + c + 1];
+      const int d = slot[(r + 1) * (cols + 1) + c], e = slot[(r + 1) * (cols + 1) + c + 1];
+      if (a < 0 || b < 0 || d < 0 || e < 0) continue;
+      index.push_back({a, b, e});
+      index.push_back({a, e, d});
+    }
+  }
+  json top = json::array(), outline = json::array();
+  const auto add = [&](json& to, int r, int c) {
+    if (const auto& p = vertex[r * (cols + 1) + c]) to.push_back(*p);
+  };
+  for (int c = 0; c <= cols; ++c) add(top, 0, c);
+  for (int c = 0; c < cols; ++c) add(outline, 0, c);
+  for (int r = 0; r < rows; ++r) add(outline, r, cols);
+  for (int c = cols; c > 0; --c) add(outline, rows, c);
+  for (int r = rows; r >= 0; --r) add(outline, r, 0);
+  return {{"positions_in_page", positions}, {"uv", uv}, {"triangles", index},
+          {"top_edge_in_page", top}, {"outline_in_page", outline}, {"through_lens", lens}};
+}
+
+// The frustum drawn: the GL camera's (linear) near plane, the image plane through the lens at
+// the points' median depth (ImagePlaneJson), a far plane just beyond the farthest point (the
+// camera's own far plane is often far beyond the scene).
 json FrustumJson(const Camera& camera, const PageFrame& in_page, double median_depth,
                  double max_depth) {
   const int w = camera.image_size.width;
@@ -167,7 +233,7 @@ json FrustumJson(const Camera& camera, const PageFrame& in_page, double median_d
           {"far_drawn", far_drawn},
           {"image_depth", image_depth},
           {"near_corners_in_page", corners_at(camera.z_near)},
-          {"image_corners_in_page", corners_at(image_depth)},
+          {"image_plane", ImagePlaneJson(camera, in_page, image_depth)},
           {"far_corners_in_page", corners_at(far_drawn)}};
 }
 
@@ -205,8 +271,8 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
   }
   if (max_distortion_px > 0.0) {
     notes.push_back(Concat(
-        "three.js cameras are linear: k1, k2 are left out of the view through the camera, which "
-        "moves the points there by up to ",
+        "three.js cameras are linear: the lens (", DistortionText(camera.intrinsics),
+        ") is left out of the view through the camera, which moves the points there by up to ",
         std::round(max_distortion_px * 100) / 100, " px against camproj project"));
   }
   json scene = {{"image_size", {camera.image_size.width, camera.image_size.height}},
@@ -215,6 +281,7 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
                 {"page_origin_in_world", Vec(in_page.origin_in_world)},
                 {"eye_in_page", in_page(Inverse(camera.cam_from_world).translation)},
                 {"frustum", FrustumJson(camera, in_page, median_depth, max_depth)},
+          {"image_depth_is_median", !depths.empty()},
                 {"points", points},
                 {"notes", notes}};
   ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
