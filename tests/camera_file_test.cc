@@ -243,6 +243,33 @@ TEST(CameraFileTest, CalibrationViewsAreSelectedByName) {
             "calib.json, view a: camera: missing");
 }
 
+// The convention a file states cx, cy in, for the commands that compare it with the user's
+// pixels: the camera file's pixel_origin, a calibration view's, kCenter where absent; a bad value
+// refused as the camera reader refuses it.
+TEST(CameraFileTest, PixelOriginIsTheFilesStatedConvention) {
+  std::mt19937_64 rng(testing::Seed(32));
+  const Camera camera = RandomFileCamera(rng);
+  for (const PixelOrigin origin : {PixelOrigin::kCenter, PixelOrigin::kCorner}) {
+    CameraFileOptions options;
+    options.pixel_origin = origin;
+    EXPECT_EQ(CameraFilePixelOrigin(CameraToJsonText(camera, options), "cam.json"), origin);
+    Calibration calibration;
+    calibration.image_size = camera.image_size;
+    CalibratedView view;
+    view.name = "left01";
+    view.camera = camera;
+    view.num_points = 54;
+    calibration.views.push_back(view);
+    calibration.intrinsics = camera.intrinsics;
+    const std::string text = CalibrationToJsonText(calibration, options);
+    EXPECT_EQ(CameraFilePixelOrigin(text, "calib.json", "left01"), origin);
+  }
+  EXPECT_EQ(CameraFilePixelOrigin(R"({"image_size": [640, 480]})", "cam.json"),
+            PixelOrigin::kCenter);
+  EXPECT_THROW(CameraFilePixelOrigin(R"({"pixel_origin": "middle"})", "cam.json"), InputError);
+  EXPECT_THROW(CameraFilePixelOrigin(R"({"views": []})", "calib.json", "left01"), InputError);
+}
+
 // Every reader of the JSON files goes through one parser, so a number beyond a double's range
 // names its line in a calibration file's view and in an intrinsics file as in a camera file
 // (fx 1e-400 read as 0 would be "fx must be positive, got 0", with no line).

@@ -979,6 +979,34 @@ for p in d["points"]:
     rays += 1
 assert rays == 20 and not d["frustum"]["image_plane"]["through_lens"]
 PY
+    # A camera fitted in the corner convention beside points whose convention is left to the
+    # default: overlay, view and project say the two differ; given either way, nothing is said.
+    py - "$data/projector/points.csv" "$work/corner.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith("#")))
+with open(sys.argv[2], "w") as f:
+    f.write("X,Y,Z,u,v\n")
+    for r in rows:
+        f.write(f"{r['X']},{r['Y']},{r['Z']},{float(r['u']) + 0.5!r},{float(r['v']) + 0.5!r}\n")
+PY
+    expect_exit 0 "$bin" fit "$work/corner.csv" --image-size 1920x1080 --pixel-origin corner -o "$work/corner.json"
+    note="corner.json states its cx, cy in the corner convention (its pixel_origin), but"
+    expect_exit 0 "$bin" view "$work/corner.json" "$work/corner.csv" -o "$work/corner.html"
+    expect_in err "^camproj: note: .*$note .*corner.csv's pixels are read in the center convention (--pixel-origin's default; the two differ by 0.5 px along u and v): give --pixel-origin corner to use the camera file's"
+    expect_exit 0 "$bin" overlay "$work/corner.json" "$work/corner.csv" -o "$work/corner.png"
+    expect_in err "^camproj: note: .*$note .*corner.csv's pixels are read in the center convention"
+    expect_exit 0 "$bin" project "$work/corner.json" "$work/corner.csv"
+    expect_in err "^camproj: note: .*$note the pixels are printed in the center convention"
+    for origin in corner center; do
+      expect_exit 0 "$bin" view "$work/corner.json" "$work/corner.csv" -o "$work/corner.html" --pixel-origin $origin
+      expect_not_in err "note"
+      expect_exit 0 "$bin" overlay "$work/corner.json" "$work/corner.csv" -o "$work/corner.png" --pixel-origin $origin
+      expect_not_in err "note"
+      expect_exit 0 "$bin" project "$work/corner.json" "$work/corner.csv" --pixel-origin $origin
+      expect_not_in err "note"
+    done
+    expect_exit 0 "$bin" project "$data/projector/truth.json" "$work/corner.csv"
+    expect_not_in err "note"
     cp "$data/projector/truth.json" "$work/cam.html"
     expect_exit 2 "$bin" view "$work/cam.html" -o "$work/cam.html"
     expect_exit 1 "$bin" view "$data/projector/truth.json" -o "$work/v.png"

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <iostream>
 #include <stdexcept>
 
 #include "camproj/file_io.h"
+#include "camproj/terminal_text.h"
 
 namespace camproj::cli {
 
@@ -93,6 +95,21 @@ std::vector<double> ParseNumbers(const std::string& text, size_t count, const st
                      text + "\"");
   }
   return numbers;
+}
+
+PixelOrigin PixelOriginOfOption(const CLI::Option* option, const std::string& value,
+                                PixelOrigin camera_file_origin, const std::string& camera_path,
+                                const std::string& pixels) {
+  const PixelOrigin origin = PixelOriginFromString(value);
+  if (option->count() == 0 && camera_file_origin != origin) {
+    std::cerr << "camproj: note: " << TerminalSafe(camera_path) << " states its cx, cy in the "
+              << ToString(camera_file_origin) << " convention (its pixel_origin), but "
+              << TerminalSafe(pixels) << " in the " << ToString(origin)
+              << " convention (--pixel-origin's default; the two differ by 0.5 px along u and "
+              << "v): give --pixel-origin " << ToString(camera_file_origin) << " to use the "
+              << "camera file's\n";
+  }
+  return origin;
 }
 
 void RequireDistinctOptionOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {

@@ -44,6 +44,15 @@ const CLI::Validator& NonNegativeFinite();
 // write would destroy the first. Call it before any work.
 void RequireDistinctOptionOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
+// The pixel convention of a command that reads or prints pixels beside a camera file: the
+// --pixel-origin `option`'s `value` where it was given; else its default, kCenter, with a note on
+// stderr where the camera file (`camera_path`) states its cx, cy in the corner convention: a user
+// who fitted with --pixel-origin corner and leaves it off here would see each point 0.5 px off
+// along u and v. `pixels` says what the convention is for ("points.csv's pixels are read").
+PixelOrigin PixelOriginOfOption(const CLI::Option* option, const std::string& value,
+                                PixelOrigin camera_file_origin, const std::string& camera_path,
+                                const std::string& pixels);
+
 // Files named on the command line, a folder standing for its *.csv files (sorted); throws
 // UsageError for a folder without any.
 std::vector<std::string> ExpandInputs(const std::vector<std::string>& paths);

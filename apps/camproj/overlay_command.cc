@@ -49,9 +49,10 @@ Command AddOverlayCommand(CLI::App& root) {
   app->add_option("--labels", args->labels_path,
                   "also write where each id was written, as CSV: id,kind,u,v,left,top,width,"
                   "height,residual_px");
-  app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
-      ->check(CLI::IsMember({"center", "corner"}));
-  return {app, [args]() {
+  const CLI::Option* pixel_origin =
+      app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
+          ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args, pixel_origin]() {
             RequireDistinctOptionOutputs({{"-o", args->output_path}, {"--labels", args->labels_path}});
             RequireOutputIsNotAnInput(args->output_path,
                                       {args->camera_path, args->points_path, args->image_path});
@@ -68,7 +69,10 @@ Command AddOverlayCommand(CLI::App& root) {
             const std::string camera_text = ReadWholeFile(args->camera_path, size_t{1} << 20);
             const Camera camera = CameraFromJsonText(camera_text, args->camera_path);
             Correspondences points = ReadCorrespondencesFile(args->points_path);
-            const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
+            const PixelOrigin origin = PixelOriginOfOption(
+                pixel_origin, args->pixel_origin,
+                CameraFilePixelOrigin(camera_text, args->camera_path), args->camera_path,
+                args->points_path + "'s pixels are read");
             for (auto& p : points.pixels) p = ConvertPixelOrigin(p, origin, PixelOrigin::kCenter);
             OverlayOptions options;
             options.magnify = args->magnify;

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "camproj/camera_file.h"
+#include "camproj/file_io.h"
 #include "camproj/number_text.h"
 #include "camproj/points_file.h"
 #include "camproj/terminal_text.h"
@@ -37,16 +38,23 @@ Command AddProjectCommand(CLI::App& root) {
                   "CAMERA is a calibration file (camproj calibrate): project through this view's "
                   "camera");
   app->add_option("POINTS", args->points_path, "CSV with X,Y,Z")->required();
-  app->add_option("--pixel-origin", args->pixel_origin, "convention of the printed pixels")
-      ->check(CLI::IsMember({"center", "corner"}));
-  return {app, [args]() {
-            const Camera camera = args->view.empty()
-                                      ? ReadCameraFile(args->camera_path)
-                                      : ReadCalibrationView(args->camera_path, args->view);
+  const CLI::Option* pixel_origin =
+      app->add_option("--pixel-origin", args->pixel_origin, "convention of the printed pixels")
+          ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args, pixel_origin]() {
+            // Read once (ReadCameraFile's 1 MB bound) for the camera and its pixel convention.
+            const std::string camera_text = ReadWholeFile(args->camera_path, size_t{1} << 20);
+            const Camera camera =
+                args->view.empty()
+                    ? CameraFromJsonText(camera_text, args->camera_path)
+                    : CalibrationViewFromJsonText(camera_text, args->camera_path, args->view);
             CorrespondencesLimits limits;
             limits.read_pixels = false;
             const Correspondences points = ReadCorrespondencesFile(args->points_path, limits);
-            const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
+            const PixelOrigin origin = PixelOriginOfOption(
+                pixel_origin, args->pixel_origin,
+                CameraFilePixelOrigin(camera_text, args->camera_path, args->view),
+                args->camera_path, "the pixels are printed");
             std::cout << "id,X,Y,Z,u,v,depth\n";
             for (size_t i = 0; i < points.points_in_world.size(); ++i) {
               const Eigen::Vector3d& x = points.points_in_world[i];

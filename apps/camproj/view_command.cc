@@ -46,9 +46,10 @@ Command AddViewCommand(CLI::App& root) {
   app->add_option("--mesh", args->mesh_path, "Wavefront OBJ model in world units");
   app->add_option("--title", args->title, "page title");
   app->add_option("-o,--output", args->output_path, "the page to write (.html)")->required();
-  app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
-      ->check(CLI::IsMember({"center", "corner"}));
-  return {app, [args]() {
+  const CLI::Option* pixel_origin =
+      app->add_option("--pixel-origin", args->pixel_origin, "convention of the CSV's pixels")
+          ->check(CLI::IsMember({"center", "corner"}));
+  return {app, [args, pixel_origin]() {
             const std::string extension =
                 std::filesystem::path(args->output_path).extension().string();
             if (extension != ".html" && extension != ".htm") {
@@ -63,7 +64,10 @@ Command AddViewCommand(CLI::App& root) {
             std::optional<Correspondences> points;
             if (!args->points_path.empty()) {
               points = ReadCorrespondencesFile(args->points_path);
-              const PixelOrigin origin = PixelOriginFromString(args->pixel_origin);
+              const PixelOrigin origin = PixelOriginOfOption(
+                  pixel_origin, args->pixel_origin,
+                  CameraFilePixelOrigin(camera_text, args->camera_path), args->camera_path,
+                  args->points_path + "'s pixels are read");
               for (auto& p : points->pixels) p = ConvertPixelOrigin(p, origin, PixelOrigin::kCenter);
             }
             ViewOptions options;

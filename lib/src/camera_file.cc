@@ -115,10 +115,10 @@ ImageSize ReadImageSize(const json& document, const Reader& reader) {
   return {static_cast<int>(size[0]), static_cast<int>(size[1])};
 }
 
-// The intrinsics of a camera-file document, in kCenter.
-Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
+// The document's "pixel_origin" (kCenter where absent).
+PixelOrigin ReadPixelOrigin(const json& document, const Reader& reader) {
   PixelOrigin origin = PixelOrigin::kCenter;
-  if (document.contains("pixel_origin")) {
+  if (document.is_object() && document.contains("pixel_origin")) {
     const json& value = document.at("pixel_origin");
     if (!value.is_string()) reader.Fail("pixel_origin", "expected \"center\" or \"corner\"");
     try {
@@ -127,6 +127,12 @@ Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
       reader.Fail("pixel_origin", e.what());
     }
   }
+  return origin;
+}
+
+// The intrinsics of a camera-file document, in kCenter.
+Intrinsics ReadIntrinsics(const json& document, const Reader& reader) {
+  const PixelOrigin origin = ReadPixelOrigin(document, reader);
 
   const json& k = reader.Member(document, "", "intrinsics");
   Intrinsics intrinsics;
@@ -345,6 +351,20 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
                      "project: --view NAME)");
   }
   return CameraFromDocument(document, Reader(source));
+}
+
+PixelOrigin CameraFilePixelOrigin(const std::string& text, const std::string& source,
+                                  const std::string& view) {
+  if (view.empty()) return ReadPixelOrigin(ParseJson(text, source), Reader(source));
+  CalibrationViewFromJsonText(text, source, view);  // its refusals, if any
+  const json document = ParseJson(text, source);
+  for (const json& entry : document.at("views")) {
+    if (entry.is_object() && entry.contains("name") && entry.at("name") == view) {
+      const Reader reader(source + ", view " + ShortName(view));
+      return ReadPixelOrigin(reader.Member(entry, "", "camera"), reader);
+    }
+  }
+  return PixelOrigin::kCenter;  // not reached: CalibrationViewFromJsonText found the view
 }
 
 Camera CalibrationViewFromJsonText(const std::string& text, const std::string& source,

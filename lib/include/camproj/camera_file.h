@@ -87,6 +87,13 @@ Camera CalibrationViewFromJsonText(const std::string& text, const std::string& s
 // ReadWholeFile + CalibrationViewFromJsonText.
 Camera ReadCalibrationView(const std::string& path, const std::string& view);
 
+// The convention a camera file states its cx, cy in: its "pixel_origin", or (`view` not empty)
+// that of the calibration file's view `view`; kCenter where absent. The camera the readers above
+// return is in kCenter either way: this is what tells a command which convention its user works
+// in. Throws InputError as those readers do for text they refuse.
+PixelOrigin CameraFilePixelOrigin(const std::string& text, const std::string& source,
+                                  const std::string& view = "");
+
 // The intrinsics of a camera file, or of any JSON object with "intrinsics" {fx, fy, cx, cy[,
 // skew, k1, k2]} and optionally "pixel_origin" (a calibration file too): returned in kCenter.
 // `image_size`, if given, gets the object's "image_size" (the image the intrinsics are for),
