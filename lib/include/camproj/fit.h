@@ -112,7 +112,8 @@ struct FitOptions {
   Refiner refiner = Refiner::kLevenbergMarquardt;  // without a loss (see Refiner)
 
   // Expected pixel noise (standard deviation per axis, px). Unset: estimated from the residuals
-  // as sqrt(sum of squared residuals / (2N - p)).
+  // as sqrt(sum of squared residuals / (2N - p)); with a robust loss (perspective), from their
+  // median as a 2D Gaussian's (FitResult::pixel_sigma).
   std::optional<double> pixel_sigma;
 
   // false: return the closed-form start (DLT / homography / PnP, projected onto the model)
@@ -400,6 +401,11 @@ struct FitResult {
   // Uncertainty: sigma used (given or estimated), covariance of the free parameters in the
   // order of free_parameters (pose as rotation_x/y/z_deg about the camera axes and eye_x/y/z in
   // world units; intrinsics in px), sigmas of every reported parameter, strong correlations.
+  // Least squares: pixel_sigma^2 (J^T J)^-1. A robust loss (perspective): the M-estimator's
+  // sandwich c (J^T W J)^-1, W the loss's weights rho'(|r_i|^2) at the answer and
+  // c = sum w_i^2 |r_i|^2 / (2 sum w_i) x 2N / (2N - p) (pixel_sigma^2 sum w_i^2 / sum w_i where
+  // given); pixel_sigma is then the residuals' median over a 2D Gaussian's, times
+  // sqrt(2N / (2N - p)), or the given one.
   double pixel_sigma = 0.0;
   bool pixel_sigma_estimated = true;
   bool covariance_available = false;

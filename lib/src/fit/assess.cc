@@ -83,15 +83,15 @@ std::string ModelName(const Model& model) {
 }
 
 // The covariance in user units with its sigmas (fields of view included) and strong
-// correlations, from result->pixel_sigma and result->camera. `scale`: the scene's.
+// correlations, from `variance_px2` times the inverse of the normal equations (least squares:
+// result->pixel_sigma squared) and result->camera. `scale`: the scene's.
 void SetCovariance(const JacobiScaledNormal<ParamMatrix>& scaled_normal,
                    const std::vector<std::string>& names, const Model& model, double scale,
-                   const FitOptions& options, FitResult* result) {
+                   const FitOptions& options, double variance_px2, FitResult* result) {
   const int num_params = static_cast<int>(names.size());
   const Camera& camera = result->camera;
   // Sigma_u = sigma^2 (J^T J)^-1 in u, then to user units by the linear map L.
-  const ParamMatrix covariance_u =
-      result->pixel_sigma * result->pixel_sigma * scaled_normal.Inverse();
+  const ParamMatrix covariance_u = variance_px2 * scaled_normal.Inverse();
   ParamMatrix l = ParamMatrix::Identity(num_params, num_params);
   for (int j = 0; j < 3; ++j) l(j, j) = kDegPerRad;
   for (int j = 3; j < 6; ++j) l(j, j) = scale;
@@ -375,10 +375,40 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
   } else {
     result.jacobian_condition = std::numeric_limits<double>::quiet_NaN();
   }
-  const bool have_sigma = SetPixelSigma(options, sum_squares, 2 * n - num_params, &result);
+  const int dof = 2 * n - num_params;
+  const bool have_sigma = SetPixelSigma(options, sum_squares, dof, &result);
+  double variance_px2 = result.pixel_sigma * result.pixel_sigma;
+  if (have_sigma && !refined.loss_weights.empty()) {
+    // A robust loss down-weights the points it takes for outliers, whose residuals the plain
+    // sum of squares holds in full. Such a fit (an M-estimator) has the sandwich covariance
+    // A^-1 B A^-1: A = sum w_i J_i^T J_i, the loss's weighted normal equations
+    // (RefinedCamera::normal), B = sum w_i^2 J_i^T r_i r_i^T J_i. With every point's J_i^T J_i
+    // alike and r_i isotropic, B ~ c A for c = sum w_i^2 |r_i|^2 / (2 sum w_i), times least
+    // squares' degrees-of-freedom factor 2N / (2N - p): c A^-1, which is J / (2N - p) (J^T J)^-1
+    // at w = 1. A down-weighted outlier adds w^2 |r|^2 to it (Huber: its scale squared), not
+    // |r|^2; an inlier the loss down-weights (a scale below the noise) counts as w^2 / w.
+    // A given noise sigma stands for the residuals: c = sigma^2 sum w_i^2 / sum w_i.
+    // The pixel noise reported is the residuals' robust estimate, the consistency gate's (the
+    // median residual against a 2D Gaussian's, fit/gate.cc), or the given one.
+    double weighted_squares = 0.0, squared_weights = 0.0, weights = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double w = refined.loss_weights[i];
+      weighted_squares += w * w * norms[i] * norms[i];
+      squared_weights += w * w;
+      weights += w;
+    }
+    if (options.pixel_sigma) {
+      variance_px2 *= squared_weights / weights;
+    } else {
+      variance_px2 = n * weighted_squares / (weights * dof);
+      result.pixel_sigma = Median(norms) / kRayleighMedian * std::sqrt(2.0 * n / dof);
+    }
+  }
   if (options.compute_uncertainty && have_sigma && effort.describe) {
-    SetCovariance(*scaled_normal, names, model, scene.scale, options, &result);
-    if (effort.check_linearity && refined.normal.jtr.size() == refined.normal.jtj.rows()) {
+    SetCovariance(*scaled_normal, names, model, scene.scale, options, variance_px2, &result);
+    // The check probes the plain sum of squares, which a robust loss does not minimise.
+    if (effort.check_linearity && options.loss == LossType::kNone &&
+        refined.normal.jtr.size() == refined.normal.jtj.rows()) {
       result.linearity =
           CheckLinearity(scene, refined, *scaled_normal, names, result.pixel_sigma);
     }
