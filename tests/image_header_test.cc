@@ -1,7 +1,10 @@
 #include "camproj/image_header.h"
 
+#include <array>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
@@ -55,6 +58,65 @@ TEST(ImageHeaderTest, JpegFrameAfterOtherSegmentsAndFillBytes) {
   const ImageHeader header = ReadImageHeader(bytes, "p.jpg");
   EXPECT_EQ(header.width, 4000);
   EXPECT_EQ(header.height, 3000);
+}
+
+// An APP1 "Exif" segment holding IFD0 with the given entries (tag, type, count, value), in
+// either byte order, inserted after a JPEG's SOI.
+std::string WithExif(const std::string& jpeg, bool big_endian,
+                     const std::vector<std::array<uint32_t, 4>>& entries) {
+  std::string tiff = big_endian ? "MM" : "II";
+  const auto put = [&](uint32_t value, int size) {
+    for (int i = 0; i < size; ++i) {
+      const int shift = 8 * (big_endian ? size - 1 - i : i);
+      tiff += static_cast<char>((value >> shift) & 0xff);
+    }
+  };
+  put(42, 2);
+  put(8, 4);
+  put(static_cast<uint32_t>(entries.size()), 2);
+  for (const auto& [tag, type, count, value] : entries) {
+    put(tag, 2);
+    put(type, 2);
+    put(count, 4);
+    put(value, 2);  // a SHORT sits in the first two bytes of the value field
+    put(0, 2);
+  }
+  put(0, 4);
+  const std::string payload = std::string("Exif\0\0", 6) + tiff;
+  const size_t length = payload.size() + 2;
+  return jpeg.substr(0, 2) + "\xff\xe1" + static_cast<char>(length >> 8) +
+         static_cast<char>(length & 0xff) + payload + jpeg.substr(2);
+}
+
+// The EXIF orientation (TIFF tag 0x0112, one SHORT in IFD0), in both byte orders, after other
+// tags; what is displayed turned a quarter (5-8) swaps width and height. Anything malformed or
+// out of range reads as upright (1), as does a PNG or a JPEG without EXIF.
+TEST(ImageHeaderTest, JpegExifOrientation) {
+  const std::string jpeg = Encoded(".jpg", 37, 11);
+  EXPECT_EQ(ReadImageHeader(jpeg, "a.jpg").exif_orientation, 1);
+  EXPECT_EQ(ReadImageHeader(Encoded(".png", 37, 11), "a.png").exif_orientation, 1);
+  for (const bool big_endian : {false, true}) {
+    for (uint32_t orientation = 1; orientation <= 8; ++orientation) {
+      const ImageHeader header = ReadImageHeader(
+          WithExif(jpeg, big_endian, {{0x010f, 2, 4, 0x4142}, {0x0112, 3, 1, orientation}}),
+          "a.jpg");
+      EXPECT_EQ(header.exif_orientation, static_cast<int>(orientation)) << big_endian;
+      EXPECT_EQ(header.width, 37);
+      EXPECT_EQ(header.DisplayedWidth(), orientation >= 5 ? 11 : 37);
+      EXPECT_EQ(header.DisplayedHeight(), orientation >= 5 ? 37 : 11);
+    }
+    EXPECT_EQ(ReadImageHeader(WithExif(jpeg, big_endian, {{0x0112, 3, 1, 9}}), "a.jpg")
+                  .exif_orientation, 1);
+    EXPECT_EQ(ReadImageHeader(WithExif(jpeg, big_endian, {{0x0112, 4, 1, 6}}), "a.jpg")
+                  .exif_orientation, 1);  // a LONG, not a SHORT
+    EXPECT_EQ(ReadImageHeader(WithExif(jpeg, big_endian, {{0x0112, 3, 2, 6}}), "a.jpg")
+                  .exif_orientation, 1);  // two values
+  }
+  // IFD0 claims more entries than the segment holds: read up to its end, no further.
+  std::string claims = WithExif(jpeg, false, {{0x010f, 2, 4, 0x4142}});
+  claims[2 + 4 + 6 + 8] = 100;
+  EXPECT_EQ(ReadImageHeader(claims, "a.jpg").exif_orientation, 1);
+  EXPECT_EQ(ReadImageHeader(claims, "a.jpg").width, 37);
 }
 
 // Only the first bytes are read: a 30000^2 PNG's header alone gives its size.

@@ -16,9 +16,42 @@ uint32_t BigEndian(std::string_view bytes, size_t at, int size) {
   return value;
 }
 
+// The Orientation of an APP1 segment's payload (after its length): "Exif\0\0", then a TIFF
+// header (byte order "II" or "MM", 42, IFD0's offset) whose IFD0 holds tag 0x0112 as one SHORT
+// (EXIF 2.32, 4.6.4). 1 for anything else or out of range.
+int ExifOrientation(std::string_view payload) {
+  if (payload.size() < 6 + 8 || payload.substr(0, 6) != std::string_view("Exif\0\0", 6)) return 1;
+  const std::string_view tiff = payload.substr(6);
+  const bool little = tiff.substr(0, 2) == "II";
+  if (!little && tiff.substr(0, 2) != "MM") return 1;
+  const auto read = [&](size_t at, int size) -> uint32_t {
+    uint32_t value = 0;
+    for (int i = 0; i < size; ++i) {
+      const uint32_t b = static_cast<unsigned char>(tiff[at + i]);
+      value |= little ? b << (8 * i) : b << (8 * (size - 1 - i));
+    }
+    return value;
+  };
+  if (read(2, 2) != 42) return 1;
+  const size_t ifd = read(4, 4);
+  if (ifd > tiff.size() || tiff.size() - ifd < 2) return 1;
+  const size_t entries = read(ifd, 2);
+  for (size_t e = 0; e < entries; ++e) {
+    const size_t at = ifd + 2 + 12 * e;
+    if (at > tiff.size() || tiff.size() - at < 12) return 1;
+    if (read(at, 2) != 0x0112) continue;
+    if (read(at + 2, 2) != 3 || read(at + 4, 4) != 1) return 1;  // one SHORT
+    const uint32_t orientation = read(at + 8, 2);
+    return orientation >= 1 && orientation <= 8 ? static_cast<int>(orientation) : 1;
+  }
+  return 1;
+}
+
 // JPEG (ITU T.81, B.1.1): after SOI (FF D8), segments FF <marker> <16-bit length incl. itself>;
 // SOF0..SOF15 except DHT (C4), JPG (C8), DAC (CC) hold precision, height, width.
 ImageHeader JpegHeader(std::string_view bytes, const std::string& source) {
+  int orientation = 1;
+  bool exif_seen = false;  // the first Exif APP1 holds the image's own tags
   size_t at = 2;
   while (at + 4 <= bytes.size()) {
     if (static_cast<unsigned char>(bytes[at]) != 0xff) break;
@@ -40,12 +73,20 @@ ImageHeader JpegHeader(std::string_view bytes, const std::string& source) {
       header.format = ImageFormat::kJpeg;
       header.height = static_cast<int>(BigEndian(bytes, at + 5, 2));
       header.width = static_cast<int>(BigEndian(bytes, at + 7, 2));
+      header.exif_orientation = orientation;
       if (header.width == 0 || header.height == 0) {
         throw InputError(source + ": the JPEG header states a zero width or height");
       }
       return header;
     }
     if (marker == 0xda || marker == 0xd9) break;  // image data or end before any frame header
+    if (marker == 0xe1 && !exif_seen && at + 2 + length <= bytes.size()) {
+      const std::string_view payload = bytes.substr(at + 4, length - 2);
+      if (payload.substr(0, 4) == "Exif") {
+        exif_seen = true;
+        orientation = ExifOrientation(payload);
+      }
+    }
     at += 2 + length;
   }
   throw InputError(source + ": a JPEG without a readable frame header (cut short or corrupt)");

@@ -17,6 +17,7 @@
 #include "check.h"
 #include "drawing.h"
 #include "image_codecs.h"
+#include "photo.h"
 
 namespace camproj {
 
@@ -37,42 +38,6 @@ void OverlayOptions::Check() const {
   internal::Require(residual_fraction > 0.0 && residual_fraction <= 1.0,
                     "residual_fraction must be in (0, 1], got ", residual_fraction);
 }
-
-namespace {
-
-// A PNG or JPEG of kMaxImagePixels is far smaller than this; a bigger file is not a photo.
-constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
-
-// The background, decoded only after its header states the camera's size (for a JPEG, either
-// way round: OpenCV turns it by its EXIF orientation while decoding).
-cv::Mat ReadBackground(const std::string& path, int w, int h) {
-  const std::string bytes = ReadWholeFile(path, kMaxImageFileBytes);
-  const ImageHeader header = ReadImageHeader(bytes, path);
-  const bool turned = header.format == ImageFormat::kJpeg && header.width == h && header.height == w;
-  if ((header.width != w || header.height != h) && !turned) {
-    throw InputError(internal::Concat(path, ": image is ", header.width, "x", header.height,
-                                      " but the camera's image size is ", w, "x", h));
-  }
-  // libpng refuses a truncated file too, but prints its own error line first.
-  RequireWholeImage(bytes, header.format, path);
-  cv::Mat image;
-  try {
-    image = internal::DecodeImage(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
-                                          const_cast<char*>(bytes.data())),
-                                  cv::IMREAD_COLOR);
-  } catch (const cv::Exception& e) {
-    throw InputError(path + ": cannot decode the image: " + e.what());
-  }
-  if (image.empty()) throw InputError(path + ": cannot decode the image (corrupt or unsupported)");
-  if (image.cols != w || image.rows != h) {
-    throw InputError(internal::Concat(path, ": image is ", image.cols, "x", image.rows,
-                                      " after its EXIF orientation, but the camera's image size is ",
-                                      w, "x", h));
-  }
-  return image;
-}
-
-}  // namespace
 
 namespace {
 
@@ -520,7 +485,7 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
   if (options.background_path.empty()) {
     image = cv::Mat(h, w, CV_8UC3, cv::Scalar(40, 40, 40));
   } else {
-    image = ReadBackground(options.background_path, w, h);
+    image = internal::DecodePhoto(internal::ReadPhoto(options.background_path, w, h));
   }
   const Style s = StyleFor(w, h);
   OverlayStats stats;

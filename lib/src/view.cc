@@ -17,6 +17,8 @@
 #include "camproj/image_header.h"
 #include "check.h"
 #include "drawing.h"
+#include "image_codecs.h"
+#include "photo.h"
 #include "view/assets.h"
 #include "view/obj_mesh.h"
 
@@ -29,8 +31,6 @@ namespace {
 using nlohmann::json;
 using internal::Concat;
 
-// A photo is a few MB; the same bound as the overlay's background.
-constexpr size_t kMaxImageFileBytes = size_t{256} << 20;
 constexpr size_t kMaxMeshFileBytes = size_t{1} << 30;
 
 std::string Base64(std::string_view bytes) {
@@ -292,17 +292,28 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
   return scene;
 }
 
+// The photo as displayed (photo.h). A JPEG with an EXIF orientation is decoded (OpenCV turns it)
+// and embedded re-encoded (JPEG, OpenCV's quality 95) without one: the page's <img> applies the
+// orientation but a WebGL texture need not, and the two views must show the pixels camproj
+// overlay draws on. Before session 44 a JPEG turned a quarter was refused by its stored size and
+// one turned half round was embedded as stored.
 json ImageJson(const std::string& path, const Camera& camera) {
-  const std::string bytes = ReadWholeFile(path, kMaxImageFileBytes);
-  const ImageHeader header = ReadImageHeader(bytes, path);
-  if (header.width != camera.image_size.width || header.height != camera.image_size.height) {
-    throw InputError(Concat(path, ": image is ", header.width, "x", header.height,
-                            " but the camera's image size is ", camera.image_size.width, "x",
-                            camera.image_size.height));
+  const internal::Photo photo =
+      internal::ReadPhoto(path, camera.image_size.width, camera.image_size.height);
+  if (photo.header.exif_orientation == 1) {
+    const char* mime = photo.header.format == ImageFormat::kPng ? "image/png" : "image/jpeg";
+    return {{"name", path},
+            {"data_url", std::string("data:") + mime + ";base64," + Base64(photo.bytes)}};
   }
-  RequireWholeImage(bytes, header.format, path);  // a browser would show the rest grey
-  const char* mime = header.format == ImageFormat::kPng ? "image/png" : "image/jpeg";
-  return {{"name", path}, {"data_url", std::string("data:") + mime + ";base64," + Base64(bytes)}};
+  std::vector<uchar> upright;
+  if (!internal::EncodeImage(".jpg", internal::DecodePhoto(photo), &upright)) {
+    throw InputError(path + ": cannot re-encode the photo turned upright");
+  }
+  return {{"name", path},
+          {"exif_orientation", photo.header.exif_orientation},
+          {"data_url", "data:image/jpeg;base64," +
+                           Base64(std::string_view(reinterpret_cast<const char*>(upright.data()),
+                                                   upright.size()))}};
 }
 
 json MeshJson(const std::string& path, const PageFrame& in_page, ViewStats& stats) {

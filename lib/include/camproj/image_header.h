@@ -16,12 +16,20 @@ enum class ImageFormat { kPng, kJpeg };
 
 struct ImageHeader {
   ImageFormat format = ImageFormat::kPng;
-  int width = 0;   // px
+  int width = 0;   // px, as stored (before any EXIF orientation)
   int height = 0;  // px
+  // A JPEG's EXIF Orientation (TIFF tag 0x0112 in IFD0 of an APP1 "Exif" segment before the
+  // frame header): 1 upright, 2-4 mirrored or turned 180 degrees, 5-8 turned a quarter (the
+  // image is displayed height x width). 1 where absent, unreadable, or out of 1-8, and for a PNG.
+  // OpenCV's decoder and browsers apply it: camproj shows photos as displayed.
+  int exif_orientation = 1;
+  bool Turned() const { return exif_orientation >= 5; }  // displayed as height x width
+  int DisplayedWidth() const { return Turned() ? height : width; }
+  int DisplayedHeight() const { return Turned() ? width : height; }
 };
 
 // The format and size stated by the file's first bytes: a PNG's IHDR chunk, or a JPEG's first
-// start-of-frame segment (any SOFn). `source` names the bytes in messages. Throws InputError
+// start-of-frame segment (any SOFn), with a JPEG's EXIF orientation. `source` names the bytes in messages. Throws InputError
 // naming `source` if the bytes are neither format, or the header is cut short or states a zero
 // size. Reads only the header: cost and memory do not depend on the stated size.
 ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source);

@@ -74,7 +74,8 @@ OverlayPicture DrawOverlayImage(const Camera& camera, const Correspondences& cor
 // (ImageFormatOfPath). Pixels of `correspondences` are in kCenter.
 // Throws std::invalid_argument if the extension is neither, an outlier index is out of range, or
 // the camera's image size is beyond kMaxImagePixels (before allocating anything); InputError if
-// the background is not a PNG or JPEG, its header states another size than the camera's (checked
+// the background is not a PNG or JPEG, its header states another size as displayed (a JPEG's
+// EXIF orientation applied: the background is drawn on as displayed) than the camera's (checked
 // before decoding), it cannot be decoded, or the output cannot be written.
 OverlayStats WriteOverlayImage(const Camera& camera, const Correspondences& correspondences,
                                const OverlayOptions& options, const std::string& output_path);

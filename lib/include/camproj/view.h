@@ -25,8 +25,8 @@ namespace camproj {
 
 struct ViewOptions {
   // Photo shown on the image plane and behind the view through the camera: PNG or JPEG of the
-  // camera's image size (EXIF-turned JPEGs are refused: the page would show them turned). Empty:
-  // none.
+  // camera's image size as displayed (a JPEG's EXIF orientation applied, as camproj overlay and
+  // browsers apply it; such a JPEG is embedded turned upright, re-encoded). Empty: none.
   std::string image_path;
   // Wavefront OBJ in world units (`v` and `f` lines; others ignored; a file without a face is
   // refused), drawn in the orbit view. Empty: none.
@@ -49,8 +49,8 @@ struct ViewStats {
 // report; absent: no report); `camera_name` names the camera on the page. `correspondences`
 // (pixels in kCenter) may be null: the camera alone. Throws InputError naming the file and line
 // for a bad OBJ (a field that is not a number, a face index out of range, a face of fewer than 3
-// vertices, more than 5e6 vertices or triangles) or a bad photo (not PNG/JPEG, another size than
-// the camera's, cut short: RequireWholeImage); std::invalid_argument for an invalid camera.
+// vertices, more than 5e6 vertices or triangles) or a bad photo (not PNG/JPEG, another size as
+// displayed than the camera's, cut short: RequireWholeImage); std::invalid_argument for an invalid camera.
 std::string ViewPageHtml(const Camera& camera, const std::string& camera_file_text,
                          const std::string& camera_name, const Correspondences* correspondences,
                          const ViewOptions& options, ViewStats* stats = nullptr);
