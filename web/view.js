@@ -247,6 +247,43 @@ controls.update();
 
 // ---- Views.
 let mode = 'orbit';
+// The largest buffer WebGL renders into here, per side (MAX_VIEWPORT_DIMS, MAX_RENDERBUFFER_SIZE,
+// MAX_TEXTURE_SIZE: 8192 in SwiftShader); the browser may cap a canvas's area further (~33 Mpx).
+function LargestSide() {
+  const gl = renderer.getContext();
+  const dims = gl.getParameter(gl.MAX_VIEWPORT_DIMS);
+  return Math.min(dims[0], dims[1], gl.getParameter(gl.MAX_RENDERBUFFER_SIZE),
+                  renderer.capabilities.maxTextureSize);
+}
+// The drawing buffer through the camera: the image, pixel for pixel, where the browser allows it;
+// else the image scaled by throughScale < 1 (the largest buffer it allows). The projection maps
+// NDC onto the whole buffer and CSS stretches the canvas to the image's shape, so a scaled buffer
+// is the same view at a lower resolution. (Before session 44 an image wider than the limit got a
+// buffer cut to it while three.js drew as if it were whole: the view through the camera was off.)
+let throughScale = 1;
+function SizeThroughBuffer() {
+  const gl = renderer.getContext();
+  let r = Math.min(1, LargestSide() / Math.max(W, H));
+  for (let attempt = 0; attempt < 3; ++attempt) {
+    renderer.setPixelRatio(r);
+    renderer.setSize(W, H, false);
+    const bw = gl.drawingBufferWidth, bh = gl.drawingBufferHeight;
+    if (bw === renderer.domElement.width && bh === renderer.domElement.height) break;
+    r = Math.min(r, bw / W, bh / H);  // the browser gave less: ask for what it gave
+  }
+  throughScale = r;
+  // The viewport is the buffer the browser made, exactly (three.js rounds W * r on its own).
+  renderer.setViewport(0, 0, gl.drawingBufferWidth / r, gl.drawingBufferHeight / r);
+  if (r < 1 && !document.getElementById('scaled-note')) {
+    const note = document.createElement('div');
+    note.id = 'scaled-note';
+    note.className = 'note';
+    note.textContent = `Through the camera: rendered at ${gl.drawingBufferWidth} × ` +
+        `${gl.drawingBufferHeight} px, the ${W} × ${H} image scaled by ${r.toPrecision(3)} ` +
+        "(the browser's largest WebGL canvas).";
+    document.getElementById('legend').appendChild(note);
+  }
+}
 function Layout() {
   const sw = stage.clientWidth, sh = stage.clientHeight;
   if (mode === 'orbit') {
@@ -260,10 +297,9 @@ function Layout() {
     overlay.setAttribute('height', sh);
     overlay.innerHTML = '';
   } else {
-    // The drawing buffer is the image, pixel for pixel; CSS scales it to the stage.
+    // The drawing buffer is the image (SizeThroughBuffer); CSS scales it to the stage.
     const s = Math.min(sw / W, sh / H);
-    renderer.setPixelRatio(1);
-    renderer.setSize(W, H, false);
+    SizeThroughBuffer();
     const cw = W * s, ch = H * s;
     for (const e of [renderer.domElement, photo].filter(Boolean)) {
       e.style.width = cw + 'px';
@@ -458,11 +494,14 @@ function Report() {
 
 // ---- Test mode (#camproj-test; tests/view_browser_test.cc): the view through the camera, each
 // point rendered alone as a Gaussian spot (sigma 2 px, in a 17 px sprite: the tail cut at the
-// sprite's edge moves the centroid by < 1e-3 px) into an image-sized target; the centroid of the
-// read-back intensities, in kCenter, is where three.js put the point.
+// sprite's edge moves the centroid by < 1e-3 px) into an image-sized target (the image scaled to
+// LargestSide where it is larger, as the view through the camera is); the centroid of the
+// read-back intensities, in kCenter image pixels, is where three.js put the point.
 function MeasureThrough() {
   const kSize = 17, kSigma = 2.0, kHalf = 16, n = 2 * kHalf + 1;
-  const target = new THREE.WebGLRenderTarget(W, H, { depthBuffer: false });
+  const r = Math.min(1, LargestSide() / Math.max(W, H));
+  const TW = Math.max(1, Math.round(W * r)), TH = Math.max(1, Math.round(H * r));
+  const target = new THREE.WebGLRenderTarget(TW, TH, { depthBuffer: false });
   const material = new THREE.ShaderMaterial({
     vertexShader: `void main() {
       gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
@@ -483,18 +522,19 @@ function MeasureThrough() {
   const buffer = new Uint8Array(n * n * 4);
   const results = [];
   for (const p of points) {
-    const r = { id: p.id, u: null, v: null };
-    results.push(r);
+    const result = { id: p.id, u: null, v: null };
+    results.push(result);
     if (!p.predicted_linear_px) continue;
     projected.fromArray(p.point_in_page).project(throughCamera);
     const xw = (projected.x + 1) / 2 * W, yw = (projected.y + 1) / 2 * H;
-    r.three_math = [xw - 0.5, H - yw - 0.5];
-    if (!(xw > kHalf && xw < W - kHalf && yw > kHalf && yw < H - kHalf)) continue;  // at the edge
+    result.three_math = [xw - 0.5, H - yw - 0.5];
+    const xt = xw * TW / W, yt = yw * TH / H;  // in the target's pixels
+    if (!(xt > kHalf && xt < TW - kHalf && yt > kHalf && yt < TH - kHalf)) continue;  // at the edge
     position.setXYZ(0, ...p.point_in_page);
     position.needsUpdate = true;
     renderer.setRenderTarget(target);
     renderer.render(alone, throughCamera);
-    const x0 = Math.floor(xw) - kHalf, y0 = Math.floor(yw) - kHalf;
+    const x0 = Math.floor(xt) - kHalf, y0 = Math.floor(yt) - kHalf;
     renderer.readRenderTargetPixels(target, x0, y0, n, n, buffer);
     let mass = 0, sx = 0, sy = 0;
     for (let j = 0; j < n; ++j) {
@@ -503,13 +543,14 @@ function MeasureThrough() {
         mass += w; sx += w * (x0 + i + 0.5); sy += w * (y0 + j + 0.5);
       }
     }
-    r.mass = mass;
+    result.mass = mass;
     if (mass > 0) {
-      // Window (x up from the bottom) -> kCenter pixel: u = x - 0.5, v = H - y - 0.5.
-      r.u = sx / mass - 0.5;
-      r.v = H - sy / mass - 0.5;
+      // Target pixels -> window (x up from the bottom) -> kCenter: u = x - 0.5, v = H - y - 0.5.
+      result.u = sx / mass * W / TW - 0.5;
+      result.v = H - sy / mass * H / TH - 0.5;
     }
   }
+  results.target_size = [TW, TH];
   renderer.setRenderTarget(null);
   target.dispose();
   return results;
@@ -519,8 +560,10 @@ Report();
 SetMode('orbit');
 if (kTestMode) {
   SetMode('through');
+  const measured = MeasureThrough();
   const result = { three_revision: THREE.REVISION, image_size: [W, H],
-                   webgl2: renderer.capabilities.isWebGL2, points: MeasureThrough() };
+                   webgl2: renderer.capabilities.isWebGL2, points: measured,
+                   target_size: measured.target_size, through_scale: throughScale };
   Render();
   document.getElementById('camproj-test-result').textContent = JSON.stringify(result);
 } else {
