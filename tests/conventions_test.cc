@@ -1,5 +1,6 @@
 #include "camproj/conventions.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -35,6 +36,15 @@ TEST(ConventionsTest, WindowCoordinatesHaveTheirOriginAtTheBottomLeftCorner) {
   EXPECT_EQ(PixelFromWindow({0.5, 479.5}, size, PixelOrigin::kCorner), Eigen::Vector2d(0.5, 0.5));
   const Eigen::Vector2d pixel(123.25, 77.75);
   EXPECT_EQ(PixelFromWindow(WindowFromPixel(pixel, size), size), pixel);
+}
+
+// kCenter: a w x h image spans -0.5 to w - 0.5, its edges included.
+TEST(ConventionsTest, PixelInImageSpansHalfAPixelBeyondTheOuterCentres) {
+  EXPECT_TRUE(PixelInImage({-0.5, -0.5}, {30, 20}));
+  EXPECT_TRUE(PixelInImage({29.5, 19.5}, {30, 20}));
+  EXPECT_FALSE(PixelInImage({29.5 + 1e-9, 10.0}, {30, 20}));
+  EXPECT_FALSE(PixelInImage({10.0, -0.5 - 1e-9}, {30, 20}));
+  EXPECT_FALSE(PixelInImage({std::nan(""), 10.0}, {30, 20}));
 }
 
 TEST(ConventionsTest, StringsRoundTripAndBadTextIsNamed) {

@@ -41,14 +41,6 @@ TEST(DrawingTest, MarkupEscapeWritesOnlyWellFormedUtf8) {
   EXPECT_EQ(MarkupEscape("x\xC3"), "x\xEF\xBF\xBD");
 }
 
-// kCenter: a w x h image spans -0.5 to w - 0.5, its edges included.
-TEST(DrawingTest, InsideImageSpansHalfAPixelBeyondTheOuterCentres) {
-  EXPECT_TRUE(InsideImage({-0.5, -0.5}, 30, 20));
-  EXPECT_TRUE(InsideImage({29.5, 19.5}, 30, 20));
-  EXPECT_FALSE(InsideImage({29.5 + 1e-9, 10.0}, 30, 20));
-  EXPECT_FALSE(InsideImage({10.0, -0.5 - 1e-9}, 30, 20));
-}
-
 // The arrow stays inside the image and points at the target for every image size, down to those
 // smaller than two arrow lengths (std::clamp's bounds crossed there: undefined behaviour).
 TEST(DrawingTest, BorderArrowsStayInsideImagesOfAnySize) {

@@ -83,12 +83,6 @@ inline std::string MarkupEscape(const std::string& text) {
   return out;
 }
 
-// Whether kCenter pixel `p` lies in a w x h image: pixel centres at integers, so the image spans
-// -0.5 to w - 0.5 (and -0.5 to h - 0.5), its edges included.
-inline bool InsideImage(const Eigen::Vector2d& p, int w, int h) {
-  return p.x() >= -0.5 && p.x() <= w - 0.5 && p.y() >= -0.5 && p.y() <= h - 0.5;
-}
-
 // An arrow `length` long inside a w x h image's border, pointing at `target` (outside the image,
 // kCenter px): its tail and tip. The tip is `length` from the border, or at the image's middle
 // where it is smaller than twice that.

@@ -199,7 +199,7 @@ double DrawResidualsOverImage(const FitResult& fit, const ReportResiduals& resid
     const Eigen::Vector2d& o = observed_pixels[i];
     const std::string id = MarkupEscape(ids[i]);
     const bool left_out = outlier[i] || !std::isfinite(length[i]);
-    if (!internal::InsideImage(o, w, h)) {
+    if (!PixelInImage(o, fit.camera.image_size)) {
       const auto [tail, tip] = internal::BorderArrow(o, w, h, border_arrow_px);
       const std::string colour = left_out ? kOutlier : Viridis(length[i] / colour_top);
       body << "<line x1='" << sx(tail.x()) << "' y1='" << sy(tail.y()) << "' x2='" << sx(tip.x())

@@ -386,8 +386,6 @@ StMap LensStMap(const Camera& camera, LensMapDirection direction) {
   map.height = target.size.height;
   map.rgba.resize(static_cast<size_t>(map.width) * map.height * 4);
   const double r_fold = RadialFoldRadius(k.k1, k.k2);
-  const double w = camera.image_size.width;
-  const double h = camera.image_size.height;
   for (int v = 0; v < map.height; ++v) {
     for (int u = 0; u < map.width; ++u) {
       float* texel = &map.rgba[(static_cast<size_t>(v) * map.width + u) * 4];
@@ -402,9 +400,7 @@ StMap LensStMap(const Camera& camera, LensMapDirection direction) {
       const Eigen::Vector2d uv = UvOfPixel(source, camera.image_size);
       texel[0] = static_cast<float>(uv.x());
       texel[1] = static_cast<float>(uv.y());
-      const bool inside = source.x() >= -0.5 && source.x() <= w - 0.5 && source.y() >= -0.5 &&
-                          source.y() <= h - 0.5;
-      texel[3] = inside ? 1.0f : 0.0f;
+      texel[3] = PixelInImage(source, camera.image_size) ? 1.0f : 0.0f;
     }
   }
   return map;

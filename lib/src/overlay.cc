@@ -317,7 +317,7 @@ std::vector<OverlayPoint> MeasurePoints(const Camera& camera, const Corresponden
   const int w = camera.image_size.width;
   const int h = camera.image_size.height;
   const size_t n = correspondences.pixels.size();
-  const auto inside = [&](const Eigen::Vector2d& p) { return internal::InsideImage(p, w, h); };
+  const auto inside = [&](const Eigen::Vector2d& p) { return PixelInImage(p, camera.image_size); };
   std::vector<OverlayPoint> points(n);
   for (size_t i = 0; i < n; ++i) {
     OverlayPoint& point = points[i];

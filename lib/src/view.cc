@@ -101,8 +101,6 @@ double Median(std::vector<double> values) {
 json PointJson(const Camera& camera, const PageFrame& in_page,
                const Correspondences& correspondences, size_t i, bool outlier,
                double ray_depth_behind, double* max_distortion_px, ViewStats& stats) {
-  const int w = camera.image_size.width;
-  const int h = camera.image_size.height;
   const Eigen::Vector3d& x = correspondences.points_in_world[i];
   const Eigen::Vector2d& observed = correspondences.pixels[i];
   const double depth = (camera.cam_from_world * x).z();
@@ -145,7 +143,7 @@ json PointJson(const Camera& camera, const PageFrame& in_page,
   point["predicted_px"] = Vec(*predicted);
   point["predicted_linear_px"] = Vec(linear);
   point["residual_px"] = (*predicted - observed).norm();
-  const bool inside = internal::InsideImage(*predicted, w, h);
+  const bool inside = PixelInImage(*predicted, camera.image_size);
   point["inside_image"] = inside;
   if (!inside) ++stats.outside_image;
   return point;

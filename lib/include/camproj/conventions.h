@@ -41,6 +41,14 @@ struct ImageSize {
   void Check() const;
 };
 
+// Whether kCenter pixel `pixel` lies in an image of `size`: pixel centres at integers, so the
+// image spans -0.5 to width - 0.5 and -0.5 to height - 0.5, its edges included (the one place
+// this test is written: overlay, view, report, lens maps and the determination check use it).
+inline bool PixelInImage(const Eigen::Vector2d& pixel, const ImageSize& size) {
+  return pixel.x() >= -0.5 && pixel.x() <= size.width - 0.5 && pixel.y() >= -0.5 &&
+         pixel.y() <= size.height - 0.5;
+}
+
 // The fixed change of axes between the computer-vision camera and OpenGL eye space.
 Eigen::Matrix3d GlEyeFromCam();
 

@@ -244,8 +244,7 @@ TestPoints TestPointsOf(const Camera& camera, const std::vector<Eigen::Vector3d>
   inside.fitted.reserve(total);
   auto consider = [&](const Eigen::Vector3d& x, int fitted) {
     const std::optional<Eigen::Vector2d> u = PixelFromWorld(camera, x);
-    if (u && u->x() >= -0.5 && u->x() <= camera.image_size.width - 0.5 && u->y() >= -0.5 &&
-        u->y() <= camera.image_size.height - 0.5 && BeforeTheFold(camera, x, *u)) {
+    if (u && PixelInImage(*u, camera.image_size) && BeforeTheFold(camera, x, *u)) {
       inside.points.push_back(x);
       inside.fitted.push_back(fitted);
     }
