@@ -220,8 +220,12 @@ Box DrawLegend(cv::Mat& image, const OverlayStats& stats, const std::vector<Eige
   char magnify_text[32];
   std::snprintf(magnify_text, sizeof magnify_text, "%g", stats.magnify);
   lines.push_back(std::string("o observed    + reprojected    line: residual x ") + magnify_text);
+  // Drawn longer than the image's diagonal, its length is clipped (or, beyond a double, inf).
+  const double drawn_px = stats.largest_residual_px * stats.magnify;
+  const double diagonal_px = std::hypot(image.cols, image.rows);
   lines.push_back("(the largest, " + FormatPx(stats.largest_residual_px) + " px, drawn " +
-                  FormatPx(stats.largest_residual_px * stats.magnify) + " px long)");
+                  (drawn_px <= diagonal_px ? FormatPx(drawn_px) + " px long)"
+                                           : std::string("past the image's edge)")));
   lines.push_back("colour: residual 0 px                    " + FormatPx(stats.largest_residual_px) +
                   " px");
   if (stats.outliers > 0) {
