@@ -783,6 +783,22 @@ TEST_F(RefusalTest, ResultCarriesTraceViewsAndDepthRange) {
   EXPECT_FALSE(fit.views.perspective.has_value());  // off-axis
 }
 
+// A projector-like scene of 40 points at 0.5 px noise, 3 of them (`bad`) mis-clicked: moved by
+// (60, -45) px.
+Scene ThreeMisclicksInForty(std::mt19937_64& rng, const RandomCamera& camera,
+                            std::vector<int>* bad) {
+  SceneOptions scene_options;
+  scene_options.num_points = 40;
+  scene_options.pixel_noise = 0.5;
+  Scene scene = MakeScene(rng, camera, scene_options);
+  bad->resize(40);
+  std::iota(bad->begin(), bad->end(), 0);
+  std::shuffle(bad->begin(), bad->end(), rng);
+  bad->resize(3);
+  for (const int i : *bad) scene.observed_pixels[i] += Eigen::Vector2d(60, -45);
+  return scene;
+}
+
 // Three mis-clicked points (75 px off) among 40: a Cauchy loss with a 2 px scale keeps the camera
 // where least squares on the 37 good points puts it (plain least squares on all 40 is pulled
 // away). Per scene, the robust fit's focal error is within 4 sigma of the good points' own fit
@@ -799,20 +815,12 @@ TEST(FitTest, RobustLossResistsAFewMisclickedPoints) {
   int plain_beyond = 0;
   for (int scene_index = 0; scene_index < kScenes; ++scene_index) {
     const RandomCamera camera = ProjectorLikeCamera(rng);
-    SceneOptions scene_options;
-    scene_options.num_points = 40;
-    scene_options.pixel_noise = 0.5;
-    Scene scene = MakeScene(rng, camera, scene_options);
-    std::vector<int> bad(40);
-    std::iota(bad.begin(), bad.end(), 0);
-    std::shuffle(bad.begin(), bad.end(), rng);
-    bad.resize(3);
+    std::vector<int> bad;
+    const Scene scene = ThreeMisclicksInForty(rng, camera, &bad);
     std::vector<Eigen::Vector3d> good_points;
     std::vector<Eigen::Vector2d> good_pixels;
     for (int i = 0; i < 40; ++i) {
-      if (std::find(bad.begin(), bad.end(), i) != bad.end()) {
-        scene.observed_pixels[i] += Eigen::Vector2d(60, -45);
-      } else {
+      if (std::find(bad.begin(), bad.end(), i) == bad.end()) {
         good_points.push_back(scene.points_in_world[i]);
         good_pixels.push_back(scene.observed_pixels[i]);
       }
@@ -859,14 +867,8 @@ TEST(FitTest, RobustLossSigmasCoverTheTruthAmongOutliers) {
   double noise_sum = 0.0;
   for (int scene_index = 0; scene_index < kScenes; ++scene_index) {
     const RandomCamera camera = ProjectorLikeCamera(rng);
-    SceneOptions scene_options;
-    scene_options.num_points = 40;
-    scene_options.pixel_noise = 0.5;
-    Scene scene = MakeScene(rng, camera, scene_options);
-    std::vector<int> bad(40);
-    std::iota(bad.begin(), bad.end(), 0);
-    std::shuffle(bad.begin(), bad.end(), rng);
-    for (int k = 0; k < 3; ++k) scene.observed_pixels[bad[k]] += Eigen::Vector2d(60, -45);
+    std::vector<int> bad;
+    const Scene scene = ThreeMisclicksInForty(rng, camera, &bad);
     FitOptions robust;
     robust.loss = LossType::kCauchy;
     robust.loss_scale_px = 2.0;
