@@ -486,6 +486,10 @@ PY
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --far 2
     expect_in out "^note: near .*, far 2: far as given (--far); near covers the fitted points' depths only"
     expect_not_in out "clips"
+    # The advice's bound is rounded away from the points: point 8 is at depth 1.3237484 of the
+    # mis-click scene's camera, and "below 1.32375" (to nearest) would not be below it.
+    expect_exit 0 "$bin" fit "$data/projector/misclicked.csv" --image-size 1920x1080 --near 1.323749
+    expect_in out "clips 1 of the 18 fitted points, nearer than it (point 8 at depth 1.32375): .* give --near below 1.32374 to draw them"
     # Given planes between the points' depths (1.317 to 1.794) clip some: the note counts them,
     # the farthest beyond each plane first, checked against the written camera's depths.
     expect_exit 0 "$bin" fit "$data/projector/points.csv" --image-size 1920x1080 --near 1.35 \
@@ -991,7 +995,10 @@ json.dump(c, open(sys.argv[2] + "/ortho.json", "w"))
 PY
     expect_exit 0 "$bin" view "$work/lens.json" "$data/projector/points.csv" -o "$work/lens.html"
     expect_exit 0 "$bin" view "$work/ortho.json" "$data/projector/points.csv" -o "$work/ortho.html"
-    py - "$work/lens.json" "$work/lens.html" "$work/ortho.json" "$work/ortho.html" <<'PY' || fail "the page's image plane or rays are not the camera's"
+    py -c "import json, sys; c = json.load(open(sys.argv[1])); c['intrinsics'].update(k1=-0.5, k2=0.0); json.dump(c, open(sys.argv[2], 'w'))" \
+      "$work/lens.json" "$work/fold.json"
+    expect_exit 0 "$bin" view "$work/fold.json" -o "$work/fold.html"
+    py - "$work/lens.json" "$work/lens.html" "$work/ortho.json" "$work/ortho.html" "$work/fold.html" <<'PY' || fail "the page's image plane or rays are not the camera's"
 import json, re, sys
 def page_data(path):
     text = open(path).read()
@@ -1017,6 +1024,20 @@ for p, (s, tv) in zip(img["positions_in_page"], img["uv"]):
     worst = max(worst, abs(u - (-0.5 + s * W)), abs(v - (-0.5 + (1 - tv) * H)))
 assert worst <= 1e-6, worst
 assert any("the lens (k1 = -0.15, k2 = 0.02)" in n for n in d["notes"]), d["notes"]
+# Its border: one closed loop round the grid (first vertex repeated at its end).
+(loop,) = img["outline_in_page"]
+cols = sum(1 for s, t in img["uv"] if t == 1.0) - 1
+rows = sum(1 for s, t in img["uv"] if s == 0.0) - 1
+assert loop[0] == loop[-1] and len(loop) == 2 * (cols + rows) + 1, (len(loop), cols, rows)
+assert img["top_edge_in_page"] == loop[:cols + 1]
+# A lens that folds inside the image (k1 = -0.5: only the bottom edge, nearest the principal
+# point, has rays): the border's runs stop where it folds, and none bridges the gap with a chord
+# (one of 2.24 units closed the bottom edge into a loop before session 44).
+d = page_data(sys.argv[5])
+runs = d["frustum"]["image_plane"]["outline_in_page"]
+lengths = [sum((a[k] - b[k]) ** 2 for k in range(3)) ** 0.5 for run in runs for a, b in zip(run, run[1:])]
+assert runs and sum(map(len, runs)) < 2 * (cols + rows), [len(r) for r in runs]
+assert max(lengths) < 5 * sorted(lengths)[len(lengths) // 2], (max(lengths), sorted(lengths)[len(lengths) // 2])
 c, d = json.load(open(sys.argv[3])), page_data(sys.argv[4])
 o, rays = d["page_origin_in_world"], 0
 for p in d["points"]:
@@ -1713,6 +1734,12 @@ PY
     cp "$work/out" "$work/by_name.out"
     expect_exit 0 "$bin" project "$work/extracted.json" "$boards/left05.csv"
     cmp -s "$work/out" "$work/by_name.out" || fail "--view and the extracted camera project differently"
+    # A calibration file over a camera file's 1 MB bound (hundreds of views) is read under the
+    # calibration reader's 16 MB, as by export (project read it under 1 MB in session 44).
+    py -c "import json, sys; c = json.load(open(sys.argv[1])); c['padding'] = 'x' * 1200000; json.dump(c, open(sys.argv[2], 'w'))" \
+      "$work/calib.json" "$work/big_calib.json"
+    expect_exit 0 "$bin" project "$work/big_calib.json" --view left05 "$boards/left05.csv"
+    cmp -s "$work/out" "$work/by_name.out" || fail "a calibration file over 1 MB projects otherwise"
     # A calibration file is not one camera; a refused view or an unknown name is named.
     expect_exit 2 "$bin" export "$work/calib.json" --to gl
     expect_in err "calib.json: a calibration file of 12 views, not one camera: select a view by its name"

@@ -99,10 +99,9 @@ const fr = data.frustum;
   // The image plane through the lens (computed by camproj: a grid whose vertices lie on their
   // pixels' rays). Its top edge in colour, so that the frustum's up is obvious.
   const img = fr.image_plane;
-  const Polyline = (vertices, closed) => vertices.slice(0, closed ? vertices.length : -1)
-      .map((v, i) => [v, vertices[(i + 1) % vertices.length]]);
+  const Polyline = vertices => vertices.slice(0, -1).map((v, i) => [v, vertices[i + 1]]);
   if (img.top_edge_in_page.length > 1) {
-    orbitOnly.add(Segments(Polyline(img.top_edge_in_page, false), 0x56b4e9));
+    orbitOnly.add(Segments(Polyline(img.top_edge_in_page), 0x56b4e9));
   }
   const plane = new THREE.BufferGeometry();
   plane.setAttribute('position', new THREE.Float32BufferAttribute(img.positions_in_page.flat(), 3));
@@ -122,9 +121,7 @@ const fr = data.frustum;
     });
   }
   orbitOnly.add(new THREE.Mesh(plane, material));
-  if (img.outline_in_page.length > 1) {
-    orbitOnly.add(Segments(Polyline(img.outline_in_page, true), 0x9aa0a6));
-  }
+  for (const run of img.outline_in_page) orbitOnly.add(Segments(Polyline(run), 0x9aa0a6));
 }
 // Rays from the eye through each observed pixel, to the point's depth, and the residual in the
 // world: from the ray's end to the point.
@@ -224,7 +221,7 @@ scene.add(markers);
 const centre = new THREE.Vector3();
 const bounds = new THREE.Box3();
 for (const p of points) bounds.expandByPoint(V3(p.point_in_page));
-for (const c of fr.image_plane.outline_in_page) bounds.expandByPoint(V3(c));
+for (const run of fr.image_plane.outline_in_page) for (const c of run) bounds.expandByPoint(V3(c));
 bounds.expandByPoint(eye);
 const sphere = bounds.getBoundingSphere(new THREE.Sphere());
 centre.copy(sphere.center);

@@ -42,8 +42,10 @@ Command AddProjectCommand(CLI::App& root) {
       app->add_option("--pixel-origin", args->pixel_origin, "convention of the printed pixels")
           ->check(CLI::IsMember({"center", "corner"}));
   return {app, [args, pixel_origin]() {
-            // Read once (ReadCameraFile's 1 MB bound) for the camera and its pixel convention.
-            const std::string camera_text = ReadWholeFile(args->camera_path, size_t{1} << 20);
+            // Read once for the camera and its pixel convention, under the readers' bounds:
+            // ReadCameraFile's 1 MB, ReadCalibrationView's 16 MB (hundreds of views).
+            const std::string camera_text = ReadWholeFile(
+                args->camera_path, args->view.empty() ? size_t{1} << 20 : size_t{16} << 20);
             const Camera camera =
                 args->view.empty()
                     ? CameraFromJsonText(camera_text, args->camera_path)

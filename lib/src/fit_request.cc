@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -498,8 +499,16 @@ std::string ClippedByPlane(bool near, double plane, bool given,
                     GeneralDouble(depth, 6));
   }
   if (clipped.size() > kNamed) names += Concat(" and ", clipped.size() - kNamed, " more");
+  // The bound in six digits, rounded away from the points (to nearest, --near 1.323749 read
+  // "give --near below 1.32375" for a point at 1.3237484).
+  const double depth = clipped.front().first;
+  double bound = std::stod(GeneralDouble(depth, 6));
+  if (near ? bound > depth : bound < depth) {
+    const double step = std::pow(10.0, std::floor(std::log10(std::abs(depth))) - 5);
+    bound = std::stod(GeneralDouble(near ? bound - step : bound + step, 6));
+  }
   const std::string keep = Concat("give ", option, near ? " below " : " beyond ",
-                                  GeneralDouble(clipped.front().first, 6), " to draw them");
+                                  GeneralDouble(bound, 6), " to draw them");
   return Concat(which, " clips ", clipped.size(), " of the ", kept, " fitted points, ",
                 near ? "nearer" : "farther", " than it (", names,
                 "): an OpenGL render of this camera draws them nowhere; ",

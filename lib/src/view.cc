@@ -155,8 +155,9 @@ json PointJson(const Camera& camera, const PageFrame& in_page,
 // photo's texture coordinate (v up) and two triangles per cell. A pinhole camera needs one cell;
 // a lens gets kLensCells along the image's longer side, so that the photo's pixel is within
 // a fraction of a pixel of its ray between vertices. A vertex beyond the lens's fold (no ray) is
-// left out with its cells. `top` gets the vertices of the image's top row, `outline` of its
-// border in order round it (both in page coordinates, those with a ray).
+// left out with its cells. `top_edge_in_page`: the top row's vertices (its first unbroken run);
+// `outline_in_page`: the border as polylines round it, each unbroken (one closed loop, its first
+// vertex repeated at its end, where every border vertex has a ray).
 json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth) {
   constexpr int kLensCells = 48;
   const int w = camera.image_size.width;
@@ -193,15 +194,35 @@ json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth
       index.push_back({a, e, d});
     }
   }
-  json top = json::array(), outline = json::array();
-  const auto add = [&](json& to, int r, int c) {
-    if (const auto& p = vertex[r * (cols + 1) + c]) to.push_back(*p);
+  // The border as polylines, broken where a vertex has no ray (a lens folding inside the image):
+  // a missing stretch is not bridged by a chord the page would draw as the image's edge.
+  std::vector<std::pair<int, int>> border;
+  for (int c = 0; c < cols; ++c) border.emplace_back(0, c);
+  for (int r = 0; r < rows; ++r) border.emplace_back(r, cols);
+  for (int c = cols; c > 0; --c) border.emplace_back(rows, c);
+  for (int r = rows; r > 0; --r) border.emplace_back(r, 0);
+  const auto at = [&](std::pair<int, int> rc) -> const std::optional<json>& {
+    return vertex[rc.first * (cols + 1) + rc.second];
   };
-  for (int c = 0; c <= cols; ++c) add(top, 0, c);
-  for (int c = 0; c < cols; ++c) add(outline, 0, c);
-  for (int r = 0; r < rows; ++r) add(outline, r, cols);
-  for (int c = cols; c > 0; --c) add(outline, rows, c);
-  for (int r = rows; r >= 0; --r) add(outline, r, 0);
+  json outline = json::array(), top = json::array(), run = json::array();
+  // Start at a vertex after a missing one (or anywhere where none is), so that no run wraps.
+  const size_t m = border.size();
+  size_t start = 0;
+  for (size_t k = 0; k < m; ++k) {
+    if (at(border[k]) && !at(border[(k + m - 1) % m])) start = k;
+  }
+  const bool whole = std::all_of(border.begin(), border.end(), [&](auto rc) { return !!at(rc); });
+  for (size_t k = 0; k <= m; ++k) {
+    const std::optional<json>& p = at(border[(start + k) % m]);
+    if (p && (k < m || whole)) run.push_back(*p);
+    if ((!p || k == m) && run.size() > 1) outline.push_back(run);
+    if (!p || k == m) run = json::array();
+  }
+  for (int c = 0; c <= cols; ++c) {  // the top row, left to right, its first run
+    const std::optional<json>& p = vertex[c];
+    if (p) top.push_back(*p);
+    if (!p && !top.empty()) break;
+  }
   return {{"positions_in_page", positions}, {"uv", uv}, {"triangles", index},
           {"top_edge_in_page", top}, {"outline_in_page", outline}, {"through_lens", lens}};
 }
