@@ -162,6 +162,8 @@ void WriteUncertainty(const FitResult& fit, std::ostream& out) {
       out << "  strongly correlated: " << c.first << ", " << c.second << " ("
           << Format("%+.3f", c.correlation) << ")\n";
     }
+  } else if (!fit.no_uncertainty_why.empty()) {
+    out << "parameters: no uncertainty (" << fit.no_uncertainty_why << ")\n";
   } else {
     out << "parameters: no uncertainty (as many equations as unknowns and no --sigma given)\n";
   }

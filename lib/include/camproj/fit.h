@@ -401,14 +401,16 @@ struct FitResult {
   // Uncertainty: sigma used (given or estimated), covariance of the free parameters in the
   // order of free_parameters (pose as rotation_x/y/z_deg about the camera axes and eye_x/y/z in
   // world units; intrinsics in px), sigmas of every reported parameter, strong correlations.
-  // Least squares: pixel_sigma^2 (J^T J)^-1. A robust loss (perspective): the M-estimator's
-  // sandwich c (J^T W J)^-1, W the loss's weights rho'(|r_i|^2) at the answer and
-  // c = sum w_i^2 |r_i|^2 / (2 sum w_i) x 2N / (2N - p) (pixel_sigma^2 sum w_i^2 / sum w_i where
-  // given); pixel_sigma is then the residuals' median over a 2D Gaussian's, times
-  // sqrt(2N / (2N - p)), or the given one.
+  // Least squares: pixel_sigma^2 (J^T J)^-1. A robust loss (perspective): Huber's estimate for
+  // an M-estimator, v (J^T J)^-1 with v = K^2 E[psi^2] / E[psi']^2 (psi the loss's influence:
+  // fit/assess.cc, RobustVariancePx2), from the residuals or, given pixel_sigma, its Gaussian;
+  // an estimated pixel_sigma is then sqrt(v), the noise at which least squares would scatter as
+  // the robust fit does.
   double pixel_sigma = 0.0;
   bool pixel_sigma_estimated = true;
   bool covariance_available = false;
+  // Why there is no covariance where one was asked for (compute_uncertainty); empty otherwise.
+  std::string no_uncertainty_why;
   Eigen::MatrixXd covariance;
   std::vector<ParameterSigma> sigmas;
   std::vector<Correlation> strong_correlations;

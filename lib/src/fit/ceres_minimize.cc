@@ -55,6 +55,13 @@ class TraceCallback : public ceres::IterationCallback {
 
 }  // namespace
 
+std::unique_ptr<ceres::LossFunction> LossOf(const FitOptions& options) {
+  if (options.loss == LossType::kHuber) {
+    return std::make_unique<ceres::HuberLoss>(options.loss_scale_px);
+  }
+  return std::make_unique<ceres::CauchyLoss>(options.loss_scale_px);
+}
+
 CeresSummary MinimizeWithCeres(const std::vector<Eigen::Vector3d>& points,
                                const std::vector<Eigen::Vector2d>& pixels,
                                ceres::LossFunction* loss, const FitOptions& options,

@@ -5,6 +5,7 @@
 #ifndef CAMPROJ_SRC_FIT_CERES_MINIMIZE_H_
 #define CAMPROJ_SRC_FIT_CERES_MINIMIZE_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ struct CeresSummary {
   int iterations = 0;
   std::string termination;  // "CONVERGENCE: ..." in Ceres' words
 };
+
+// The robust loss `options` asks for (options.loss not kNone): ceres::HuberLoss or CauchyLoss
+// at options.loss_scale_px, applied to a point's squared residual (px^2).
+std::unique_ptr<ceres::LossFunction> LossOf(const FitOptions& options);
 
 // Minimizes sum over points of loss(|pixel(point) - observed|^2) (loss nullptr: plain least
 // squares) from *rotation, *center, *model (the normalized world, kCenter pixels) with options'

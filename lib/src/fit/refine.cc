@@ -238,48 +238,6 @@ RefinedCamera RefineWithoutLoss(const Scene& scene, const Start& start, const Fi
   return refined;
 }
 
-// The loss `options` asks for (not kNone).
-std::unique_ptr<ceres::LossFunction> LossOf(const FitOptions& options) {
-  return std::unique_ptr<ceres::LossFunction>(
-      options.loss == LossType::kHuber
-          ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale_px))
-          : new ceres::CauchyLoss(options.loss_scale_px));
-}
-
-// RefinedCamera::normal under a robust loss: every point's normal equations (one point each,
-// the same chart) weighted by rho'(s) at its squared residual s. Before session 44 the
-// covariance read every point at full weight and the noise from the raw sum of squares: on
-// data/projector/misclicked.csv (two mis-clicks of 120 and 180 px) huber:2 gave fx 1476 +- 801 px
-// for a true 1483.6, at a "pixel noise 38.9 px".
-void WeighByLoss(const Scene& scene, const FitOptions& options, RefinedCamera* refined) {
-  const std::unique_ptr<ceres::LossFunction> loss = LossOf(options);
-  refined->loss_weights.clear();
-  NormalEquations weighted;
-  std::vector<Eigen::Vector3d> point(1);
-  std::vector<Eigen::Vector2d> pixel(1);
-  for (size_t i = 0; i < scene.points.size(); ++i) {
-    point[0] = scene.points[i];
-    pixel[0] = scene.pixels[i];
-    NormalEquations one;
-    if (!ComputeNormalEquations(point, pixel, refined->rotation, refined->center, refined->model,
-                                &one)) {
-      refined->loss_weights.clear();
-      return;  // behind the camera: `normal` is empty, and the assessment refuses it
-    }
-    double rho[3];
-    loss->Evaluate(one.cost, rho);
-    if (weighted.jtj.size() == 0) {
-      weighted.jtj = ParamMatrix::Zero(one.jtj.rows(), one.jtj.cols());
-      weighted.jtr = ParamVector::Zero(one.jtr.size());
-    }
-    weighted.jtj += rho[1] * one.jtj;
-    weighted.jtr += rho[1] * one.jtr;
-    weighted.cost += one.cost;
-    refined->loss_weights.push_back(rho[1]);
-  }
-  refined->normal = weighted;
-}
-
 // With a robust loss: Ceres (MinimizeWithCeres), which the own LM does not replace there
 // (a robust loss reweights each point's residual).
 RefinedCamera RefineRobust(const Scene& scene, const Start& start, const FitOptions& options,
@@ -329,12 +287,8 @@ RefinedCamera RefineCamera(const Scene& scene, const Start& start, const FitOpti
     refined.termination = "not refined (closed-form start only)";
   }
   // A point behind the camera leaves them empty: the assessment refuses it.
-  if (options.loss == LossType::kNone) {
-    ComputeNormalEquations(scene.points, scene.pixels, refined.rotation, refined.center,
-                           refined.model, &refined.normal);
-  } else {
-    WeighByLoss(scene, options, &refined);
-  }
+  ComputeNormalEquations(scene.points, scene.pixels, refined.rotation, refined.center,
+                         refined.model, &refined.normal);
   return refined;
 }
 

@@ -28,13 +28,8 @@ struct RefinedCamera {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Model model;
   // ComputeNormalEquations at the camera (least squares: possibly one settling step before it);
-  // empty when a point is behind the camera, which the assessment refuses. With a robust loss,
-  // each point's J^T J and J^T r are weighted by the loss's rho'(|r|^2) at the camera (the IRLS
-  // weight: 1 within the loss's scale, falling beyond it: the information the robust fit draws
-  // from that point); `cost` stays the plain sum of squared residuals.
+  // empty when a point is behind the camera, which the assessment refuses.
   NormalEquations normal;
-  // With a robust loss: each point's rho'(|r|^2) at the camera, in input order; else empty.
-  std::vector<double> loss_weights;
   bool normal_predicted_step_back = false;  // LeastSquaresOutcome's
   int iterations = 0;
   std::string refiner;      // FitResult::refiner
