@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "camproj/errors.h"
+#include "photo.h"
 
 namespace camproj {
 namespace {
@@ -117,6 +118,47 @@ TEST(ImageHeaderTest, JpegExifOrientation) {
   claims[2 + 4 + 6 + 8] = 100;
   EXPECT_EQ(ReadImageHeader(claims, "a.jpg").exif_orientation, 1);
   EXPECT_EQ(ReadImageHeader(claims, "a.jpg").width, 37);
+}
+
+// A PNG's eXIf chunk (after IHDR, before IDAT) carries the orientation too.
+TEST(ImageHeaderTest, PngExifOrientation) {
+  const std::string png = Encoded(".png", 37, 11);
+  for (const bool big_endian : {false, true}) {
+    // The TIFF data WithExif builds for a JPEG, as an eXIf chunk (its CRC is not checked).
+    const std::string jpeg_with = WithExif(Encoded(".jpg", 1, 1), big_endian, {{0x0112, 3, 1, 6}});
+    const std::string tiff = jpeg_with.substr(2 + 4 + 6, jpeg_with.size() - Encoded(".jpg", 1, 1).size() - 4 - 6);
+    const uint32_t n = static_cast<uint32_t>(tiff.size());
+    const std::string chunk = std::string{static_cast<char>(n >> 24), static_cast<char>(n >> 16),
+                                          static_cast<char>(n >> 8), static_cast<char>(n)} +
+                              "eXIf" + tiff + std::string(4, '\0');
+    const std::string with = png.substr(0, 33) + chunk + png.substr(33);  // after IHDR's 25 bytes
+    const ImageHeader header = ReadImageHeader(with, "a.png");
+    EXPECT_EQ(header.exif_orientation, 6) << big_endian;
+    EXPECT_EQ(header.DisplayedWidth(), 11);
+    // Cut inside the chunk: upright, not a read beyond it.
+    EXPECT_EQ(ReadImageHeader(with.substr(0, 33 + 8 + 4), "a.png").exif_orientation, 1);
+  }
+}
+
+// A photo is decoded as OpenCV shows it: for each EXIF orientation the pixels OpenCV's own
+// decode turns (cv::IMREAD_COLOR applies it for these files) are DecodePhoto's, exactly.
+TEST(ImageHeaderTest, PhotosDecodeAsDisplayed) {
+  cv::Mat stored(11, 37, CV_8UC3);
+  cv::randu(stored, 0, 255);
+  std::vector<uchar> bytes;
+  ASSERT_TRUE(cv::imencode(".jpg", stored, bytes));
+  const std::string jpeg(bytes.begin(), bytes.end());
+  for (uint32_t orientation = 1; orientation <= 8; ++orientation) {
+    internal::Photo photo;
+    photo.path = "a.jpg";
+    photo.bytes = WithExif(jpeg, false, {{0x0112, 3, 1, orientation}});
+    photo.header = ReadImageHeader(photo.bytes, "a.jpg");
+    const cv::Mat ours = internal::DecodePhoto(photo);
+    const cv::Mat opencv = cv::imdecode(
+        cv::Mat(1, static_cast<int>(photo.bytes.size()), CV_8U, photo.bytes.data()), cv::IMREAD_COLOR);
+    ASSERT_EQ(ours.size(), opencv.size()) << orientation;
+    EXPECT_EQ(cv::norm(ours, opencv, cv::NORM_INF), 0.0) << orientation;
+  }
 }
 
 // Only the first bytes are read: a 30000^2 PNG's header alone gives its size.

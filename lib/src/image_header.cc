@@ -16,12 +16,10 @@ uint32_t BigEndian(std::string_view bytes, size_t at, int size) {
   return value;
 }
 
-// The Orientation of an APP1 segment's payload (after its length): "Exif\0\0", then a TIFF
-// header (byte order "II" or "MM", 42, IFD0's offset) whose IFD0 holds tag 0x0112 as one SHORT
-// (EXIF 2.32, 4.6.4). 1 for anything else or out of range.
-int ExifOrientation(std::string_view payload) {
-  if (payload.size() < 6 + 8 || payload.substr(0, 6) != std::string_view("Exif\0\0", 6)) return 1;
-  const std::string_view tiff = payload.substr(6);
+// The Orientation of EXIF data: a TIFF header (byte order "II" or "MM", 42, IFD0's offset) whose
+// IFD0 holds tag 0x0112 as one SHORT (EXIF 2.32, 4.6.4). 1 for anything else or out of range.
+int TiffOrientation(std::string_view tiff) {
+  if (tiff.size() < 8) return 1;
   const bool little = tiff.substr(0, 2) == "II";
   if (!little && tiff.substr(0, 2) != "MM") return 1;
   const auto read = [&](size_t at, int size) -> uint32_t {
@@ -43,6 +41,27 @@ int ExifOrientation(std::string_view payload) {
     if (read(at + 2, 2) != 3 || read(at + 4, 4) != 1) return 1;  // one SHORT
     const uint32_t orientation = read(at + 8, 2);
     return orientation >= 1 && orientation <= 8 ? static_cast<int>(orientation) : 1;
+  }
+  return 1;
+}
+
+// The Orientation of a JPEG's APP1 payload (after its length): "Exif\0\0", then TIFF data.
+int ExifOrientation(std::string_view payload) {
+  if (payload.size() < 6 || payload.substr(0, 6) != std::string_view("Exif\0\0", 6)) return 1;
+  return TiffOrientation(payload.substr(6));
+}
+
+// The Orientation of a PNG's eXIf chunk (PNG 1.5 extensions: TIFF data, before IDAT), 1 without
+// one. Chunks are walked by their lengths from the one after IHDR.
+int PngOrientation(std::string_view bytes) {
+  size_t at = 8;  // the signature
+  while (at + 8 <= bytes.size()) {
+    const size_t length = BigEndian(bytes, at, 4);
+    const std::string_view type = bytes.substr(at + 4, 4);
+    if (type == "IDAT" || type == "IEND" || length > bytes.size() - at - 8) return 1;
+    if (type == "eXIf") return TiffOrientation(bytes.substr(at + 8, length));
+    if (bytes.size() - at - 8 - length < 4) return 1;  // its CRC cut off
+    at += 12 + length;
   }
   return 1;
 }
@@ -167,7 +186,9 @@ ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source) {
       throw InputError(source + ": the PNG header states an invalid size " + std::to_string(width) +
                        "x" + std::to_string(height));
     }
-    return {ImageFormat::kPng, static_cast<int>(width), static_cast<int>(height)};
+    ImageHeader header{ImageFormat::kPng, static_cast<int>(width), static_cast<int>(height)};
+    header.exif_orientation = PngOrientation(bytes);
+    return header;
   }
   if (bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0xff &&
       static_cast<unsigned char>(bytes[1]) == 0xd8) {

@@ -46,14 +46,29 @@ Photo ReadPhoto(const std::string& path, int width, int height) {
 cv::Mat DecodePhoto(const Photo& photo) {
   cv::Mat image;
   try {
+    // Decoded as stored, then turned by the header's orientation: OpenCV's own EXIF reading
+    // takes a JPEG's first APP1 whatever it holds and any type of the tag, where camproj's
+    // header and browsers take the Exif one and a SHORT (an XMP segment before the EXIF one
+    // made overlay refuse a photo its header accepted).
     image = DecodeImage(cv::Mat(1, static_cast<int>(photo.bytes.size()), CV_8U,
                                 const_cast<char*>(photo.bytes.data())),
-                        cv::IMREAD_COLOR);
+                        cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
     throw InputError(photo.path + ": cannot decode the image: " + e.what());
   }
   if (image.empty()) {
     throw InputError(photo.path + ": cannot decode the image (corrupt or unsupported)");
+  }
+  // EXIF 2.32, 4.6.4 (as OpenCV's ExifTransform applies them).
+  switch (photo.header.exif_orientation) {
+    case 2: cv::flip(image, image, 1); break;
+    case 3: cv::flip(image, image, -1); break;
+    case 4: cv::flip(image, image, 0); break;
+    case 5: cv::transpose(image, image); break;
+    case 6: cv::transpose(image, image); cv::flip(image, image, 1); break;
+    case 7: cv::transpose(image, image); cv::flip(image, image, -1); break;
+    case 8: cv::transpose(image, image); cv::flip(image, image, 0); break;
+    default: break;
   }
   if (image.cols != photo.header.DisplayedWidth() || image.rows != photo.header.DisplayedHeight()) {
     throw InputError(Concat(photo.path, ": image decodes to ", image.cols, "x", image.rows,

@@ -26,8 +26,8 @@ struct Photo {
 // (RequireWholeImage); the file's own errors as ReadWholeFile throws them.
 Photo ReadPhoto(const std::string& path, int width, int height);
 
-// The photo's pixels as displayed, 8-bit BGR (cv::IMREAD_COLOR: OpenCV applies the EXIF
-// orientation). Throws InputError naming the path if OpenCV cannot decode it, or decodes it to
+// The photo's pixels as displayed, 8-bit BGR: decoded as stored and turned by the header's EXIF
+// orientation. Throws InputError naming the path if OpenCV cannot decode it, or decodes it to
 // another size than the header's as displayed.
 cv::Mat DecodePhoto(const Photo& photo);
 

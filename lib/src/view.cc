@@ -311,8 +311,8 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
   return scene;
 }
 
-// The photo as displayed (photo.h). A JPEG with an EXIF orientation is decoded (OpenCV turns it)
-// and embedded re-encoded (JPEG, OpenCV's quality 95) without one: the page's <img> applies the
+// The photo as displayed (photo.h). A photo with an EXIF orientation is decoded, turned, and
+// embedded re-encoded without one (a PNG as PNG, a JPEG at OpenCV's quality 95): the page's <img> applies the
 // orientation but a WebGL texture need not, and the two views must show the pixels camproj
 // overlay draws on. Before session 44 a JPEG turned a quarter was refused by its stored size and
 // one turned half round was embedded as stored.
@@ -324,13 +324,14 @@ json ImageJson(const std::string& path, const Camera& camera) {
     return {{"name", path},
             {"data_url", std::string("data:") + mime + ";base64," + Base64(photo.bytes)}};
   }
+  const bool png = photo.header.format == ImageFormat::kPng;
   std::vector<uchar> upright;
-  if (!internal::EncodeImage(".jpg", internal::DecodePhoto(photo), &upright)) {
+  if (!internal::EncodeImage(png ? ".png" : ".jpg", internal::DecodePhoto(photo), &upright)) {
     throw InputError(path + ": cannot re-encode the photo turned upright");
   }
   return {{"name", path},
           {"exif_orientation", photo.header.exif_orientation},
-          {"data_url", "data:image/jpeg;base64," +
+          {"data_url", std::string(png ? "data:image/png" : "data:image/jpeg") + ";base64," +
                            Base64(std::string_view(reinterpret_cast<const char*>(upright.data()),
                                                    upright.size()))}};
 }

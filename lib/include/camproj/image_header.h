@@ -18,10 +18,11 @@ struct ImageHeader {
   ImageFormat format = ImageFormat::kPng;
   int width = 0;   // px, as stored (before any EXIF orientation)
   int height = 0;  // px
-  // A JPEG's EXIF Orientation (TIFF tag 0x0112 in IFD0 of an APP1 "Exif" segment before the
-  // frame header): 1 upright, 2-4 mirrored or turned 180 degrees, 5-8 turned a quarter (the
-  // image is displayed height x width). 1 where absent, unreadable, or out of 1-8, and for a PNG.
-  // OpenCV's decoder and browsers apply it: camproj shows photos as displayed.
+  // The EXIF Orientation (TIFF tag 0x0112 in IFD0) of a JPEG's first APP1 "Exif" segment before
+  // its frame header, or of a PNG's eXIf chunk: 1 upright, 2-4 mirrored or turned 180 degrees,
+  // 5-8 turned a quarter (the image is displayed height x width). 1 where absent, unreadable, or
+  // out of 1-8. Browsers apply it, and camproj shows photos as displayed (photo.h: by this value,
+  // not OpenCV's own reading, which differs on odd files).
   int exif_orientation = 1;
   bool Turned() const { return exif_orientation >= 5; }  // displayed as height x width
   int DisplayedWidth() const { return Turned() ? height : width; }
@@ -29,7 +30,7 @@ struct ImageHeader {
 };
 
 // The format and size stated by the file's first bytes: a PNG's IHDR chunk, or a JPEG's first
-// start-of-frame segment (any SOFn), with a JPEG's EXIF orientation. `source` names the bytes in messages. Throws InputError
+// start-of-frame segment (any SOFn), with the EXIF orientation. `source` names the bytes in messages. Throws InputError
 // naming `source` if the bytes are neither format, or the header is cut short or states a zero
 // size. Reads only the header: cost and memory do not depend on the stated size.
 ImageHeader ReadImageHeader(std::string_view bytes, const std::string& source);
