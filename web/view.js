@@ -260,17 +260,19 @@ function LargestSide() {
 let throughScale = 1;
 function SizeThroughBuffer() {
   const gl = renderer.getContext();
+  // Whole pixels (pixel ratio 1): a fractional ratio left three.js's viewport a pixel short of
+  // the buffer after setRenderTarget(null), which floors it.
+  renderer.setPixelRatio(1);
   let r = Math.min(1, LargestSide() / Math.max(W, H));
   for (let attempt = 0; attempt < 3; ++attempt) {
-    renderer.setPixelRatio(r);
-    renderer.setSize(W, H, false);
-    const bw = gl.drawingBufferWidth, bh = gl.drawingBufferHeight;
-    if (bw === renderer.domElement.width && bh === renderer.domElement.height) break;
-    r = Math.min(r, bw / W, bh / H);  // the browser gave less: ask for what it gave
+    const bw = Math.max(1, Math.round(W * r)), bh = Math.max(1, Math.round(H * r));
+    renderer.setSize(bw, bh, false);
+    if (gl.drawingBufferWidth === bw && gl.drawingBufferHeight === bh) break;
+    // The browser gave less (its cap on a canvas's area): ask for what it gave.
+    r = Math.min(r, gl.drawingBufferWidth / W, gl.drawingBufferHeight / H);
   }
   throughScale = r;
-  // The viewport is the buffer the browser made, exactly (three.js rounds W * r on its own).
-  renderer.setViewport(0, 0, gl.drawingBufferWidth / r, gl.drawingBufferHeight / r);
+  renderer.setViewport(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight);
   if (r < 1 && !document.getElementById('scaled-note')) {
     const note = document.createElement('div');
     note.id = 'scaled-note';
@@ -491,14 +493,14 @@ function Report() {
 
 // ---- Test mode (#camproj-test; tests/view_browser_test.cc): the view through the camera, each
 // point rendered alone as a Gaussian spot (sigma 2 px, in a 17 px sprite: the tail cut at the
-// sprite's edge moves the centroid by < 1e-3 px) into an image-sized target (the image scaled to
-// LargestSide where it is larger, as the view through the camera is); the centroid of the
-// read-back intensities, in kCenter image pixels, is where three.js put the point.
+// sprite's edge moves the centroid by < 1e-3 px) into the page's own canvas as the view through
+// the camera sized it (SizeThroughBuffer: the image, or the image scaled to the browser's
+// largest canvas); the centroid of the read-back intensities, in kCenter image pixels, is where
+// three.js put the point.
 function MeasureThrough() {
   const kSize = 17, kSigma = 2.0, kHalf = 16, n = 2 * kHalf + 1;
-  const r = Math.min(1, LargestSide() / Math.max(W, H));
-  const TW = Math.max(1, Math.round(W * r)), TH = Math.max(1, Math.round(H * r));
-  const target = new THREE.WebGLRenderTarget(TW, TH, { depthBuffer: false });
+  const gl = renderer.getContext();
+  const TW = gl.drawingBufferWidth, TH = gl.drawingBufferHeight;
   const material = new THREE.ShaderMaterial({
     vertexShader: `void main() {
       gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
@@ -525,14 +527,13 @@ function MeasureThrough() {
     projected.fromArray(p.point_in_page).project(throughCamera);
     const xw = (projected.x + 1) / 2 * W, yw = (projected.y + 1) / 2 * H;
     result.three_math = [xw - 0.5, H - yw - 0.5];
-    const xt = xw * TW / W, yt = yw * TH / H;  // in the target's pixels
+    const xt = xw * TW / W, yt = yw * TH / H;  // in the canvas's pixels
     if (!(xt > kHalf && xt < TW - kHalf && yt > kHalf && yt < TH - kHalf)) continue;  // at the edge
     position.setXYZ(0, ...p.point_in_page);
     position.needsUpdate = true;
-    renderer.setRenderTarget(target);
     renderer.render(alone, throughCamera);
     const x0 = Math.floor(xt) - kHalf, y0 = Math.floor(yt) - kHalf;
-    renderer.readRenderTargetPixels(target, x0, y0, n, n, buffer);
+    gl.readPixels(x0, y0, n, n, gl.RGBA, gl.UNSIGNED_BYTE, buffer);
     let mass = 0, sx = 0, sy = 0;
     for (let j = 0; j < n; ++j) {
       for (let i = 0; i < n; ++i) {
@@ -542,14 +543,12 @@ function MeasureThrough() {
     }
     result.mass = mass;
     if (mass > 0) {
-      // Target pixels -> window (x up from the bottom) -> kCenter: u = x - 0.5, v = H - y - 0.5.
+      // Canvas pixels -> window (x up from the bottom) -> kCenter: u = x - 0.5, v = H - y - 0.5.
       result.u = sx / mass * W / TW - 0.5;
       result.v = H - sy / mass * H / TH - 0.5;
     }
   }
   results.target_size = [TW, TH];
-  renderer.setRenderTarget(null);
-  target.dispose();
   return results;
 }
 
