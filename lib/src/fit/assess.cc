@@ -109,6 +109,19 @@ std::optional<double> RobustVariancePx2(const FitOptions& options,
   };
   const int n = static_cast<int>(norms.size());
   const double components = 2.0 * n;
+  // A redescending (Cauchy) loss whose scale is far below the residuals seeks a mode the
+  // asymptotics do not describe. Measured over 100 `camproj synth` scenes of 30 points at 1 px
+  // noise, median residual 1.2 px (the RMS of error / sigma, 1 for calibrated sigmas; least
+  // squares 1.04-1.14): Cauchy at 0.1 px 9.8 and at 0.5 px 1.35-1.63, hence the bound (2.4
+  // scales at 0.5); Cauchy 1 and 2 px 1.04-1.18; Huber 0.1, 0.2, 0.5 and 2 px 1.03-1.34 (Huber
+  // is convex: one minimum, whatever its scale). A given noise's median residual is
+  // kRayleighMedian sigma.
+  const double median_px = options.pixel_sigma ? kRayleighMedian * *options.pixel_sigma
+                                               : Median(norms);
+  if (options.loss == LossType::kCauchy &&
+      !(median_px <= kMaxCauchyMedianScales * options.loss_scale_px)) {
+    return std::nullopt;
+  }
   if (options.pixel_sigma) {
     // E over t ~ Exp(1) by the trapezoid rule on [0, 50] (e^-50 ~ 2e-22 beyond).
     constexpr int kSteps = 5000;
@@ -138,16 +151,6 @@ std::optional<double> RobustVariancePx2(const FitOptions& options,
   }
   const double m = slope_sum / components;
   if (!(m > 0.0) || !(dof > 0.0)) return std::nullopt;
-  // A redescending (Cauchy) loss whose scale is far below the residuals seeks a mode the
-  // asymptotics do not describe. Measured over 100 `camproj synth` scenes of 30 points at 1 px
-  // noise, median residual 1.2 px (the RMS of error / sigma, 1 for calibrated sigmas; least
-  // squares 1.04-1.14): Cauchy at 0.1 px 9.8 and at 0.5 px 1.35-1.63, hence the bound (2.4
-  // scales at 0.5); Cauchy 1 and 2 px 1.04-1.18; Huber 0.1, 0.2, 0.5 and 2 px 1.03-1.34 (Huber
-  // is convex: one minimum, whatever its scale).
-  if (options.loss == LossType::kCauchy &&
-      !(Median(norms) <= kMaxCauchyMedianScales * options.loss_scale_px)) {
-    return std::nullopt;
-  }
   const double slope_variance = std::max(0.0, slope_squares / components - m * m);
   const double k = 1.0 + num_params / components * slope_variance / (m * m);
   return k * k * (psi2 / dof) / (m * m);
@@ -454,9 +457,9 @@ FitResult AssessFit(const Scene& scene, const std::string& start_method, Refined
     have_sigma = robust.has_value();
     if (!robust) {
       result.no_uncertainty_why =
-          "the Cauchy loss's scale is far below the residuals (their median more than 2 "
-          "scales), and the fit a mode of them that sigmas cannot describe: a scale about the "
-          "pixel noise gives them";
+          "the robust loss's scale is far below the residuals (a Cauchy loss: their median, or "
+          "a given noise's, more than 2 scales), and the fit a mode of them that sigmas cannot "
+          "describe: a scale about the pixel noise gives them";
     } else {
       variance_px2 = *robust;
       if (!options.pixel_sigma) result.pixel_sigma = std::sqrt(variance_px2);
