@@ -260,8 +260,8 @@ function LargestSide() {
 let throughScale = 1;
 function SizeThroughBuffer() {
   const gl = renderer.getContext();
-  // Whole pixels (pixel ratio 1): a fractional ratio left three.js's viewport a pixel short of
-  // the buffer after setRenderTarget(null), which floors it.
+  // Whole pixels (pixel ratio 1): with a fractional ratio three.js rounds the viewport in one
+  // place and floors it in another (setRenderTarget(null)), a pixel short of the buffer.
   renderer.setPixelRatio(1);
   let r = Math.min(1, LargestSide() / Math.max(W, H));
   for (let attempt = 0; attempt < 3; ++attempt) {
@@ -548,8 +548,7 @@ function MeasureThrough() {
       result.v = H - sy / mass * H / TH - 0.5;
     }
   }
-  results.target_size = [TW, TH];
-  return results;
+  return { points: results, target_size: [TW, TH] };
 }
 
 Report();
@@ -558,7 +557,7 @@ if (kTestMode) {
   SetMode('through');
   const measured = MeasureThrough();
   const result = { three_revision: THREE.REVISION, image_size: [W, H],
-                   webgl2: renderer.capabilities.isWebGL2, points: measured,
+                   webgl2: renderer.capabilities.isWebGL2, points: measured.points,
                    target_size: measured.target_size, through_scale: throughScale };
   Render();
   document.getElementById('camproj-test-result').textContent = JSON.stringify(result);

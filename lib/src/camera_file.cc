@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -353,31 +354,21 @@ Camera CameraFromJsonText(const std::string& text, const std::string& source) {
   return CameraFromDocument(document, Reader(source));
 }
 
-PixelOrigin CameraFilePixelOrigin(const std::string& text, const std::string& source,
-                                  const std::string& view) {
-  if (view.empty()) return ReadPixelOrigin(ParseJson(text, source), Reader(source));
-  CalibrationViewFromJsonText(text, source, view);  // its refusals, if any
-  const json document = ParseJson(text, source);
-  for (const json& entry : document.at("views")) {
-    if (entry.is_object() && entry.contains("name") && entry.at("name") == view) {
-      const Reader reader(source + ", view " + ShortName(view));
-      return ReadPixelOrigin(reader.Member(entry, "", "camera"), reader);
-    }
-  }
-  return PixelOrigin::kCenter;  // not reached: CalibrationViewFromJsonText found the view
-}
-
-Camera CalibrationViewFromJsonText(const std::string& text, const std::string& source,
-                                   const std::string& view) {
-  const json document = ParseJson(text, source);
+// The `camera` object of the entry of a calibration file's `views` named `view`, and the reader
+// whose messages name it ("SOURCE, view NAME"). Throws InputError as CalibrationViewFromJsonText
+// says.
+std::pair<const json*, Reader> CalibrationViewCamera(const json& document,
+                                                     const std::string& source,
+                                                     const std::string& view) {
   if (!IsCalibrationFile(document)) {
     throw InputError(source + ": not a calibration file (no views array): a view is selected "
                               "only in the file camproj calibrate writes");
   }
   for (const json& entry : document.at("views")) {
     if (entry.is_object() && entry.contains("name") && entry.at("name") == view) {
-      const Reader reader(source + ", view " + ShortName(view));
-      return CameraFromDocument(reader.Member(entry, "", "camera"), reader);
+      Reader reader(source + ", view " + ShortName(view));
+      const json* camera = &reader.Member(entry, "", "camera");
+      return {camera, std::move(reader)};
     }
   }
   const std::vector<std::string> refused = ViewNames(document, "refused_views");
@@ -394,6 +385,21 @@ Camera CalibrationViewFromJsonText(const std::string& text, const std::string& s
   if (names.size() > kMaxListed) listed += ", ... (" + std::to_string(names.size()) + " in all)";
   throw InputError(source + ": no view named " + ShortName(view) + "; the views are " +
                    (listed.empty() ? "none" : listed));
+}
+
+PixelOrigin CameraFilePixelOrigin(const std::string& text, const std::string& source,
+                                  const std::string& view) {
+  const json document = ParseJson(text, source);
+  if (view.empty()) return ReadPixelOrigin(document, Reader(source));
+  const auto [camera, reader] = CalibrationViewCamera(document, source, view);
+  return ReadPixelOrigin(*camera, reader);
+}
+
+Camera CalibrationViewFromJsonText(const std::string& text, const std::string& source,
+                                   const std::string& view) {
+  const json document = ParseJson(text, source);
+  const auto [camera, reader] = CalibrationViewCamera(document, source, view);
+  return CameraFromDocument(*camera, reader);
 }
 
 Camera ReadCalibrationView(const std::string& path, const std::string& view) {

@@ -166,9 +166,9 @@ json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth
   const int cols = lens ? (w >= h ? kLensCells : std::max(2, kLensCells * w / h)) : 1;
   const int rows = lens ? (h >= w ? kLensCells : std::max(2, kLensCells * h / w)) : 1;
   const Rigid3 world_from_cam = Inverse(camera.cam_from_world);
-  std::vector<std::optional<json>> vertex((cols + 1) * (rows + 1));
   json positions = json::array(), uv = json::array(), index = json::array();
-  std::vector<int> slot(vertex.size(), -1);
+  // Each grid vertex's index in `positions`, -1 where it has no ray.
+  std::vector<int> slot((cols + 1) * (rows + 1), -1);
   for (int r = 0; r <= rows; ++r) {
     for (int c = 0; c <= cols; ++c) {
       const double s = static_cast<double>(c) / cols, t = static_cast<double>(r) / rows;
@@ -177,7 +177,6 @@ json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth
         const json p = in_page(world_from_cam *
                                PointInCamAtDepth(camera, camera.intrinsics, pixel, depth));
         slot[r * (cols + 1) + c] = static_cast<int>(positions.size());
-        vertex[r * (cols + 1) + c] = p;
         positions.push_back(p);
         uv.push_back({s, 1.0 - t});
       } catch (const std::domain_error&) {
@@ -201,25 +200,29 @@ json ImagePlaneJson(const Camera& camera, const PageFrame& in_page, double depth
   for (int r = 0; r < rows; ++r) border.emplace_back(r, cols);
   for (int c = cols; c > 0; --c) border.emplace_back(rows, c);
   for (int r = rows; r > 0; --r) border.emplace_back(r, 0);
-  const auto at = [&](std::pair<int, int> rc) -> const std::optional<json>& {
-    return vertex[rc.first * (cols + 1) + rc.second];
+  // The vertex at (row, column), or null where it has no ray.
+  const auto at = [&](int r, int c) -> const json* {
+    const int k = slot[r * (cols + 1) + c];
+    return k < 0 ? nullptr : &positions[k];
   };
   json outline = json::array(), top = json::array(), run = json::array();
   // Start at a vertex after a missing one (or anywhere where none is), so that no run wraps.
   const size_t m = border.size();
   size_t start = 0;
+  const auto on_border = [&](size_t k) { return at(border[k % m].first, border[k % m].second); };
   for (size_t k = 0; k < m; ++k) {
-    if (at(border[k]) && !at(border[(k + m - 1) % m])) start = k;
+    if (on_border(k) && !on_border(k + m - 1)) start = k;
   }
-  const bool whole = std::all_of(border.begin(), border.end(), [&](auto rc) { return !!at(rc); });
+  bool whole = true;
+  for (size_t k = 0; k < m; ++k) whole = whole && on_border(k) != nullptr;
   for (size_t k = 0; k <= m; ++k) {
-    const std::optional<json>& p = at(border[(start + k) % m]);
+    const json* p = on_border(start + k);
     if (p && (k < m || whole)) run.push_back(*p);
     if ((!p || k == m) && run.size() > 1) outline.push_back(run);
     if (!p || k == m) run = json::array();
   }
   for (int c = 0; c <= cols; ++c) {  // the top row, left to right, its first run
-    const std::optional<json>& p = vertex[c];
+    const json* p = at(0, c);
     if (p) top.push_back(*p);
     if (!p && !top.empty()) break;
   }
@@ -300,7 +303,7 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
                 {"page_origin_in_world", Vec(in_page.origin_in_world)},
                 {"eye_in_page", in_page(Inverse(camera.cam_from_world).translation)},
                 {"frustum", FrustumJson(camera, in_page, median_depth, max_depth)},
-          {"image_depth_is_median", !depths.empty()},
+                {"image_depth_is_median", !depths.empty()},
                 {"points", points},
                 {"notes", notes}};
   ExportOptions export_options;  // depth "no": WebGLRenderer's clip volume
@@ -312,28 +315,27 @@ json SceneJson(const Camera& camera, const PageFrame& in_page,
 }
 
 // The photo as displayed (photo.h). A photo with an EXIF orientation is decoded, turned, and
-// embedded re-encoded without one (a PNG as PNG, a JPEG at OpenCV's quality 95): the page's <img> applies the
-// orientation but a WebGL texture need not, and the two views must show the pixels camproj
-// overlay draws on. Before session 44 a JPEG turned a quarter was refused by its stored size and
-// one turned half round was embedded as stored.
+// embedded re-encoded without one (a PNG as PNG, a JPEG at OpenCV's quality 95): the page's
+// <img> applies the orientation but a WebGL texture need not, and the two views must show the
+// pixels camproj overlay draws on. Before session 44 a JPEG turned a quarter was refused by its
+// stored size and one turned half round was embedded as stored.
 json ImageJson(const std::string& path, const Camera& camera) {
   const internal::Photo photo =
       internal::ReadPhoto(path, camera.image_size.width, camera.image_size.height);
-  if (photo.header.exif_orientation == 1) {
-    const char* mime = photo.header.format == ImageFormat::kPng ? "image/png" : "image/jpeg";
-    return {{"name", path},
-            {"data_url", std::string("data:") + mime + ";base64," + Base64(photo.bytes)}};
-  }
   const bool png = photo.header.format == ImageFormat::kPng;
+  const std::string data_url =
+      std::string("data:") + (png ? "image/png" : "image/jpeg") + ";base64,";
+  if (photo.header.exif_orientation == 1) {
+    return {{"name", path}, {"data_url", data_url + Base64(photo.bytes)}};
+  }
   std::vector<uchar> upright;
   if (!internal::EncodeImage(png ? ".png" : ".jpg", internal::DecodePhoto(photo), &upright)) {
     throw InputError(path + ": cannot re-encode the photo turned upright");
   }
+  const std::string_view bytes(reinterpret_cast<const char*>(upright.data()), upright.size());
   return {{"name", path},
           {"exif_orientation", photo.header.exif_orientation},
-          {"data_url", std::string(png ? "data:image/png" : "data:image/jpeg") + ";base64," +
-                           Base64(std::string_view(reinterpret_cast<const char*>(upright.data()),
-                                                   upright.size()))}};
+          {"data_url", data_url + Base64(bytes)}};
 }
 
 json MeshJson(const std::string& path, const PageFrame& in_page, ViewStats& stats) {
